@@ -1,0 +1,259 @@
+"""The one PTZ camera model: poses, homographies, the head/feet homology, Jacobians.
+
+Conventions
+-----------
+World frame: metres, the ground is the plane z = 0, z points up.
+Camera frame: OpenCV's (x right, y down, z along the optical axis).
+A pose is an array ``(..., 3)`` holding ``(pan_deg, tilt_deg, zoom)``:
+
+* ``pan_deg`` turns about the vertical axis; 0 looks along world +y and a
+  positive pan turns towards +x (clockwise seen from above);
+* ``tilt_deg`` is the depression of the optical axis below the horizon, so a
+  positive tilt looks down;
+* ``zoom = f / f_min``; the focal length in pixels is ``zoom * f_min_px``.
+
+The camera turns about its own optical centre (no roll, no offset), which is
+the model of both a real PTZ head and the paper's virtual camera. Every
+function broadcasts over leading axes: ``poses`` of shape ``(*P, 3)`` go with
+ground points of shape ``(*P, N, 2)`` (or anything that broadcasts to it).
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+PAN, TILT, ZOOM = 0, 1, 2
+
+
+@dataclass(frozen=True)
+class PTZCamera:
+    """A PTZ camera mounted at a known position above the ground.
+
+    Attributes
+    ----------
+    position_m : (3,) optical centre (x, y, z) in world metres, z > 0.
+    image_width_px, image_height_px : image size; the principal point is its centre.
+    f_min_px : focal length in pixels at zoom 1 (the widest view).
+    """
+
+    position_m: tuple[float, float, float]
+    image_width_px: int
+    image_height_px: int
+    f_min_px: float
+
+    @property
+    def centre_m(self) -> np.ndarray:
+        return np.asarray(self.position_m, dtype=float)
+
+    @property
+    def principal_point_px(self) -> np.ndarray:
+        return np.array([self.image_width_px / 2.0, self.image_height_px / 2.0])
+
+
+def rotation_world_to_camera(pan_deg, tilt_deg) -> np.ndarray:
+    """Rotation ``R`` with ``X_cam = R (X_world - C)``; shape ``(*P, 3, 3)``.
+
+    Its rows are the camera's right, down and forward axes in world coordinates.
+    """
+    pan = np.deg2rad(np.asarray(pan_deg, dtype=float))
+    tilt = np.deg2rad(np.asarray(tilt_deg, dtype=float))
+    cp, sp, ct, st = np.cos(pan), np.sin(pan), np.cos(tilt), np.sin(tilt)
+    zero = np.zeros_like(pan)
+    right = np.stack([cp, -sp, zero], axis=-1)
+    forward = np.stack([ct * sp, ct * cp, -st * np.ones_like(pan)], axis=-1)
+    down = np.cross(forward, right)
+    return np.stack([right, down, forward], axis=-2)
+
+
+def intrinsics(camera: PTZCamera, zoom) -> np.ndarray:
+    """Intrinsic matrix ``K`` at the given zoom; shape ``(*P, 3, 3)``."""
+    focal_px = np.asarray(zoom, dtype=float) * camera.f_min_px
+    cx, cy = camera.principal_point_px
+    K = np.zeros(focal_px.shape + (3, 3))
+    K[..., 0, 0] = focal_px
+    K[..., 1, 1] = focal_px
+    K[..., 0, 2] = cx
+    K[..., 1, 2] = cy
+    K[..., 2, 2] = 1.0
+    return K
+
+
+def projection_matrix(camera: PTZCamera, poses) -> np.ndarray:
+    """World-to-image projection ``P = K R [I | -C]``; shape ``(*P, 3, 4)``."""
+    poses = np.asarray(poses, dtype=float)
+    R = rotation_world_to_camera(poses[..., PAN], poses[..., TILT])
+    K = intrinsics(camera, poses[..., ZOOM])
+    KR = K @ R
+    translation = -KR @ camera.centre_m
+    return np.concatenate([KR, translation[..., None]], axis=-1)
+
+
+def plane_homography(camera: PTZCamera, poses, height_m=0.0) -> np.ndarray:
+    """Homography from the horizontal plane ``z = height_m`` to the image.
+
+    Maps ``(x, y, 1)`` on that plane to homogeneous pixels; shape ``(*P, 3, 3)``.
+    ``height_m`` broadcasts against the pose axes.
+    """
+    P = projection_matrix(camera, poses)
+    height_m = np.asarray(height_m, dtype=float)[..., None]
+    return np.stack([P[..., 0], P[..., 1], P[..., 3] + height_m * P[..., 2]], axis=-1)
+
+
+def ground_to_image(camera: PTZCamera, poses) -> np.ndarray:
+    """The ground-plane homography ``g`` of the paper; shape ``(*P, 3, 3)``."""
+    return plane_homography(camera, poses, 0.0)
+
+
+def image_to_ground(camera: PTZCamera, poses) -> np.ndarray:
+    """Inverse of :func:`ground_to_image`; shape ``(*P, 3, 3)``."""
+    return np.linalg.inv(ground_to_image(camera, poses))
+
+
+def apply_homography(H, points) -> np.ndarray:
+    """Map 2-D points through homographies.
+
+    H : (*P, 3, 3); points : (*P, N, 2). Returns (*P, N, 2). Points that map
+    to the line at infinity come out as inf or nan.
+    """
+    points = np.asarray(points, dtype=float)
+    homogeneous = H[..., None, :, :2] @ points[..., :, None] + H[..., None, :, 2:]
+    homogeneous = homogeneous[..., 0]
+    return homogeneous[..., :2] / homogeneous[..., 2:]
+
+
+def head_from_feet_homology(camera: PTZCamera, poses, height_m) -> np.ndarray:
+    """The homology ``W`` mapping a feet pixel to the head pixel of a person
+    ``height_m`` tall standing there: ``W = H_h H_0^-1``; shape ``(*P, 3, 3)``."""
+    return plane_homography(camera, poses, height_m) @ image_to_ground(camera, poses)
+
+
+def feet_jacobian(camera: PTZCamera, poses, ground_xy) -> np.ndarray:
+    """Jacobian of the feet pixel ``(u, v)`` with respect to the ground point ``(x, y)``.
+
+    The position block of the EKF's observation matrix ``C_x(a)``.
+    ground_xy : (*P, N, 2) metres. Returns (*P, N, 2, 2) in pixels per metre,
+    rows (u, v), columns (x, y).
+    """
+    H = ground_to_image(camera, poses)[..., None, :, :]
+    ground_xy = np.asarray(ground_xy, dtype=float)
+    homogeneous = H[..., :, :2] @ ground_xy[..., :, None] + H[..., :, 2:]
+    w = homogeneous[..., 2, :]
+    pixel = homogeneous[..., :2, :] / w[..., None, :]
+    return (H[..., :2, :2] - pixel * H[..., 2:, :2]) / w[..., None, :]
+
+
+def camera_depth_m(camera: PTZCamera, poses, points_m) -> np.ndarray:
+    """Depth along the optical axis of world points (*P, N, 3); returns (*P, N)."""
+    poses = np.asarray(poses, dtype=float)
+    R = rotation_world_to_camera(poses[..., PAN], poses[..., TILT])
+    forward = R[..., 2, :]
+    return np.sum((np.asarray(points_m, dtype=float) - camera.centre_m) * forward[..., None, :], axis=-1)
+
+
+@dataclass(frozen=True)
+class ProjectedPeople:
+    """Standing people seen at a pose; leading axes ``(*P, N)``.
+
+    feet_px, head_px : (*P, N, 2) pixels.
+    box_px : (*P, N, 4) as (left, top, right, bottom) pixels.
+    depth_m : (*P, N) depth of the feet along the optical axis (> 0 in front).
+    """
+
+    feet_px: np.ndarray
+    head_px: np.ndarray
+    box_px: np.ndarray
+    depth_m: np.ndarray
+
+    @property
+    def height_px(self) -> np.ndarray:
+        return self.box_px[..., 3] - self.box_px[..., 1]
+
+
+def project_people(camera: PTZCamera, poses, ground_xy, height_m, width_m) -> ProjectedPeople:
+    """Project people (feet at ``ground_xy``, ``height_m`` tall, ``width_m`` wide) to boxes.
+
+    ground_xy : (*P, N, 2); height_m, width_m : (*P, N) or broadcastable.
+    The box spans the feet and head pixels and is as wide as the person seen
+    at the mean depth of feet and head.
+    """
+    poses = np.asarray(poses, dtype=float)
+    ground_xy = np.asarray(ground_xy, dtype=float)
+    height_m = np.broadcast_to(np.asarray(height_m, dtype=float), ground_xy.shape[:-1])
+    feet_m = np.concatenate([ground_xy, np.zeros_like(ground_xy[..., :1])], axis=-1)
+    head_m = feet_m + np.stack([np.zeros_like(height_m)] * 2 + [height_m], axis=-1)
+    P = projection_matrix(camera, poses)[..., None, :, :]
+
+    def project(points_m):
+        homogeneous = (P[..., :3] @ points_m[..., None] + P[..., 3:])[..., 0]
+        return homogeneous[..., :2] / homogeneous[..., 2:], homogeneous[..., 2]
+
+    feet_px, feet_depth_m = project(feet_m)
+    head_px, head_depth_m = project(head_m)
+    focal_px = poses[..., ZOOM, None] * camera.f_min_px
+    half_width_px = 0.5 * focal_px * np.asarray(width_m, dtype=float) / (0.5 * (feet_depth_m + head_depth_m))
+    box_px = np.stack(
+        [
+            np.minimum(feet_px[..., 0], head_px[..., 0]) - half_width_px,
+            np.minimum(feet_px[..., 1], head_px[..., 1]),
+            np.maximum(feet_px[..., 0], head_px[..., 0]) + half_width_px,
+            np.maximum(feet_px[..., 1], head_px[..., 1]),
+        ],
+        axis=-1,
+    )
+    return ProjectedPeople(feet_px=feet_px, head_px=head_px, box_px=box_px, depth_m=feet_depth_m)
+
+
+def inside_image(camera: PTZCamera, pixels) -> np.ndarray:
+    """Whether pixels (..., 2) fall inside the image; returns (...) bool."""
+    pixels = np.asarray(pixels, dtype=float)
+    return (
+        (pixels[..., 0] >= 0)
+        & (pixels[..., 0] <= camera.image_width_px)
+        & (pixels[..., 1] >= 0)
+        & (pixels[..., 1] <= camera.image_height_px)
+    )
+
+
+def person_in_view(camera: PTZCamera, people: ProjectedPeople) -> np.ndarray:
+    """Whether each person stands in front of the camera with head and feet in the image; (*P, N)."""
+    return (people.depth_m > 0) & inside_image(camera, people.feet_px) & inside_image(camera, people.head_px)
+
+
+def look_at(camera: PTZCamera, target_xy, zoom=1.0) -> np.ndarray:
+    """The pose whose optical axis passes through the ground point(s) ``target_xy`` (..., 2)."""
+    target_xy = np.asarray(target_xy, dtype=float)
+    offset = target_xy - camera.centre_m[:2]
+    pan_deg = np.rad2deg(np.arctan2(offset[..., 0], offset[..., 1]))
+    tilt_deg = np.rad2deg(np.arctan2(camera.centre_m[2], np.linalg.norm(offset, axis=-1)))
+    return np.stack([pan_deg, tilt_deg, np.broadcast_to(zoom, pan_deg.shape)], axis=-1)
+
+
+def ground_footprint(camera: PTZCamera, poses, points_per_edge: int = 16, max_range_m: float = 60.0) -> np.ndarray:
+    """The field of view on the ground: a polygon (*P, 4 * points_per_edge, 2) in metres.
+
+    The image border is sampled and each pixel's ray is cut with the ground.
+    Rays at or above the horizon, or meeting the ground beyond ``max_range_m``,
+    stop at that horizontal range, so a view of the horizon gives a finite
+    polygon.
+    """
+    poses = np.asarray(poses, dtype=float)
+    w, h = camera.image_width_px, camera.image_height_px
+    s = np.linspace(0.0, 1.0, points_per_edge, endpoint=False)
+    border_px = np.concatenate(
+        [
+            np.stack([s * w, np.zeros_like(s)], -1),
+            np.stack([np.full_like(s, w), s * h], -1),
+            np.stack([(1 - s) * w, np.full_like(s, h)], -1),
+            np.stack([np.zeros_like(s), (1 - s) * h], -1),
+        ]
+    )
+    R = rotation_world_to_camera(poses[..., PAN], poses[..., TILT])
+    K_inv = np.linalg.inv(intrinsics(camera, poses[..., ZOOM]))
+    border_h = np.concatenate([border_px, np.ones((len(border_px), 1))], axis=-1)
+    rays = np.einsum("...ji,...jk,nk->...ni", R, K_inv, border_h)
+    height_m = camera.centre_m[2]
+    horizontal = np.linalg.norm(rays[..., :2], axis=-1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        range_m = np.where(rays[..., 2] < 0, height_m * horizontal / -rays[..., 2], np.inf)
+    range_m = np.minimum(range_m, max_range_m)
+    return camera.centre_m[:2] + rays[..., :2] / horizontal[..., None] * range_m[..., None]
