@@ -1,0 +1,165 @@
+"""One validated configuration object per run, loadable from YAML.
+
+The defaults are the synthetic scene of the paper's section 5.1 with the
+camera mounting chosen in :mod:`ptztrack.scene.synthetic`.
+"""
+
+from pathlib import Path
+from typing import Annotated, Literal
+
+import numpy as np
+import pydantic
+import yaml
+from pydantic import BaseModel, ConfigDict, Field, model_validator
+
+from ptztrack.camera.actions import ActionGrid
+from ptztrack.geometry.ptz import PTZCamera
+
+PositiveFloat = Annotated[float, Field(gt=0)]
+NonNegativeFloat = Annotated[float, Field(ge=0)]
+
+
+class ScenarioError(ValueError):
+    """A scenario that cannot be run; the message is one line naming the field and value."""
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True, strict=False)
+
+
+class People(_Strict):
+    count: int = Field(7, ge=0)
+    speed_m_s: tuple[PositiveFloat, PositiveFloat] = (1.0, 1.5)
+    height_m: tuple[PositiveFloat, PositiveFloat] = (1.6, 1.9)
+    width_m: PositiveFloat = 0.5
+    turn_rate_sigma_deg_s: NonNegativeFloat = 40.0
+    enter_leave: bool = False
+    stay_s: tuple[PositiveFloat, PositiveFloat] = (8.0, 20.0)
+
+    @model_validator(mode="after")
+    def _intervals_ordered(self):
+        for name in ("speed_m_s", "height_m", "stay_s"):
+            low, high = getattr(self, name)
+            if high < low:
+                raise ValueError(f"{name} must be [low, high] with low <= high (got {[low, high]})")
+        return self
+
+
+class Camera(_Strict):
+    position_m: tuple[float, float, PositiveFloat] = (7.5, -4.0, 7.0)
+    image_size_px: tuple[Annotated[int, Field(gt=0)], Annotated[int, Field(gt=0)]] = (640, 480)
+    f_min_px: PositiveFloat = 400.0
+
+
+class AxisRange(_Strict):
+    start: float
+    stop: float
+    count: int = Field(ge=1)
+
+    def values(self) -> np.ndarray:
+        return np.linspace(self.start, self.stop, self.count)
+
+
+class Actions(_Strict):
+    pan_deg: AxisRange = AxisRange(start=-45.0, stop=45.0, count=7)
+    tilt_deg: AxisRange = AxisRange(start=15.0, stop=60.0, count=10)
+    zoom: tuple[Annotated[float, Field(ge=1)], ...] = (1.0, 2.0, 3.0, 4.0)
+    max_steps: tuple[Annotated[int, Field(ge=0)], Annotated[int, Field(ge=0)], Annotated[int, Field(ge=0)]] = (
+        2,
+        2,
+        1,
+    )
+
+    @model_validator(mode="after")
+    def _zoom_increasing(self):
+        if len(self.zoom) == 0 or np.any(np.diff(self.zoom) <= 0):
+            raise ValueError(f"zoom must be a non-empty increasing list (got {list(self.zoom)})")
+        if not -90 < self.tilt_deg.start <= self.tilt_deg.stop < 90:
+            raise ValueError("tilt_deg must run upwards within (-90, 90)")
+        return self
+
+
+class Detector(_Strict):
+    kind: Literal["ideal", "realistic"] = "realistic"
+    recall_kd: PositiveFloat = 0.0098
+    recall_r0_px: NonNegativeFloat = 21.29
+    pixel_noise_px: NonNegativeFloat = 2.0
+    false_positives_per_frame: NonNegativeFloat = 0.0
+
+
+class Tracker(_Strict):
+    acceleration_sigma_m_s2: PositiveFloat = 1.5
+    initial_speed_sigma_m_s: PositiveFloat = 0.9
+    gate_probability: float = Field(0.99, gt=0, lt=1)
+    max_missed_steps: int = Field(5, ge=0)
+    max_position_sigma_m: PositiveFloat = 2.0
+
+
+class Scenario(_Strict):
+    """Everything a run needs besides the policy and the seed."""
+
+    area_m: tuple[PositiveFloat, PositiveFloat] = (15.0, 15.0)
+    frames: int = Field(50, ge=1)
+    frame_rate_hz: PositiveFloat = 5.0
+    people: People = People()
+    camera: Camera = Camera()
+    actions: Actions = Actions()
+    detector: Detector = Detector()
+    tracker: Tracker = Tracker()
+
+    def ptz_camera(self) -> PTZCamera:
+        width_px, height_px = self.camera.image_size_px
+        return PTZCamera(tuple(self.camera.position_m), width_px, height_px, self.camera.f_min_px)
+
+    def action_grid(self) -> ActionGrid:
+        return ActionGrid(
+            pan_deg=self.actions.pan_deg.values(),
+            tilt_deg=self.actions.tilt_deg.values(),
+            zoom=np.asarray(self.actions.zoom, dtype=float),
+            max_steps=tuple(self.actions.max_steps),
+        )
+
+
+def _first_error_line(error: pydantic.ValidationError, source: str) -> str:
+    first = error.errors()[0]
+    field = ".".join(str(part) for part in first["loc"]) or "(top level)"
+    message = first["msg"]
+    if first["type"] == "extra_forbidden":
+        message = "unknown key"
+    return f"{source}: {field}: {message} (got {first['input']!r})"
+
+
+def scenario_from_dict(data: dict, source: str = "scenario", **overrides) -> Scenario:
+    """Validate a scenario mapping, with top-level ``overrides`` applied on top.
+
+    Raises :class:`ScenarioError` with one line naming the source, the field and the value.
+    """
+    if not isinstance(data, dict):
+        raise ScenarioError(f"{source}: expected a mapping of scenario fields (got {type(data).__name__})")
+    merged = dict(data)
+    for key, value in overrides.items():
+        section, _, field = key.partition(".")
+        if field:
+            merged[section] = {**merged.get(section, {}), field: value}
+        else:
+            merged[key] = value
+    try:
+        return Scenario.model_validate(merged)
+    except pydantic.ValidationError as error:
+        raise ScenarioError(_first_error_line(error, source)) from None
+
+
+def load_scenario(path: str | Path, **overrides) -> Scenario:
+    """Read and validate a YAML scenario file (see the README for the format)."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as error:
+        raise ScenarioError(f"{path}: cannot read scenario file ({error.strerror})") from None
+    try:
+        data = yaml.safe_load(text)
+    except yaml.YAMLError as error:
+        mark = getattr(error, "problem_mark", None)
+        where = f" at line {mark.line + 1}" if mark else ""
+        raise ScenarioError(f"{path}: not valid YAML{where}") from None
+    return scenario_from_dict({} if data is None else data, str(path), **overrides)

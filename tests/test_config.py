@@ -1,0 +1,57 @@
+from pathlib import Path
+
+import pytest
+
+from ptztrack.config import Scenario, ScenarioError, load_scenario
+
+EXAMPLE = Path(__file__).parent.parent / "examples" / "scenario.yaml"
+
+
+def test_the_documented_example_is_valid_and_states_the_defaults():
+    assert load_scenario(EXAMPLE) == Scenario()
+
+
+def test_the_default_grid_is_the_papers_280_actions():
+    grid = Scenario().action_grid()
+    assert grid.shape == (7, 10, 4)
+    assert grid.size == 280
+    assert grid.max_steps == (2, 2, 1)
+
+
+@pytest.mark.parametrize(
+    "text, expected",
+    [
+        ("area_m: [15, 15]\nwalls: 3\n", "walls: unknown key (got 3)"),
+        ("area_m: [-15, 15]\n", "area_m.0: Input should be greater than 0 (got -15)"),
+        ("frames: many\n", "frames: Input should be a valid integer"),
+        ("people: {count: -1}\n", "people.count: Input should be greater than or equal to 0 (got -1)"),
+        ("detector: {kind: perfect}\n", "detector.kind: Input should be 'ideal' or 'realistic' (got 'perfect')"),
+        ("people: {speed_m_s: [2.0, 1.0]}\n", "people: Value error, speed_m_s must be [low, high]"),
+        ("actions: {zoom: [2, 1]}\n", "actions: Value error, zoom must be a non-empty increasing list"),
+        ("- 1\n- 2\n", "expected a mapping of scenario fields (got list)"),
+        ("area_m: [1, 2\n", "not valid YAML at line"),
+    ],
+)
+def test_bad_scenarios_get_one_line_naming_the_file_field_and_value(tmp_path, text, expected):
+    path = tmp_path / "bad.yaml"
+    path.write_text(text)
+    with pytest.raises(ScenarioError) as error:
+        load_scenario(path)
+    message = str(error.value)
+    assert "\n" not in message
+    assert message.startswith(str(path))
+    assert expected in message
+
+
+def test_a_missing_file_is_named(tmp_path):
+    with pytest.raises(ScenarioError, match="nope.yaml: cannot read scenario file"):
+        load_scenario(tmp_path / "nope.yaml")
+
+
+def test_overrides_apply_on_top_of_the_file(tmp_path):
+    path = tmp_path / "s.yaml"
+    path.write_text("frames: 20\ndetector: {pixel_noise_px: 1.0}\n")
+    scenario = load_scenario(path, **{"detector.kind": "ideal", "frames": 10})
+    assert scenario.frames == 10
+    assert scenario.detector.kind == "ideal"
+    assert scenario.detector.pixel_noise_px == 1.0
