@@ -1,0 +1,48 @@
+import numpy as np
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from ptztrack.config import People
+from ptztrack.scene.synthetic import walk_people
+
+AREA = (15.0, 15.0)
+
+
+def walk(seed, frames=200, **people):
+    return walk_people(People(**people), AREA, frames, 5.0, np.random.default_rng(seed))
+
+
+@settings(deadline=None, max_examples=25)
+@given(seed=st.integers(0, 2**32 - 1))
+def test_walkers_stay_inside_at_human_speeds_with_smooth_turns(seed):
+    truth = walk(seed)
+    assert truth.present.all()
+    assert np.all((truth.positions_m >= 0) & (truth.positions_m <= 15.0))
+    step = np.diff(truth.positions_m, axis=0)
+    speed = np.linalg.norm(step, axis=-1) * 5.0
+    assert np.all(speed <= 1.5 + 1e-9)
+    assert np.median(speed) >= 1.0
+    heading = np.arctan2(step[..., 1], step[..., 0])
+    turn_deg = np.rad2deg(np.abs((np.diff(heading, axis=0) + np.pi) % (2 * np.pi) - np.pi))
+    assert np.percentile(turn_deg, 99) < 30.0
+    assert np.all((truth.heights_m >= 1.6) & (truth.heights_m <= 1.9))
+
+
+def test_the_seed_fixes_the_scene():
+    np.testing.assert_array_equal(walk(3).positions_m, walk(3).positions_m)
+    assert not np.array_equal(walk(3).positions_m, walk(4).positions_m)
+
+
+def test_people_entering_and_leaving_do_so_once_through_the_border():
+    truth = walk(5, frames=300, enter_leave=True, count=12, stay_s=(5.0, 10.0))
+    present = truth.present
+    for person in range(12):
+        frames = np.flatnonzero(present[:, person])
+        assert len(frames) > 0
+        assert np.all(np.diff(frames) == 1), "a person is present for one contiguous stretch"
+        first = truth.positions_m[frames[0], person]
+        assert np.min(np.abs(np.concatenate([first, 15.0 - first]))) < 1e-9, "enters on the border"
+        if frames[-1] < 299:
+            last = truth.positions_m[frames[-1], person]
+            assert np.min(np.abs(np.concatenate([last, 15.0 - last]))) < 0.5, "leaves near the border"
+    assert present.sum(axis=1).max() < 12 or not present[0].all()
