@@ -1,0 +1,44 @@
+"""Kalman filter steps for a batch of constant-velocity ground-plane states.
+
+State ``x = [x_m, y_m, vx_m_s, vy_m_s]``; every function takes a batch of
+``n`` filters: ``x`` (n, 4), ``P`` (n, 4, 4). Matrices are named as in the
+paper's equations (2): ``F``, ``U`` (process noise), ``C`` (linearised
+observation), ``V`` (observation noise). The paper prints
+``P- = F^T P F + U``; the standard and intended form is ``F P F^T + U``.
+"""
+
+import numpy as np
+
+
+def constant_velocity_model(dt_s: float, acceleration_sigma_m_s2: float) -> tuple[np.ndarray, np.ndarray]:
+    """``F`` and ``U`` (4, 4) for a constant-velocity walker driven by white acceleration noise."""
+    F = np.eye(4)
+    F[0, 2] = F[1, 3] = dt_s
+    block = acceleration_sigma_m_s2**2 * np.array([[dt_s**4 / 4, dt_s**3 / 2], [dt_s**3 / 2, dt_s**2]])
+    U = np.kron(block, np.eye(2))
+    return F, U
+
+
+def predict(x, P, F, U) -> tuple[np.ndarray, np.ndarray]:
+    """``x- = F x``, ``P- = F P F^T + U``."""
+    return x @ F.T, F @ P @ F.T + U
+
+
+def innovation_covariance(P, C, V) -> np.ndarray:
+    """``S = C P C^T + V``; C (n, 2, 4), returns (n, 2, 2)."""
+    return C @ P @ np.swapaxes(C, -1, -2) + V
+
+
+def update(x, P, innovation, C, V) -> tuple[np.ndarray, np.ndarray]:
+    """EKF update with the innovation ``o - g(x-)`` (n, 2) and ``C = dg/dx`` at ``x-``.
+
+    Uses the Joseph form of ``P+ = (I - K C) P-`` so that P stays symmetric
+    positive definite when the gain is large (zoomed-in views).
+    """
+    S = innovation_covariance(P, C, V)
+    K = np.swapaxes(np.linalg.solve(S, C @ P), -1, -2)
+    x_plus = x + (K @ innovation[..., None])[..., 0]
+    I_KC = np.eye(x.shape[-1]) - K @ C
+    P_plus = I_KC @ P @ np.swapaxes(I_KC, -1, -2) + K @ V @ np.swapaxes(K, -1, -2)
+    return x_plus, P_plus
+

@@ -1,0 +1,168 @@
+"""Multi-person tracker: one EKF per person on the ground, Hungarian association in the image.
+
+Observations are feet pixels taken at a known pose; the observation function
+is the ground-to-image homography of that pose, linearised at the predicted
+state (the paper's section 3.1).
+"""
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+from scipy.optimize import linear_sum_assignment
+from scipy.stats import chi2
+
+from ptztrack.config import Tracker
+from ptztrack.geometry.ptz import (
+    PTZCamera,
+    apply_homography,
+    feet_jacobian,
+    ground_to_image,
+    image_to_ground,
+    inside_image,
+)
+from ptztrack.track import kalman
+
+
+@dataclass(frozen=True)
+class Tracks:
+    """All live tracks.
+
+    ids : (n,) stable integer ids.
+    mean : (n, 4) states [x_m, y_m, vx_m_s, vy_m_s].
+    covariance : (n, 4, 4).
+    missed_steps : (n,) consecutive steps without an associated detection.
+    next_id : the id the next new track gets.
+    """
+
+    ids: np.ndarray
+    mean: np.ndarray
+    covariance: np.ndarray
+    missed_steps: np.ndarray
+    next_id: int = 0
+
+    def __len__(self) -> int:
+        return len(self.ids)
+
+    def select(self, keep) -> "Tracks":
+        return replace(
+            self,
+            ids=self.ids[keep],
+            mean=self.mean[keep],
+            covariance=self.covariance[keep],
+            missed_steps=self.missed_steps[keep],
+        )
+
+    @property
+    def position_sigma_m(self) -> np.ndarray:
+        """(n,) standard deviation along the most uncertain ground direction."""
+        return np.sqrt(np.linalg.eigvalsh(self.covariance[:, :2, :2])[:, -1])
+
+
+def no_tracks() -> Tracks:
+    return Tracks(np.zeros(0, dtype=int), np.zeros((0, 4)), np.zeros((0, 4, 4)), np.zeros(0, dtype=int))
+
+
+def observation_matrix(camera: PTZCamera, pose, mean) -> np.ndarray:
+    """``C_x(a)``: (n, 2, 4) Jacobian of the feet pixel w.r.t. the state, at the states ``mean``."""
+    position_block = feet_jacobian(camera, pose, mean[:, :2])
+    return np.concatenate([position_block, np.zeros_like(position_block)], axis=-1)
+
+
+def predict_tracks(tracks: Tracks, F, U) -> Tracks:
+    mean, covariance = kalman.predict(tracks.mean, tracks.covariance, F, U)
+    return replace(tracks, mean=mean, covariance=covariance)
+
+
+def associate(
+    tracks: Tracks, feet_px, camera: PTZCamera, pose, V, gate_probability: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """Hungarian assignment of detections to predicted tracks on the Mahalanobis distance.
+
+    Pairs whose squared Mahalanobis distance exceeds the chi-square quantile
+    ``gate_probability`` (2 degrees of freedom) are not allowed, nor are
+    tracks behind the camera. Returns matched (track_index, detection_index) arrays.
+    """
+    if len(tracks) == 0 or len(feet_px) == 0:
+        return np.zeros(0, dtype=int), np.zeros(0, dtype=int)
+    H = ground_to_image(camera, pose)
+    predicted_px = apply_homography(H, tracks.mean[:, :2])
+    in_front = (tracks.mean[:, :2] @ H[2, :2] + H[2, 2]) > 0
+    S = kalman.innovation_covariance(tracks.covariance, observation_matrix(camera, pose, tracks.mean), V)
+    residual = feet_px[None, :, :] - predicted_px[:, None, :]
+    distance2 = np.einsum("tdi,tij,tdj->td", residual, np.linalg.inv(S), residual)
+    gate = chi2.ppf(gate_probability, df=2)
+    allowed = in_front[:, None] & (distance2 <= gate)
+    cost = np.where(allowed, distance2, gate * 1e3)
+    rows, cols = linear_sum_assignment(cost)
+    keep = allowed[rows, cols]
+    return rows[keep], cols[keep]
+
+
+def predicted_in_view(tracks: Tracks, camera: PTZCamera, pose) -> np.ndarray:
+    """(n,) bool: the track's predicted feet fall inside the image at ``pose``."""
+    H = ground_to_image(camera, pose)
+    in_front = (tracks.mean[:, :2] @ H[2, :2] + H[2, 2]) > 0
+    return in_front & inside_image(camera, apply_homography(H, tracks.mean[:, :2]))
+
+
+def start_tracks(feet_px, camera: PTZCamera, pose, V, config: Tracker, first_id: int) -> Tracks:
+    """New tracks at the ground points of detections, with the pixel noise carried to the ground.
+
+    Velocity starts at 0 with spread ``initial_speed_sigma_m_s`` per axis.
+    Detections at or above the horizon cannot start a track and are dropped.
+    """
+    G = image_to_ground(camera, pose)
+    # G (u, v, 1) = (x, y, 1) / depth, so its last entry is positive only for
+    # pixels whose ray meets the ground in front of the camera.
+    homogeneous = feet_px @ G[:, :2].T + G[:, 2]
+    ok = homogeneous[:, 2] > 0
+    ground_xy = homogeneous[ok, :2] / homogeneous[ok, 2:]
+    count = len(ground_xy)
+    J_inv = np.linalg.inv(feet_jacobian(camera, pose, ground_xy))
+    covariance = np.zeros((count, 4, 4))
+    covariance[:, :2, :2] = J_inv @ V @ np.swapaxes(J_inv, -1, -2)
+    covariance[:, 2:, 2:] = config.initial_speed_sigma_m_s**2 * np.eye(2)
+    return Tracks(
+        ids=first_id + np.arange(count),
+        mean=np.concatenate([ground_xy, np.zeros((count, 2))], axis=-1),
+        covariance=covariance,
+        missed_steps=np.zeros(count, dtype=int),
+        next_id=first_id + count,
+    )
+
+
+def update_tracks(tracks: Tracks, feet_px, camera: PTZCamera, pose, V, config: Tracker) -> Tracks:
+    """Associate, update, start and delete: the tracker's step after prediction.
+
+    feet_px : (K, 2) detections taken at ``pose``. A step counts as missed
+    for a track only if the track was predicted inside the image: a PTZ
+    camera that looks elsewhere has not missed anybody. A track is deleted
+    after more than ``max_missed_steps`` missed steps, or when its position
+    standard deviation exceeds ``max_position_sigma_m`` (which is what ends
+    a track the camera no longer looks at).
+    """
+    feet_px = np.asarray(feet_px, dtype=float).reshape(-1, 2)
+    track_index, detection_index = associate(tracks, feet_px, camera, pose, V, config.gate_probability)
+    mean, covariance = tracks.mean.copy(), tracks.covariance.copy()
+    if len(track_index):
+        prior = tracks.mean[track_index]
+        H = ground_to_image(camera, pose)
+        innovation = feet_px[detection_index] - apply_homography(H, prior[:, :2])
+        mean[track_index], covariance[track_index] = kalman.update(
+            prior, tracks.covariance[track_index], innovation, observation_matrix(camera, pose, prior), V
+        )
+    missed = tracks.missed_steps + predicted_in_view(tracks, camera, pose)
+    missed[track_index] = 0
+    updated = replace(tracks, mean=mean, covariance=covariance, missed_steps=missed)
+    survivors = updated.select(
+        (updated.missed_steps <= config.max_missed_steps) & (updated.position_sigma_m <= config.max_position_sigma_m)
+    )
+    unmatched = np.setdiff1d(np.arange(len(feet_px)), detection_index)
+    born = start_tracks(feet_px[unmatched], camera, pose, V, config, tracks.next_id)
+    return Tracks(
+        ids=np.concatenate([survivors.ids, born.ids]),
+        mean=np.concatenate([survivors.mean, born.mean]),
+        covariance=np.concatenate([survivors.covariance, born.covariance]),
+        missed_steps=np.concatenate([survivors.missed_steps, born.missed_steps]),
+        next_id=born.next_id,
+    )

@@ -1,0 +1,54 @@
+import numpy as np
+import pytest
+
+from ptztrack.track import kalman
+
+
+def test_predict_of_a_certain_state_is_the_process_noise():
+    F, U = kalman.constant_velocity_model(0.2, 1.5)
+    x, P = kalman.predict(np.array([[1.0, 2.0, 0.5, -1.0]]), np.zeros((1, 4, 4)), F, U)
+    np.testing.assert_allclose(x, [[1.1, 1.8, 0.5, -1.0]])
+    np.testing.assert_allclose(P[0], U)
+    np.testing.assert_allclose(U[0, 0], 1.5**2 * 0.2**4 / 4)
+    np.testing.assert_allclose(U[0, 2], 1.5**2 * 0.2**3 / 2)
+
+
+def test_update_matches_the_scalar_closed_form():
+    prior_var, obs_scale, noise_var = 0.7, 3.0, 2.0
+    P = np.diag([prior_var, prior_var, 1.0, 1.0])[None]
+    C = np.array([[[obs_scale, 0, 0, 0], [0, obs_scale, 0, 0]]], dtype=float)
+    x, P_plus = kalman.update(np.zeros((1, 4)), P, np.array([[1.5, -0.5]]), C, noise_var * np.eye(2))
+    gain = prior_var * obs_scale / (obs_scale**2 * prior_var + noise_var)
+    np.testing.assert_allclose(x[0, :2], [gain * 1.5, gain * -0.5])
+    np.testing.assert_allclose(P_plus[0, 0, 0], prior_var * noise_var / (noise_var + obs_scale**2 * prior_var))
+    np.testing.assert_allclose(x[0, 2:], 0.0)
+
+
+@pytest.mark.parametrize("acceleration_sigma, noise_sigma", [(1.5, 0.05), (0.5, 0.3), (3.0, 0.01)])
+def test_steady_state_gain_is_the_alpha_beta_filter(acceleration_sigma, noise_sigma):
+    """Bar-Shalom's closed form for the discrete white-noise acceleration model:
+    tracking index lambda = sigma_a T^2 / sigma_w gives the steady-state alpha and beta."""
+    dt = 0.2
+    F, U = kalman.constant_velocity_model(dt, acceleration_sigma)
+    C = np.array([[[1.0, 0, 0, 0], [0, 1.0, 0, 0]]])
+    V = noise_sigma**2 * np.eye(2)
+    x, P = np.zeros((1, 4)), np.eye(4)[None] * 10.0
+    for _ in range(500):
+        x, P = kalman.predict(x, P, F, U)
+        S = kalman.innovation_covariance(P, C, V)
+        gain = P @ np.swapaxes(C, -1, -2) @ np.linalg.inv(S)
+        x, P = kalman.update(x, P, np.zeros((1, 2)), C, V)
+    lam = acceleration_sigma * dt**2 / noise_sigma
+    root = np.sqrt(lam**2 + 8 * lam)
+    alpha = -(lam**2 + 8 * lam - (lam + 4) * root) / 8
+    beta = (lam**2 + 4 * lam - lam * root) / 4
+    np.testing.assert_allclose(gain[0, 0, 0], alpha, rtol=1e-9)
+    np.testing.assert_allclose(gain[0, 2, 0] * dt, beta, rtol=1e-9)
+
+
+def test_joseph_update_keeps_covariance_symmetric_positive_definite_under_huge_gain():
+    P = np.diag([100.0, 100.0, 10.0, 10.0])[None]
+    C = np.array([[[5000.0, 10.0, 0, 0], [-20.0, 4000.0, 0, 0]]])
+    _, P_plus = kalman.update(np.zeros((1, 4)), P, np.ones((1, 2)), C, 0.25 * np.eye(2))
+    np.testing.assert_allclose(P_plus, np.swapaxes(P_plus, -1, -2))
+    assert np.all(np.linalg.eigvalsh(P_plus) > 0)

@@ -1,0 +1,93 @@
+import numpy as np
+
+from ptztrack.config import Tracker
+from ptztrack.geometry.ptz import PTZCamera, apply_homography, feet_jacobian, ground_to_image, look_at
+from ptztrack.track.kalman import constant_velocity_model
+from ptztrack.track.tracker import no_tracks, observation_matrix, predict_tracks, start_tracks, update_tracks
+
+CAMERA = PTZCamera((7.5, -4.0, 7.0), 640, 480, 400.0)
+POSE = look_at(CAMERA, [7.5, 6.0], 1.0)
+V = 4.0 * np.eye(2)
+CONFIG = Tracker()
+
+
+def feet_px(ground_xy, pose=POSE):
+    return apply_homography(ground_to_image(CAMERA, pose), np.asarray(ground_xy, dtype=float))
+
+
+def test_observation_matrix_is_the_feet_jacobian_with_zero_velocity_columns():
+    mean = np.array([[6.0, 5.0, 1.0, -1.0], [9.0, 8.0, 0.0, 0.5]])
+    C = observation_matrix(CAMERA, POSE, mean)
+    np.testing.assert_array_equal(C[:, :, 2:], 0.0)
+    np.testing.assert_allclose(C[:, :, :2], feet_jacobian(CAMERA, POSE, mean[:, :2]))
+
+
+def test_a_new_track_starts_at_the_ground_point_with_the_pixel_noise_carried_to_the_ground():
+    ground = np.array([[5.0, 6.0], [10.0, 9.0]])
+    tracks = start_tracks(feet_px(ground), CAMERA, POSE, V, CONFIG, first_id=7)
+    np.testing.assert_allclose(tracks.mean[:, :2], ground, atol=1e-9)
+    np.testing.assert_array_equal(tracks.ids, [7, 8])
+    assert tracks.next_id == 9
+    J = feet_jacobian(CAMERA, POSE, ground)
+    np.testing.assert_allclose(J @ tracks.covariance[:, :2, :2] @ np.swapaxes(J, -1, -2), np.stack([V, V]), atol=1e-9)
+    np.testing.assert_allclose(tracks.covariance[:, 2, 2], CONFIG.initial_speed_sigma_m_s**2)
+
+
+def test_pixels_above_the_horizon_start_no_track():
+    pose = np.array([0.0, 5.0, 1.0])
+    tracks = start_tracks(np.array([[320.0, 10.0], [320.0, 400.0]]), CAMERA, pose, V, CONFIG, first_id=0)
+    assert len(tracks) == 1
+
+
+def test_tracks_follow_walkers_and_keep_their_ids():
+    dt = 0.2
+    F, U = constant_velocity_model(dt, CONFIG.acceleration_sigma_m_s2)
+    start = np.array([[4.0, 4.0], [11.0, 10.0]])
+    velocity = np.array([[1.0, 0.5], [-0.8, -0.6]])
+    tracks = no_tracks()
+    for step in range(30):
+        truth = start + velocity * step * dt
+        tracks = update_tracks(predict_tracks(tracks, F, U), feet_px(truth), CAMERA, POSE, V, CONFIG)
+        order = np.argsort(tracks.ids)
+        np.testing.assert_array_equal(tracks.ids[order], [0, 1])
+    np.testing.assert_allclose(tracks.mean[order, :2], truth, atol=0.02)
+    np.testing.assert_allclose(tracks.mean[order, 2:], velocity, atol=0.05)
+
+
+def test_hungarian_assignment_ignores_detection_order_and_gates_outliers():
+    F, U = constant_velocity_model(0.2, CONFIG.acceleration_sigma_m_s2)
+    tracks = start_tracks(feet_px([[5.0, 5.0], [9.0, 7.0]]), CAMERA, POSE, V, CONFIG, first_id=0)
+    detections = feet_px([[9.0, 7.0], [14.0, 1.0], [5.0, 5.0]])
+    updated = update_tracks(predict_tracks(tracks, F, U), detections, CAMERA, POSE, V, CONFIG)
+    np.testing.assert_array_equal(updated.ids, [0, 1, 2])
+    np.testing.assert_allclose(updated.mean[:, :2], [[5.0, 5.0], [9.0, 7.0], [14.0, 1.0]], atol=1e-6)
+    np.testing.assert_array_equal(updated.missed_steps, 0)
+
+
+def test_a_track_in_view_is_deleted_after_the_allowed_missed_steps_but_not_one_out_of_view():
+    F, U = constant_velocity_model(0.2, CONFIG.acceleration_sigma_m_s2)
+    config = Tracker(max_missed_steps=2, max_position_sigma_m=100.0)
+    tracks = start_tracks(feet_px([[7.5, 6.0]]), CAMERA, POSE, V, config, first_id=0)
+    looking_away = np.array([60.0, 40.0, 4.0])
+    for _ in range(5):
+        tracks = update_tracks(predict_tracks(tracks, F, U), np.zeros((0, 2)), CAMERA, looking_away, V, config)
+    assert len(tracks) == 1 and tracks.missed_steps[0] == 0
+    lengths = []
+    for _ in range(3):
+        tracks = update_tracks(predict_tracks(tracks, F, U), np.zeros((0, 2)), CAMERA, POSE, V, config)
+        lengths.append(len(tracks))
+    assert lengths == [1, 1, 0]
+
+
+def test_a_track_is_deleted_when_its_uncertainty_grows_too_large():
+    F, U = constant_velocity_model(0.2, CONFIG.acceleration_sigma_m_s2)
+    config = Tracker(max_position_sigma_m=1.0, max_missed_steps=1000)
+    tracks = start_tracks(feet_px([[7.5, 6.0]]), CAMERA, POSE, V, config, first_id=0)
+    looking_away = np.array([60.0, 40.0, 4.0])
+    alive = 0
+    while len(tracks):
+        tracks = update_tracks(predict_tracks(tracks, F, U), np.zeros((0, 2)), CAMERA, looking_away, V, config)
+        alive += 1
+        assert alive < 100
+    # position sd 0.9 m/s * t (initial velocity spread) passes 1 m between 1.0 s and 1.2 s
+    assert alive in (5, 6)
