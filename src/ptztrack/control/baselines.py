@@ -1,0 +1,101 @@
+"""The paper's comparison strategies: 'fix', 'patrol' and 'random' (section 5)."""
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ptztrack.camera.actions import ActionGrid
+from ptztrack.control.policy import DecisionContext
+from ptztrack.geometry.ptz import PTZCamera, person_in_view, project_people
+
+REFERENCE_PERSON_HEIGHT_M = 1.75
+
+
+def area_samples_m(area_m, per_axis: int = 30) -> np.ndarray:
+    """(per_axis**2, 2) cell centres of a regular grid over the area ``[0, w] x [0, d]``."""
+    xs = (np.arange(per_axis) + 0.5) / per_axis * area_m[0]
+    ys = (np.arange(per_axis) + 0.5) / per_axis * area_m[1]
+    return np.stack(np.meshgrid(xs, ys), axis=-1).reshape(-1, 2)
+
+
+def area_coverage(camera: PTZCamera, poses, area_m) -> np.ndarray:
+    """Fraction of the area where a standing person has head and feet in the image; (*P,)."""
+    people = project_people(camera, poses, area_samples_m(area_m), REFERENCE_PERSON_HEIGHT_M, 0.0)
+    return person_in_view(camera, people).mean(axis=-1)
+
+def widest_view_action(camera: PTZCamera, grid: ActionGrid, area_m) -> int:
+    """The zoom-1 action that sees most of the area: where 'fix' looks, and where every run starts."""
+    widest = np.flatnonzero(grid.axis_indices[:, 2] == 0)
+    return int(widest[np.argmax(area_coverage(camera, grid.poses[widest], area_m))])
+
+
+@dataclass
+class FixPolicy:
+    """Stay at the widest view aimed at the area."""
+
+    action: int
+
+    def choose(self, context: DecisionContext) -> int:
+        return self.action
+
+
+@dataclass
+class RandomPolicy:
+    """Uniform over the reachable actions."""
+
+    def choose(self, context: DecisionContext) -> int:
+        return int(context.rng.choice(context.reachable))
+
+
+@dataclass
+class PatrolPolicy:
+    """Scan a preset route of waypoints, dwelling ``dwell_steps`` at each.
+
+    The camera moves towards the next waypoint as fast as the mechanics allow.
+    """
+
+    grid: ActionGrid
+    waypoints: np.ndarray
+    dwell_steps: int = 2
+    _next: int = field(default=0, init=False)
+    _dwelt: int = field(default=0, init=False)
+
+    def choose(self, context: DecisionContext) -> int:
+        if context.current_action == self.waypoints[self._next]:
+            self._dwelt += 1
+            if self._dwelt >= self.dwell_steps:
+                self._next = (self._next + 1) % len(self.waypoints)
+                self._dwelt = 0
+        return self.grid.step_towards(context.current_action, int(self.waypoints[self._next]))
+
+
+def patrol_route(camera: PTZCamera, grid: ActionGrid, area_m, zoom_index: int | None = None) -> np.ndarray:
+    """A boustrophedon over the pan x tilt grid at one zoom, covering the area.
+
+    Along pan and tilt the waypoints are spread evenly from the first to the
+    last grid value, at most as many grid steps apart as fit in the field of
+    view at that zoom, so consecutive views touch; waypoints whose view does
+    not meet the area are skipped. ``zoom_index`` defaults to the lower
+    middle of the zoom range (2x of 1-4x: 8 waypoints on the default grid,
+    where 3x would need 19 and see each person about once in 50 steps). Returns the flat action indices in visiting order.
+    """
+    zoom_index = (len(grid.zoom) - 1) // 2 if zoom_index is None else zoom_index
+    focal_px = grid.zoom[zoom_index] * camera.f_min_px
+    fov_pan_deg = 2 * np.rad2deg(np.arctan(camera.image_width_px / 2 / focal_px))
+    fov_tilt_deg = 2 * np.rad2deg(np.arctan(camera.image_height_px / 2 / focal_px))
+    pan_stride = max(1, int(fov_pan_deg // np.min(np.diff(grid.pan_deg), initial=np.inf)))
+    tilt_stride = max(1, int(fov_tilt_deg // np.min(np.diff(grid.tilt_deg), initial=np.inf)))
+    pans = _spread_indices(len(grid.pan_deg), pan_stride)
+    route = []
+    for row, tilt in enumerate(_spread_indices(len(grid.tilt_deg), tilt_stride)):
+        for pan in pans if row % 2 == 0 else pans[::-1]:
+            route.append(grid.index(pan, tilt, zoom_index))
+    route = np.asarray(route)
+    sees_area = area_coverage(camera, grid.poses[route], area_m) > 0
+    return route[sees_area]
+
+
+def _spread_indices(count: int, max_stride: int) -> np.ndarray:
+    """Evenly spread indices from 0 to ``count - 1``, at most ``max_stride`` apart."""
+    intervals = int(np.ceil((count - 1) / max_stride))
+    return np.unique(np.round(np.linspace(0, count - 1, intervals + 1)).astype(int))
