@@ -1,0 +1,50 @@
+import csv
+import json
+import subprocess
+import sys
+
+from ptztrack.cli import main
+
+
+def test_run_writes_metrics_tracks_and_picture(tmp_path, capsys):
+    assert main(["run", "--policy", "fix", "--detector", "ideal", "--frames", "20", "--out", str(tmp_path)]) == 0
+    printed = capsys.readouterr().out
+    assert "MOTA" in printed and "MOTP [m]" in printed
+    metrics = json.loads((tmp_path / "metrics.json").read_text())
+    assert {"mota", "motp_m", "idf1", "height_px", "detections", "zoom"} <= set(metrics)
+    with open(tmp_path / "tracks.csv", newline="") as file:
+        rows = list(csv.DictReader(file))
+    assert {"frame", "id", "x_m", "y_m", "var_x_m2", "cov_xy_m2", "var_y_m2"} <= set(rows[0])
+    assert {int(row["frame"]) for row in rows} == set(range(20))
+    assert (tmp_path / "episode.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert not list(tmp_path.glob(".*tmp"))
+
+
+def test_same_seed_gives_byte_identical_outputs_and_another_seed_does_not(tmp_path):
+    common = ["run", "--policy", "fix", "--detector", "ideal", "--frames", "15"]
+    for name, seed in (("a", "0"), ("b", "0"), ("c", "1")):
+        assert main(common + ["--seed", seed, "--out", str(tmp_path / name)]) == 0
+    for name in ("metrics.json", "tracks.csv", "episode.png"):
+        assert (tmp_path / "a" / name).read_bytes() == (tmp_path / "b" / name).read_bytes()
+    assert (tmp_path / "a" / "tracks.csv").read_bytes() != (tmp_path / "c" / "tracks.csv").read_bytes()
+
+
+def test_a_scenario_file_runs(tmp_path, capsys):
+    path = tmp_path / "small.yaml"
+    path.write_text("area_m: [10, 10]\nframes: 8\npeople: {count: 3}\ncamera: {position_m: [5, -3, 6]}\n")
+    assert main(["run", "--scenario", str(path)]) == 0
+    assert "3 people" in capsys.readouterr().out
+
+
+def test_bad_scenario_file_exits_2_with_one_line_and_no_traceback(tmp_path):
+    for text, field in (("area_m: [-15, 15]\n", "area_m.0"), ("speed: 3\n", "speed: unknown key")):
+        path = tmp_path / "bad.yaml"
+        path.write_text(text)
+        result = subprocess.run(
+            [sys.executable, "-m", "ptztrack.cli", "run", "--scenario", str(path)], capture_output=True, text=True
+        )
+        assert result.returncode == 2
+        lines = result.stderr.strip().splitlines()
+        assert len(lines) == 1, result.stderr
+        assert field in lines[0] and str(path) in lines[0]
+        assert "Traceback" not in result.stderr

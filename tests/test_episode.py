@@ -1,0 +1,49 @@
+import numpy as np
+
+from ptztrack.config import scenario_from_dict
+from ptztrack.episode import run_episode
+from ptztrack.evaluate.metrics import episode_metrics
+
+SEEDS = range(6)
+
+
+def mean_metrics(detector, policy):
+    scenario = scenario_from_dict({"detector": {"kind": detector}})
+    rows = [episode_metrics(run_episode(scenario, policy, seed)) for seed in SEEDS]
+    return {key: np.mean([row[key] for row in rows]) for key in rows[0]}
+
+
+def test_fix_tracks_well_with_the_ideal_detector_and_worse_with_the_realistic_one():
+    """The paper's Tables 1 and 2: fix is at 94.6 % MOTA with the ideal
+    detector and 56.6 % with the realistic one, because people are small at zoom 1."""
+    ideal = mean_metrics("ideal", "fix")
+    realistic = mean_metrics("realistic", "fix")
+    assert ideal["mota"] > 0.8
+    assert realistic["mota"] < ideal["mota"] - 0.15
+    assert realistic["detections"] < 0.5 * ideal["detections"]
+    assert realistic["motp_m"] > ideal["motp_m"]
+    assert ideal["zoom"] == realistic["zoom"] == 1.0
+
+
+def test_zooming_policies_see_people_larger_than_fix():
+    fix = mean_metrics("ideal", "fix")
+    for policy in ("patrol", "random"):
+        zooming = mean_metrics("ideal", policy)
+        assert zooming["zoom"] > 1.5
+        assert zooming["height_px"] > fix["height_px"]
+
+
+def test_same_seed_same_episode_other_seed_other_episode():
+    scenario = scenario_from_dict({})
+    first, again, other = (run_episode(scenario, "random", seed) for seed in (11, 11, 12))
+    np.testing.assert_array_equal(first.actions, again.actions)
+    for a, b in zip(first.tracks, again.tracks, strict=True):
+        np.testing.assert_array_equal(a.mean, b.mean)
+    assert episode_metrics(first) == episode_metrics(again)
+    assert not np.array_equal(first.truth.positions_m, other.truth.positions_m)
+
+
+def test_policies_meet_the_same_people_under_the_same_seed():
+    scenario = scenario_from_dict({})
+    fix, patrol = run_episode(scenario, "fix", 5), run_episode(scenario, "patrol", 5)
+    np.testing.assert_array_equal(fix.truth.positions_m, patrol.truth.positions_m)
