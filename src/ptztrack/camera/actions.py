@@ -1,6 +1,7 @@
 """The discrete PTZ action set and the mechanics that limit each step (paper section 4.3)."""
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -32,12 +33,12 @@ class ActionGrid:
     def size(self) -> int:
         return int(np.prod(self.shape))
 
-    @property
+    @cached_property
     def axis_indices(self) -> np.ndarray:
         """(L, 3) grid indices (pan, tilt, zoom) of every action."""
         return np.stack(np.unravel_index(np.arange(self.size), self.shape), axis=-1)
 
-    @property
+    @cached_property
     def poses(self) -> np.ndarray:
         """(L, 3) poses (pan_deg, tilt_deg, zoom) of every action."""
         i = self.axis_indices

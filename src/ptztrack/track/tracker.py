@@ -73,21 +73,27 @@ def predict_tracks(tracks: Tracks, F, U) -> Tracks:
     return replace(tracks, mean=mean, covariance=covariance)
 
 
-def associate(
-    tracks: Tracks, feet_px, camera: PTZCamera, pose, V, gate_probability: float
-) -> tuple[np.ndarray, np.ndarray]:
+def predicted_feet_px(camera: PTZCamera, pose, mean) -> tuple[np.ndarray, np.ndarray]:
+    """Where the states ``mean`` (n, 4) put the feet in the image at ``pose``.
+
+    Returns the pixels (n, 2) and whether each point is in front of the camera (n,).
+    """
+    H = ground_to_image(camera, pose)
+    in_front = (mean[:, :2] @ H[2, :2] + H[2, 2]) > 0
+    return apply_homography(H, mean[:, :2]), in_front
+
+
+def associate(predicted_px, in_front, S, feet_px, gate_probability: float) -> tuple[np.ndarray, np.ndarray]:
     """Hungarian assignment of detections to predicted tracks on the Mahalanobis distance.
 
+    predicted_px : (n, 2) and in_front : (n,) from :func:`predicted_feet_px`;
+    S : (n, 2, 2) innovation covariances; feet_px : (K, 2) detections.
     Pairs whose squared Mahalanobis distance exceeds the chi-square quantile
     ``gate_probability`` (2 degrees of freedom) are not allowed, nor are
     tracks behind the camera. Returns matched (track_index, detection_index) arrays.
     """
-    if len(tracks) == 0 or len(feet_px) == 0:
+    if len(predicted_px) == 0 or len(feet_px) == 0:
         return np.zeros(0, dtype=int), np.zeros(0, dtype=int)
-    H = ground_to_image(camera, pose)
-    predicted_px = apply_homography(H, tracks.mean[:, :2])
-    in_front = (tracks.mean[:, :2] @ H[2, :2] + H[2, 2]) > 0
-    S = kalman.innovation_covariance(tracks.covariance, observation_matrix(camera, pose, tracks.mean), V)
     residual = feet_px[None, :, :] - predicted_px[:, None, :]
     distance2 = np.einsum("tdi,tij,tdj->td", residual, np.linalg.inv(S), residual)
     gate = chi2.ppf(gate_probability, df=2)
@@ -96,13 +102,6 @@ def associate(
     rows, cols = linear_sum_assignment(cost)
     keep = allowed[rows, cols]
     return rows[keep], cols[keep]
-
-
-def predicted_in_view(tracks: Tracks, camera: PTZCamera, pose) -> np.ndarray:
-    """(n,) bool: the track's predicted feet fall inside the image at ``pose``."""
-    H = ground_to_image(camera, pose)
-    in_front = (tracks.mean[:, :2] @ H[2, :2] + H[2, 2]) > 0
-    return in_front & inside_image(camera, apply_homography(H, tracks.mean[:, :2]))
 
 
 def start_tracks(feet_px, camera: PTZCamera, pose, V, config: Tracker, first_id: int) -> Tracks:
@@ -142,16 +141,19 @@ def update_tracks(tracks: Tracks, feet_px, camera: PTZCamera, pose, V, config: T
     a track the camera no longer looks at).
     """
     feet_px = np.asarray(feet_px, dtype=float).reshape(-1, 2)
-    track_index, detection_index = associate(tracks, feet_px, camera, pose, V, config.gate_probability)
+    predicted_px, in_front = predicted_feet_px(camera, pose, tracks.mean)
+    C = observation_matrix(camera, pose, tracks.mean)
+    S = kalman.innovation_covariance(tracks.covariance, C, V)
+    track_index, detection_index = associate(predicted_px, in_front, S, feet_px, config.gate_probability)
     mean, covariance = tracks.mean.copy(), tracks.covariance.copy()
-    if len(track_index):
-        prior = tracks.mean[track_index]
-        H = ground_to_image(camera, pose)
-        innovation = feet_px[detection_index] - apply_homography(H, prior[:, :2])
-        mean[track_index], covariance[track_index] = kalman.update(
-            prior, tracks.covariance[track_index], innovation, observation_matrix(camera, pose, prior), V
-        )
-    missed = tracks.missed_steps + predicted_in_view(tracks, camera, pose)
+    mean[track_index], covariance[track_index] = kalman.update(
+        tracks.mean[track_index],
+        tracks.covariance[track_index],
+        feet_px[detection_index] - predicted_px[track_index],
+        C[track_index],
+        V,
+    )
+    missed = tracks.missed_steps + (in_front & inside_image(camera, predicted_px))
     missed[track_index] = 0
     updated = replace(tracks, mean=mean, covariance=covariance, missed_steps=missed)
     survivors = updated.select(
