@@ -56,6 +56,8 @@ def occluded_fraction(box_px, depth_m, valid) -> np.ndarray:
     box along every occluder edge into at most (2N - 1)^2 cells.
     """
     box_px = np.asarray(box_px, dtype=float)
+    depth_m = np.asarray(depth_m, dtype=float)
+    valid = np.asarray(valid, dtype=bool)
     count = box_px.shape[-2]
     target = box_px[..., :, None, :]
     occluder = box_px[..., None, :, :]

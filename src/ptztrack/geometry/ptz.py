@@ -253,7 +253,7 @@ def ground_footprint(camera: PTZCamera, poses, points_per_edge: int = 16, max_ra
     rays = np.einsum("...ji,...jk,nk->...ni", R, K_inv, border_h)
     height_m = camera.centre_m[2]
     horizontal = np.linalg.norm(rays[..., :2], axis=-1)
-    with np.errstate(divide="ignore", invalid="ignore"):
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         range_m = np.where(rays[..., 2] < 0, height_m * horizontal / -rays[..., 2], np.inf)
     range_m = np.minimum(range_m, max_range_m)
     return camera.centre_m[:2] + rays[..., :2] / horizontal[..., None] * range_m[..., None]
