@@ -1,0 +1,420 @@
+"""Tests of the simulated detectors in ptztrack.detect.simulated."""
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from ptztrack.config import Detector, Scenario
+from ptztrack.detect.simulated import detect, detection_probability, occluded_fraction, recall
+from ptztrack.geometry.ptz import apply_homography, image_to_ground, inside_image, look_at, project_people
+
+CAMERA = Scenario().ptz_camera()
+REALISTIC = Detector()
+IDEAL = Detector(kind="ideal")
+PROPERTY = settings(deadline=None, max_examples=100)
+
+
+def fraction(boxes, depths, valid=None):
+    boxes = np.asarray(boxes, dtype=float)
+    depths = np.asarray(depths, dtype=float)
+    valid = np.ones(depths.shape, dtype=bool) if valid is None else np.asarray(valid, dtype=bool)
+    return occluded_fraction(boxes, depths, valid)
+
+
+# ---------------------------------------------------------------------------
+# occluded_fraction: hand-computed cases
+
+
+def test_two_boxes_partial_overlap():
+    result = fraction([[0, 0, 10, 10], [5, 5, 15, 15]], [5.0, 1.0])
+    np.testing.assert_allclose(result, [0.25, 0.0], rtol=0, atol=1e-15)
+    # swapping the depths swaps who is hidden
+    result = fraction([[0, 0, 10, 10], [5, 5, 15, 15]], [1.0, 5.0])
+    np.testing.assert_allclose(result, [0.0, 0.25], rtol=0, atol=1e-15)
+
+
+def test_overlapping_occluders_are_not_double_counted():
+    boxes = [[0, 0, 10, 10], [0, 0, 6, 10], [4, 0, 10, 10]]
+    result = fraction(boxes, [10.0, 1.0, 2.0])
+    # target fully covered (not 1.2); the second occluder is a third behind the first
+    np.testing.assert_allclose(result, [1.0, 0.0, 20.0 / 60.0], rtol=0, atol=1e-15)
+
+
+def test_union_of_two_partial_occluders():
+    boxes = [[0, 0, 10, 10], [0, 0, 5, 5], [3, 3, 8, 8]]
+    result = fraction(boxes, [10.0, 1.0, 1.0])  # equal-depth occluders do not hide each other
+    np.testing.assert_allclose(result, [(25 + 25 - 4) / 100.0, 0.0, 0.0], rtol=0, atol=1e-15)
+
+
+def test_occluder_larger_than_target_is_clipped():
+    result = fraction([[2, 2, 4, 6], [-100, 3, 100, 100]], [3.0, 2.0])
+    np.testing.assert_allclose(result, [3.0 / 4.0, 0.0], rtol=0, atol=1e-15)
+
+
+def test_invalid_occluder_has_no_effect():
+    boxes = [[0, 0, 10, 10], [5, 5, 15, 15], [0, 0, 6, 10]]
+    depths = [5.0, 1.0, 1.0]
+    np.testing.assert_allclose(fraction(boxes, depths, [True, False, False]), [0.0, 0.0, 0.0], atol=1e-15)
+    np.testing.assert_allclose(fraction(boxes, depths, [True, True, False]), [0.25, 0.0, 0.0], atol=1e-15)
+    np.testing.assert_allclose(fraction(boxes, depths, [True, False, True]), [0.6, 0.0, 0.0], atol=1e-15)
+    # an invalid target is reported as not hidden
+    np.testing.assert_allclose(fraction(boxes, depths, [False, True, True]), [0.0, 0.0, 0.0], atol=1e-15)
+
+
+def test_nearer_box_is_not_hidden_by_farther_people():
+    boxes = [[0, 0, 10, 10], [0, 0, 10, 10], [-5, -5, 20, 20]]
+    result = fraction(boxes, [1.0, 2.0, 3.0])
+    # the nearest sees everything; the middle one is exactly covered by the nearest;
+    # the farthest (area 625) has the 100 px of the two nearer boxes hidden
+    np.testing.assert_allclose(result, [0.0, 1.0, 100.0 / 625.0], rtol=0, atol=1e-15)
+
+
+def test_equal_depths_and_disjoint_and_degenerate_boxes():
+    # identical boxes at identical depth do not hide each other
+    np.testing.assert_allclose(fraction([[0, 0, 4, 4], [0, 0, 4, 4]], [2.0, 2.0]), [0.0, 0.0])
+    # disjoint boxes and boxes touching along an edge
+    np.testing.assert_allclose(fraction([[0, 0, 4, 4], [4, 0, 8, 4], [20, 20, 30, 30]], [3.0, 1.0, 0.5]), [0, 0, 0])
+    # zero-area targets come out as 0, not NaN
+    result = fraction([[1, 1, 1, 5], [0, 0, 10, 10]], [5.0, 1.0])
+    np.testing.assert_array_equal(result, [0.0, 0.0])
+    # a single person and no people at all
+    np.testing.assert_array_equal(fraction([[0, 0, 1, 1]], [1.0]), [0.0])
+    assert fraction(np.zeros((0, 4)), np.zeros(0)).shape == (0,)
+
+
+# ---------------------------------------------------------------------------
+# occluded_fraction against a brute-force raster
+
+
+GRID_PX = 12
+
+
+def raster(box):
+    left, top, right, bottom = (int(v) for v in box)
+    mask = np.zeros((GRID_PX, GRID_PX), dtype=bool)
+    mask[top:bottom, left:right] = True
+    return mask
+
+
+def brute_force_fraction(boxes, depths, valid):
+    boxes = np.asarray(boxes)
+    result = np.zeros(len(boxes))
+    for i, box in enumerate(boxes):
+        target = raster(box)
+        if not valid[i] or not target.any():
+            continue
+        union = np.zeros_like(target)
+        for j, other in enumerate(boxes):
+            if j != i and valid[j] and depths[j] < depths[i]:
+                union |= raster(other)
+        result[i] = np.count_nonzero(target & union) / np.count_nonzero(target)
+    return result
+
+
+@st.composite
+def integer_people(draw, count):
+    boxes = []
+    for _ in range(count):
+        left, right = sorted(draw(st.lists(st.integers(0, GRID_PX), min_size=2, max_size=2)))
+        top, bottom = sorted(draw(st.lists(st.integers(0, GRID_PX), min_size=2, max_size=2)))
+        boxes.append([left, top, right, bottom])
+    depths = draw(st.lists(st.integers(0, 4), min_size=count, max_size=count))  # ties on purpose
+    valid = draw(st.lists(st.booleans(), min_size=count, max_size=count))
+    return np.array(boxes, dtype=float), np.array(depths, dtype=float), np.array(valid, dtype=bool)
+
+
+@PROPERTY
+@given(st.integers(1, 7).flatmap(integer_people))
+def test_occluded_fraction_matches_raster(people):
+    boxes, depths, valid = people
+    result = occluded_fraction(boxes, depths, valid)
+    expected = brute_force_fraction(boxes, depths, valid)
+    np.testing.assert_allclose(result, expected, rtol=1e-12, atol=1e-12)
+    assert np.all((result >= 0) & (result <= 1))
+    # scaling by a power of two and shifting (exact in floating point) changes nothing
+    moved = boxes * 0.25 + np.array([100.5, -7.25, 100.5, -7.25])
+    np.testing.assert_allclose(occluded_fraction(moved, depths, valid), expected, rtol=1e-12, atol=1e-12)
+
+
+@PROPERTY
+@given(st.integers(1, 5).flatmap(lambda count: st.lists(integer_people(count), min_size=1, max_size=4)))
+def test_occluded_fraction_batched_matches_raster(frames):
+    boxes = np.stack([f[0] for f in frames])  # (B, N, 4)
+    depths = np.stack([f[1] for f in frames])
+    valid = np.stack([f[2] for f in frames])
+    result = occluded_fraction(boxes, depths, valid)
+    assert result.shape == depths.shape
+    for b, (box, depth, ok) in enumerate(frames):
+        np.testing.assert_allclose(result[b], brute_force_fraction(box, depth, ok), rtol=1e-12, atol=1e-12)
+    # two leading axes
+    twice = occluded_fraction(
+        np.stack([boxes, boxes[::-1]]), np.stack([depths, depths[::-1]]), np.stack([valid, valid[::-1]])
+    )
+    assert twice.shape == (2,) + depths.shape
+    np.testing.assert_allclose(twice[0], result, rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(twice[1], result[::-1], rtol=1e-12, atol=1e-12)
+
+
+# ---------------------------------------------------------------------------
+# recall
+
+
+def test_realistic_recall():
+    assert REALISTIC.kind == "realistic"
+    assert REALISTIC.recall_r0_px == 21.29 and REALISTIC.recall_kd == 0.0098
+    below = recall(np.array([0.0, 5.0, 21.0, 21.2899]), REALISTIC)
+    np.testing.assert_array_equal(below, 0.0)
+    assert recall(21.29, REALISTIC) == 0.0
+    value = recall(100.0, REALISTIC)
+    np.testing.assert_allclose(value, 1 - np.exp(-0.0098 * (100 - 21.29)), rtol=1e-14)
+    np.testing.assert_allclose(value, 0.5376, atol=5e-5)
+    heights = np.array([30.0, 50.0, 200.0, 480.0])
+    np.testing.assert_allclose(recall(heights, REALISTIC), 1 - np.exp(-0.0098 * (heights - 21.29)), rtol=1e-14)
+    np.testing.assert_allclose(recall(1e5, REALISTIC), 1.0, rtol=1e-12)
+
+
+def test_recall_is_monotone_and_keeps_shape():
+    heights = np.linspace(0, 1000, 5001)
+    values = recall(heights, REALISTIC)
+    assert values.shape == heights.shape
+    assert np.all(np.diff(values) >= 0)
+    assert np.all(np.diff(values[heights > 21.29]) > 0)
+    assert np.all((values >= 0) & (values < 1))
+    grid = recall(heights[:5000].reshape(50, 100), REALISTIC)
+    np.testing.assert_array_equal(grid, values[:5000].reshape(50, 100))
+    other = Detector(recall_kd=0.05, recall_r0_px=10.0)
+    np.testing.assert_allclose(recall(30.0, other), 1 - np.exp(-0.05 * 20.0), rtol=1e-14)
+    assert recall(9.99, other) == 0.0
+
+
+def test_ideal_recall_is_one():
+    heights = np.array([[0.0, 1.0, 21.0], [100.0, 1e4, 3.5]])
+    np.testing.assert_array_equal(recall(heights, IDEAL), np.ones((2, 3)))
+
+
+# ---------------------------------------------------------------------------
+# detection_probability on a camera
+
+# Looking at (7.5, 8) with zoom 2 from the scenario camera: a 1.75 m person there is
+# ~93 px tall (p ~ 0.50). Persons 2 and 3 stand farther along the same pan line.
+POSE = look_at(CAMERA, (7.5, 8.0), 2.0)
+ALL = np.ones(4, dtype=bool)
+
+
+def scene():
+    xy = np.array([[7.5, 8.0], [7.5, 10.0], [7.5, 9.6], [12.0, 8.0]])
+    heights = np.array([1.75, 1.75, 0.8, 1.75])
+    return project_people(CAMERA, POSE, xy, heights, 0.5)
+
+
+def box_area(box):
+    return (box[2] - box[0]) * (box[3] - box[1])
+
+
+def intersection_area(a, b):
+    width = max(0.0, min(a[2], b[2]) - max(a[0], b[0]))
+    height = max(0.0, min(a[3], b[3]) - max(a[1], b[1]))
+    return width * height
+
+
+def test_unoccluded_person_in_middle_has_recall_probability():
+    people = project_people(CAMERA, POSE, np.array([[7.5, 8.0], [12.0, 8.0]]), 1.75, 0.5)
+    np.testing.assert_allclose(people.feet_px[0], [320.0, 240.0], atol=1e-9)
+    assert 80 < people.height_px[0] < 110
+    p = detection_probability(CAMERA, people, np.ones(2, dtype=bool), REALISTIC)
+    np.testing.assert_allclose(p, recall(people.height_px, REALISTIC), rtol=1e-14)
+    assert 0.4 < p[0] < 0.6
+    np.testing.assert_array_equal(detection_probability(CAMERA, people, np.ones(2, dtype=bool), IDEAL), [1.0, 1.0])
+    # a person who is not present is never detected and does not count
+    np.testing.assert_array_equal(detection_probability(CAMERA, people, np.array([False, True]), IDEAL), [0.0, 1.0])
+
+
+def test_person_behind_another_is_reduced_by_visible_fraction():
+    people = scene()
+    box = people.box_px
+    assert np.all(np.diff(people.depth_m[:2]) > 0)
+    # person 1 (farther, same column) is partly covered by person 0 only
+    c1 = intersection_area(box[1], box[0]) / box_area(box[1])
+    assert 0.2 < c1 < 0.8
+    # person 2 (a 0.8 m child right behind person 0) is entirely inside person 0's box
+    assert box[0, 0] <= box[2, 0] and box[2, 2] <= box[0, 2] and box[0, 1] <= box[2, 1] and box[2, 3] <= box[0, 3]
+
+    hidden = occluded_fraction(box, people.depth_m, ALL)
+    np.testing.assert_allclose(hidden[:3], [0.0, c1, 1.0], rtol=1e-12, atol=1e-12)
+
+    r = recall(people.height_px, REALISTIC)
+    p = detection_probability(CAMERA, people, ALL, REALISTIC)
+    np.testing.assert_allclose(p, [r[0], r[1] * (1 - c1), 0.0, r[3]], rtol=1e-12, atol=1e-12)
+    p_ideal = detection_probability(CAMERA, people, ALL, IDEAL)
+    np.testing.assert_allclose(p_ideal, [1.0, 1 - c1, 0.0, 1.0], rtol=1e-12, atol=1e-12)
+
+    # without the front person, the child is fully visible and now it alone hides part of person 1
+    assert people.depth_m[2] < people.depth_m[1]
+    c1_child = intersection_area(box[1], box[2]) / box_area(box[1])
+    assert 0 < c1_child < c1
+    present = np.array([False, True, True, True])
+    p_alone = detection_probability(CAMERA, people, present, REALISTIC)
+    np.testing.assert_allclose(p_alone, [0.0, r[1] * (1 - c1_child), r[2], r[3]], rtol=1e-12)
+    # and without both, person 1 is fully visible
+    present = np.array([False, True, False, True])
+    p_free = detection_probability(CAMERA, people, present, REALISTIC)
+    np.testing.assert_allclose(p_free, [0.0, r[1], 0.0, r[3]], rtol=1e-12)
+
+
+def test_person_outside_image_or_cut_off_is_never_detected():
+    # person 3 at (12, 8) is in view at zoom 2 but off the right border at zoom 3
+    xy = np.array([[12.0, 8.0]])
+    zoom2 = project_people(CAMERA, POSE, xy, 1.75, 0.5)
+    zoom3 = project_people(CAMERA, POSE * [1, 1, 1.5], xy, 1.75, 0.5)
+    assert inside_image(CAMERA, zoom2.feet_px).all() and not inside_image(CAMERA, zoom3.feet_px).any()
+    assert detection_probability(CAMERA, zoom2, np.ones(1, bool), IDEAL)[0] == 1.0
+    assert detection_probability(CAMERA, zoom3, np.ones(1, bool), IDEAL)[0] == 0.0
+
+    to_ground = image_to_ground(CAMERA, POSE)
+    # feet 10 px below the top border: the head is above the image
+    top = apply_homography(to_ground, np.array([[320.0, 10.0]]))
+    cut = project_people(CAMERA, POSE, top, 1.75, 0.5)
+    assert inside_image(CAMERA, cut.feet_px).all() and cut.head_px[0, 1] < 0
+    assert detection_probability(CAMERA, cut, np.ones(1, bool), IDEAL)[0] == 0.0
+    # feet just below the bottom border: head inside, feet outside
+    bottom = apply_homography(to_ground, np.array([[320.0, 485.0]]))
+    low = project_people(CAMERA, POSE, bottom, 1.75, 0.5)
+    assert inside_image(CAMERA, low.head_px).all() and not inside_image(CAMERA, low.feet_px).any()
+    assert detection_probability(CAMERA, low, np.ones(1, bool), IDEAL)[0] == 0.0
+
+
+def test_person_behind_the_camera_is_never_detected():
+    # at a shallow tilt the sky part of the image shows (mirrored) points behind the camera
+    pose = np.array([0.0, 5.0, 1.0])
+    behind = project_people(CAMERA, pose, np.array([[7.5, -104.0]]), 1.75, 0.5)
+    assert behind.depth_m[0] < 0
+    assert inside_image(CAMERA, behind.feet_px).all() and inside_image(CAMERA, behind.head_px).all()
+    assert detection_probability(CAMERA, behind, np.ones(1, bool), IDEAL)[0] == 0.0
+
+
+def test_detection_probability_batched_over_poses():
+    poses = np.array([POSE, POSE * [1, 1, 1.5], look_at(CAMERA, (5.0, 5.0), 1.0)])
+    xy = np.array([[7.5, 8.0], [7.5, 10.0], [7.5, 9.6], [12.0, 8.0]])
+    heights = np.array([1.75, 1.75, 0.8, 1.75])
+    present = np.array([True, True, True, False])
+    batch = project_people(CAMERA, poses, np.broadcast_to(xy, (3, 4, 2)), heights, 0.5)
+    p = detection_probability(CAMERA, batch, np.broadcast_to(present, (3, 4)), REALISTIC)
+    assert p.shape == (3, 4)
+    for k, pose in enumerate(poses):
+        single = project_people(CAMERA, pose, xy, heights, 0.5)
+        np.testing.assert_allclose(p[k], detection_probability(CAMERA, single, present, REALISTIC), rtol=1e-12)
+
+
+# ---------------------------------------------------------------------------
+# detect: sampling
+
+
+FRAMES, ROW = 2000, 10
+DRAWS = FRAMES * ROW  # 20000 person draws
+
+
+@pytest.fixture(scope="module")
+def many_draws():
+    """2000 images of ten people side by side (p ~ 0.50 each): 20000 independent draws.
+
+    They stand on a ground line across the view at exactly the same depth, so they have
+    the same height in pixels and (disjoint boxes, equal depth) do not hide each other.
+    """
+    xy = np.stack([7.5 + np.linspace(-4.68, 4.68, ROW), np.full(ROW, 8.0)], axis=-1)
+    people = project_people(CAMERA, POSE, xy, 1.75, 0.5)
+    present = np.ones(ROW, dtype=bool)
+    rng = np.random.default_rng(20240611)
+    frames = [detect(CAMERA, people, present, REALISTIC, rng) for _ in range(FRAMES)]
+    return people, present, frames
+
+
+def test_empirical_detection_rate_matches_probability(many_draws):
+    people, present, frames = many_draws
+    p = detection_probability(CAMERA, people, present, REALISTIC)
+    np.testing.assert_allclose(p, p[0], rtol=1e-12)
+    assert 0.4 < p[0] < 0.6
+    np.testing.assert_array_equal(occluded_fraction(people.box_px, people.depth_m, present), 0.0)
+    index = np.concatenate([f.person_index for f in frames])
+    assert np.all((index >= 0) & (index < ROW))
+    # each person at most once per image, reported in index order
+    assert all(np.all(np.diff(f.person_index) > 0) for f in frames)
+    np.testing.assert_array_equal(np.concatenate([f.height_px for f in frames]), people.height_px[index])
+    rate = len(index) / DRAWS
+    standard_error = np.sqrt(p[0] * (1 - p[0]) / DRAWS)
+    assert abs(rate - p[0]) < 4 * standard_error, (rate, p[0])
+    # and every person separately (2000 draws each)
+    per_person = np.bincount(index, minlength=ROW) / FRAMES
+    assert np.all(np.abs(per_person - p) < 4 * np.sqrt(p * (1 - p) / FRAMES)), per_person
+
+
+def test_pixel_noise_matches_detector(many_draws):
+    people, _, frames = many_draws
+    residuals = np.concatenate([f.feet_px - people.feet_px[f.person_index] for f in frames])
+    assert residuals.shape[1] == 2 and len(residuals) > 5000
+    std = residuals.std(axis=0, ddof=1)
+    np.testing.assert_allclose(std, REALISTIC.pixel_noise_px, rtol=0.05)
+    # zero-mean noise: 4 standard errors
+    assert np.all(np.abs(residuals.mean(axis=0)) < 4 * REALISTIC.pixel_noise_px / np.sqrt(len(residuals)))
+    # noise on u and v is uncorrelated
+    assert abs(np.corrcoef(residuals.T)[0, 1]) < 4 / np.sqrt(len(residuals))
+
+
+def test_noise_free_detector_reports_exact_feet():
+    people = scene()
+    detector = Detector(kind="ideal", pixel_noise_px=0.0)
+    found = detect(CAMERA, people, np.ones(4, dtype=bool), detector, np.random.default_rng(3))
+    # ideal detector: everyone except the fully hidden child (2); person 1 with probability 1 - c
+    assert 0 in found.person_index and 3 in found.person_index and 2 not in found.person_index
+    np.testing.assert_array_equal(found.feet_px, people.feet_px[found.person_index])
+    np.testing.assert_array_equal(found.height_px, people.height_px[found.person_index])
+
+
+def test_false_positives():
+    rate = 1.5
+    detector = Detector(false_positives_per_frame=rate)
+    people = scene()
+    absent = np.zeros(4, dtype=bool)
+    rng = np.random.default_rng(99)
+    frames = [detect(CAMERA, people, absent, detector, rng) for _ in range(4000)]
+    counts = np.array([len(f) for f in frames])
+    standard_error = np.sqrt(rate / len(counts))
+    assert abs(counts.mean() - rate) < 4 * standard_error
+    # Poisson: the variance equals the mean (4 standard errors of the sample variance)
+    assert abs(counts.var(ddof=1) - rate) < 4 * np.sqrt((rate + 2 * rate**2) / len(counts))
+    feet = np.concatenate([f.feet_px for f in frames])
+    assert np.all(np.concatenate([f.person_index for f in frames]) == -1)
+    assert np.all(np.isnan(np.concatenate([f.height_px for f in frames])))
+    assert np.all(inside_image(CAMERA, feet))
+    # uniform over the image: mean at the centre (4 standard errors of a uniform)
+    spread = np.array([640.0, 480.0]) / np.sqrt(12 * len(feet))
+    assert np.all(np.abs(feet.mean(axis=0) - [320.0, 240.0]) < 4 * spread)
+
+    # with a true person present, false positives come after the hits
+    present = np.array([True, False, False, True])
+    ideal = Detector(kind="ideal", false_positives_per_frame=rate)
+    mixed = [detect(CAMERA, people, present, ideal, rng) for _ in range(50)]
+    for frame in mixed:
+        true = frame.person_index >= 0
+        assert np.all(true[: true.sum()]) and not np.any(true[true.sum():])
+        assert np.all(np.isfinite(frame.height_px[true])) and np.all(np.isnan(frame.height_px[~true]))
+        np.testing.assert_array_equal(frame.person_index[true], [0, 3])
+
+
+def test_same_seed_gives_identical_detections():
+    people = scene()
+    detector = Detector(false_positives_per_frame=2.0)
+    present = np.ones(4, dtype=bool)
+    first = [detect(CAMERA, people, present, detector, np.random.default_rng(7)) for _ in range(3)]
+    again = detect(CAMERA, people, present, detector, np.random.default_rng(7))
+    for frame in first:
+        np.testing.assert_array_equal(frame.feet_px, again.feet_px)
+        np.testing.assert_array_equal(frame.height_px, again.height_px)
+        np.testing.assert_array_equal(frame.person_index, again.person_index)
+    # a stream of draws is reproducible too, and different seeds differ
+    def stream(seed):
+        rng = np.random.default_rng(seed)
+        return np.concatenate([detect(CAMERA, people, present, detector, rng).feet_px.ravel() for _ in range(20)])
+
+    np.testing.assert_array_equal(stream(11), stream(11))
+    assert not np.array_equal(stream(11), stream(12))
