@@ -48,3 +48,11 @@ def test_bad_scenario_file_exits_2_with_one_line_and_no_traceback(tmp_path):
         assert len(lines) == 1, result.stderr
         assert field in lines[0] and str(path) in lines[0]
         assert "Traceback" not in result.stderr
+
+
+def test_an_output_path_that_cannot_be_a_directory_exits_2_naming_it(tmp_path, capsys):
+    blocker = tmp_path / "file"
+    blocker.write_text("keep me")
+    assert main(["run", "--frames", "3", "--out", str(blocker / "out")]) == 2
+    assert f"{blocker / 'out'}: Not a directory" in capsys.readouterr().err
+    assert blocker.read_text() == "keep me"

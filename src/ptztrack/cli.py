@@ -1,6 +1,7 @@
 """The ``ptztrack`` command: a thin layer over the Python API."""
 
 import argparse
+import os
 import sys
 from pathlib import Path
 
@@ -74,8 +75,14 @@ def main(argv: list[str] | None = None) -> int:
     except ScenarioError as error:
         print(f"ptztrack: error: {error}", file=sys.stderr)
         return 2
+    except BrokenPipeError:
+        # The reader (say, `head`) has gone: stop quietly, and keep Python from
+        # complaining again when it flushes stdout at exit.
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 1
     except OSError as error:
-        print(f"ptztrack: error: {error.filename or ''}: {error.strerror}", file=sys.stderr)
+        where = f"{error.filename}: " if error.filename else ""
+        print(f"ptztrack: error: {where}{error.strerror or error}", file=sys.stderr)
         return 2
 
 
