@@ -31,7 +31,8 @@ class Episode:
     """What happened in one run.
 
     truth : the people.
-    actions : (T,) flat action index taken at each step; poses : (T, 3) the same as poses.
+    actions : (T,) flat action index taken at each step.
+    poses : (T, 3) those actions as (pan_deg, tilt_deg, zoom).
     tracks : per step, the tracks after that step's update.
     detections : per step, what the detector reported.
     """

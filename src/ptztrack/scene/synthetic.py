@@ -82,7 +82,7 @@ def walk_people(
         towards_inside = rng.uniform(0.25, 0.75, size=(count, 2)) * area - position
         heading = np.arctan2(towards_inside[:, 1], towards_inside[:, 0])
     else:
-        stay_frames = np.full(count, np.iinfo(np.int64).max // 2)
+        stay_frames = np.full(count, frames)
         entry_frame = np.zeros(count, dtype=int)
         position = rng.uniform(BORDER_MARGIN_M, area - BORDER_MARGIN_M, size=(count, 2))
         heading = rng.uniform(-np.pi, np.pi, size=count)
