@@ -47,10 +47,6 @@ class GroundTruth:
         """(T, N) bool: the person is in the scene at that frame."""
         return ~np.isnan(self.positions_m[..., 0])
 
-    @property
-    def num_frames(self) -> int:
-        return self.positions_m.shape[0]
-
 
 def _wrap_angle(angle_rad):
     return (angle_rad + np.pi) % (2 * np.pi) - np.pi
