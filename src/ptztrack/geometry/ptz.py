@@ -127,6 +127,20 @@ def head_from_feet_homology(camera: PTZCamera, poses, height_m) -> np.ndarray:
     return plane_homography(camera, poses, height_m) @ image_to_ground(camera, poses)
 
 
+def homography_jacobian(H, points) -> np.ndarray:
+    """Jacobian of ``p -> H p`` (inhomogeneous) at ``points``.
+
+    H : (*P, 3, 3); points : (*P, N, 2). Returns (*P, N, 2, 2): rows are the
+    output coordinates, columns the input ones.
+    """
+    H = np.asarray(H, dtype=float)[..., None, :, :]
+    points = np.asarray(points, dtype=float)
+    homogeneous = H[..., :, :2] @ points[..., :, None] + H[..., :, 2:]
+    w = homogeneous[..., 2, :]
+    mapped = homogeneous[..., :2, :] / w[..., None, :]
+    return (H[..., :2, :2] - mapped * H[..., 2:, :2]) / w[..., None, :]
+
+
 def feet_jacobian(camera: PTZCamera, poses, ground_xy) -> np.ndarray:
     """Jacobian of the feet pixel ``(u, v)`` with respect to the ground point ``(x, y)``.
 
@@ -134,12 +148,7 @@ def feet_jacobian(camera: PTZCamera, poses, ground_xy) -> np.ndarray:
     ground_xy : (*P, N, 2) metres. Returns (*P, N, 2, 2) in pixels per metre,
     rows (u, v), columns (x, y).
     """
-    H = ground_to_image(camera, poses)[..., None, :, :]
-    ground_xy = np.asarray(ground_xy, dtype=float)
-    homogeneous = H[..., :, :2] @ ground_xy[..., :, None] + H[..., :, 2:]
-    w = homogeneous[..., 2, :]
-    pixel = homogeneous[..., :2, :] / w[..., None, :]
-    return (H[..., :2, :2] - pixel * H[..., 2:, :2]) / w[..., None, :]
+    return homography_jacobian(ground_to_image(camera, poses), ground_xy)
 
 
 def camera_depth_m(camera: PTZCamera, poses, points_m) -> np.ndarray:
