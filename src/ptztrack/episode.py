@@ -2,8 +2,10 @@
 
 ``run_episode`` knows only the roles: a camera backend with ``observe``, the
 tracker's predict and update, and a policy with ``choose``. Random draws come
-from three independent streams spawned from the seed (scene, detector,
-policy), so different policies run with the same seed meet the same people.
+from independent streams spawned from the seed: the scene, the policy, and
+one detector stream per frame. So different policies run with the same seed
+meet the same people and, frame by frame, the same detector luck (common
+random numbers), which makes their paired comparison far less noisy.
 """
 
 from dataclasses import dataclass
@@ -13,17 +15,15 @@ import numpy as np
 from ptztrack.camera.simulated import SimulatedPTZ
 from ptztrack.config import Scenario
 from ptztrack.control.baselines import FixPolicy, PatrolPolicy, RandomPolicy, patrol_route, widest_view_action
+from ptztrack.control.exploration import exploration_map
+from ptztrack.control.information_policy import InformationGainPolicy
 from ptztrack.control.policy import DecisionContext, Policy
 from ptztrack.detect.simulated import Detections
 from ptztrack.scene.synthetic import GroundTruth, walk_people
 from ptztrack.track.kalman import constant_velocity_model
-from ptztrack.track.tracker import Tracks, no_tracks, predict_tracks, update_tracks
+from ptztrack.track.tracker import Tracks, no_tracks, pixel_noise_covariance, predict_tracks, update_tracks
 
-POLICIES = ("fix", "patrol", "random")
-# Feet are found on a pixel grid: the tracker trusts them to half a pixel at
-# best, which also keeps the innovation covariance invertible for a
-# noiseless simulated detector.
-MIN_PIXEL_NOISE_PX = 0.5
+POLICIES = ("fix", "patrol", "random", "intg", "smpl")
 
 
 @dataclass(frozen=True)
@@ -53,6 +53,22 @@ def make_policy(name: str, scenario: Scenario) -> Policy:
         return PatrolPolicy(grid, patrol_route(camera, grid, scenario.area_m))
     if name == "random":
         return RandomPolicy()
+    if name in ("intg", "smpl"):
+        exploration = None
+        if scenario.control.beta > 0:
+            exploration = exploration_map(
+                camera, grid.poses, scenario.area_m, scenario.detector, scenario.control, 1.0 / scenario.frame_rate_hz
+            )
+        return InformationGainPolicy(
+            camera,
+            grid,
+            scenario.detector,
+            scenario.control,
+            pixel_noise_covariance(scenario.detector),
+            scenario.people.width_m,
+            name,
+            exploration,
+        )
     raise ValueError(f"unknown policy {name!r}; expected one of {', '.join(POLICIES)}")
 
 
@@ -65,9 +81,10 @@ def run_episode(scenario: Scenario, policy_name: str, seed: int) -> Episode:
     )
     backend = SimulatedPTZ(camera, truth, scenario.detector)
     policy = make_policy(policy_name, scenario)
-    detector_rng, policy_rng = np.random.default_rng(detector_seed), np.random.default_rng(policy_seed)
+    frame_seeds = detector_seed.spawn(scenario.frames)
+    policy_rng = np.random.default_rng(policy_seed)
     F, U = constant_velocity_model(1.0 / scenario.frame_rate_hz, scenario.tracker.acceleration_sigma_m_s2)
-    V = max(scenario.detector.pixel_noise_px, MIN_PIXEL_NOISE_PX) ** 2 * np.eye(2)
+    V = pixel_noise_covariance(scenario.detector)
 
     action = widest_view_action(camera, grid, scenario.area_m)
     tracks = no_tracks()
@@ -77,7 +94,7 @@ def run_episode(scenario: Scenario, policy_name: str, seed: int) -> Episode:
         context = DecisionContext(step, action, grid.reachable(action), tracks, policy_rng)
         action = policy.choose(context)
         pose = grid.poses[action]
-        detections = backend.observe(step, pose, detector_rng)
+        detections = backend.observe(step, pose, np.random.default_rng(frame_seeds[step]))
         tracks = update_tracks(tracks, detections.feet_px, camera, pose, V, scenario.tracker)
         actions.append(action)
         track_history.append(tracks)

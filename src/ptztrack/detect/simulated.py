@@ -100,11 +100,15 @@ def detect(
 
     people : the (N,) people of this frame projected at the current pose;
     present : (N,) bool.
+    The draws for every person are made whether or not it is in view, in a
+    fixed order, so that for one generator state the luck of each person
+    does not depend on the pose (common random numbers across policies).
     """
     probability = detection_probability(camera, people, present, detector)
-    hit = rng.random(probability.shape) < probability
-    index = np.flatnonzero(hit)
-    feet_px = people.feet_px[index] + rng.normal(0.0, detector.pixel_noise_px, size=(len(index), 2))
+    luck = rng.random(probability.shape)
+    noise_px = rng.normal(0.0, detector.pixel_noise_px, size=people.feet_px.shape)
+    index = np.flatnonzero(luck < probability)
+    feet_px = people.feet_px[index] + noise_px[index]
     false_count = rng.poisson(detector.false_positives_per_frame)
     false_feet_px = rng.uniform((0, 0), (camera.image_width_px, camera.image_height_px), size=(false_count, 2))
     return Detections(
