@@ -95,6 +95,17 @@ class Tracker(_Strict):
     max_position_sigma_m: PositiveFloat = 2.0
 
 
+class Control(_Strict):
+    """Parameters of the information-gain policies (paper sections 4 and 4.4)."""
+
+    samples: int = Field(100, ge=1)
+    beta: NonNegativeFloat = 0.0
+    person_height_m: PositiveFloat = 1.75
+    exploration_cell_m: PositiveFloat = 1.0
+    prior_occupancy: float = Field(0.05, ge=0, lt=1)
+    arrival_rate_per_m2_s: NonNegativeFloat = 0.002
+
+
 class Scenario(_Strict):
     """Everything a run needs besides the policy and the seed."""
 
@@ -106,6 +117,7 @@ class Scenario(_Strict):
     actions: Actions = Actions()
     detector: Detector = Detector()
     tracker: Tracker = Tracker()
+    control: Control = Control()
 
     def ptz_camera(self) -> PTZCamera:
         width_px, height_px = self.camera.image_size_px

@@ -11,7 +11,7 @@ import numpy as np
 from scipy.optimize import linear_sum_assignment
 from scipy.stats import chi2
 
-from ptztrack.config import Tracker
+from ptztrack.config import Detector, Tracker
 from ptztrack.geometry.ptz import (
     PTZCamera,
     apply_homography,
@@ -21,6 +21,17 @@ from ptztrack.geometry.ptz import (
     inside_image,
 )
 from ptztrack.track import kalman
+
+
+# Feet are found on a pixel grid: the tracker trusts them to half a pixel at
+# best, which also keeps the innovation covariance invertible for a
+# noiseless simulated detector.
+MIN_PIXEL_NOISE_PX = 0.5
+
+
+def pixel_noise_covariance(detector: Detector) -> np.ndarray:
+    """``V`` (2, 2) px^2: the feet-pixel noise the tracker and the policies assume."""
+    return max(detector.pixel_noise_px, MIN_PIXEL_NOISE_PX) ** 2 * np.eye(2)
 
 
 @dataclass(frozen=True)

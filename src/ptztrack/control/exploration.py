@@ -1,0 +1,97 @@
+"""The patrolling term ``I_p(b | a)`` of equation 20: information about people not yet tracked.
+
+The paper cites this term without defining it; here it is derived.
+
+The ground is cut into cells. Let ``b_c`` be the event "cell c holds a person
+the tracker does not know yet", with belief ``p_c``. New people arrive as a
+Poisson process of rate ``lambda`` per m^2 per second, so between two steps
+(``dt``) a cell of area ``A`` gains
+
+    p_c <- 1 - (1 - p_c) exp(-lambda A dt).
+
+Looking with action ``a``, a person in cell c is detected with probability
+``q_c(a) = recall(r_c(a))`` if it stands fully in view (head and feet in the
+image), 0 otherwise. The observation ``d_c`` of the cell is "detected" with
+probability ``p_c q_c`` (then b_c is known: entropy 0) or "not detected",
+after which Bayes gives ``p_c' = p_c (1 - q_c) / (1 - p_c q_c)``. The mutual
+information between ``b_c`` and ``d_c`` is therefore
+
+    I_c(a) = H_b(p_c) - (1 - p_c q_c) H_b(p_c'),
+
+with ``H_b`` the binary entropy in nats, and cells are independent, so
+``I_p(a) = sum_c I_c(a)``. It is zero for a cell the camera cannot see
+(``q_c = 0``) and for a cell it has just cleared (``p_c`` near 0), and it grows
+the longer a cell goes unobserved: the camera is drawn back to places it has
+not looked at for a while, and more to views where it would actually detect
+(larger people, so zoom matters as well). After the camera looks, each
+cell's belief takes the no-detection posterior (a detection becomes a track).
+"""
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ptztrack.config import Control, Detector
+from ptztrack.detect.simulated import recall
+from ptztrack.geometry.ptz import PTZCamera, person_in_view, project_people
+
+
+def binary_entropy_nats(p) -> np.ndarray:
+    p = np.clip(np.asarray(p, dtype=float), 1e-15, 1 - 1e-15)
+    return -(p * np.log(p) + (1 - p) * np.log1p(-p))
+
+
+def cell_detection_probability(
+    camera: PTZCamera, poses, cell_centres_m, detector: Detector, person_height_m: float
+) -> np.ndarray:
+    """``q_c(a)``: (L, C) probability of detecting an unoccluded person standing at each cell."""
+    people = project_people(camera, poses, cell_centres_m, person_height_m, 0.0)
+    return np.where(person_in_view(camera, people), recall(people.height_px, detector), 0.0)
+
+
+def exploration_information_nats(occupancy, detection_probability) -> np.ndarray:
+    """``I_p(a)`` for beliefs ``occupancy`` (C,) and ``q`` (L, C): returns (L,) nats."""
+    p, q = occupancy, detection_probability
+    no_detection = 1.0 - p * q
+    posterior = p * (1.0 - q) / no_detection
+    return np.sum(binary_entropy_nats(p) - no_detection * binary_entropy_nats(posterior), axis=-1)
+
+
+@dataclass
+class ExplorationMap:
+    """Beliefs that cells hold people not yet tracked, and how each action would observe them.
+
+    detection_probability : (L, C) ``q_c(a)`` for every action of the grid.
+    occupancy : (C,) current beliefs ``p_c``.
+    arrival_probability : (C,) chance that a person arrives in a cell during one step.
+    """
+
+    detection_probability: np.ndarray
+    occupancy: np.ndarray
+    arrival_probability: np.ndarray = field(repr=False)
+
+    def information_nats(self, actions) -> np.ndarray:
+        """``I_p(a)`` for the given flat action indices; (len(actions),)."""
+        return exploration_information_nats(self.occupancy, self.detection_probability[actions])
+
+    def advance(self, action: int) -> None:
+        """One step: people may arrive anywhere, then the camera looks with ``action``."""
+        self.occupancy = 1.0 - (1.0 - self.occupancy) * (1.0 - self.arrival_probability)
+        q = self.detection_probability[action]
+        self.occupancy = self.occupancy * (1.0 - q) / (1.0 - self.occupancy * q)
+
+
+def exploration_map(
+    camera: PTZCamera, poses, area_m, detector: Detector, control: Control, dt_s: float
+) -> ExplorationMap:
+    """A fresh map over the area with cells of ``control.exploration_cell_m``."""
+    cell_m = control.exploration_cell_m
+    xs = np.arange(cell_m / 2, area_m[0], cell_m)
+    ys = np.arange(cell_m / 2, area_m[1], cell_m)
+    centres = np.stack(np.meshgrid(xs, ys), axis=-1).reshape(-1, 2)
+    arrival = -np.expm1(-control.arrival_rate_per_m2_s * cell_m**2 * dt_s)
+    return ExplorationMap(
+        detection_probability=cell_detection_probability(camera, poses, centres, detector, control.person_height_m),
+        occupancy=np.full(len(centres), control.prior_occupancy),
+        arrival_probability=np.full(len(centres), arrival),
+    )

@@ -1,0 +1,88 @@
+"""The information-gain policies 'intg' and 'smpl' (paper equations 3, 8, 19 and 20).
+
+Each step, among the actions the mechanics allow, pick
+
+    argmax_a  sum_k alpha_k(a) 1/2 log(det Sigma_o,k(a) / det V)  +  beta I_p(a),
+
+with ``alpha`` in closed form ('intg') or by sampling with occlusions
+('smpl'). When no action is strictly better than staying (no tracks and no
+exploration term), the camera stays.
+"""
+
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+
+from ptztrack.camera.actions import ActionGrid
+from ptztrack.config import Control, Detector
+from ptztrack.control.exploration import ExplorationMap
+from ptztrack.control.information_gain import (
+    detection_weight_integral,
+    detection_weight_sampled,
+    information_gain_nats,
+    predicted_observations,
+)
+from ptztrack.control.policy import DecisionContext
+from ptztrack.geometry.ptz import PTZCamera, look_at
+
+
+@dataclass
+class InformationGainPolicy:
+    """Greedy expected-information-gain control.
+
+    method : 'intg' (equation 8, closed form) or 'smpl' (equation 19, ``control.samples`` draws).
+    exploration : the patrolling term's map, or None when ``control.beta`` is 0.
+    """
+
+    camera: PTZCamera
+    grid: ActionGrid
+    detector: Detector
+    control: Control
+    V: np.ndarray
+    person_width_m: float
+    method: Literal["intg", "smpl"]
+    exploration: ExplorationMap | None = None
+
+    def rewards(self, actions, tracks, rng: np.random.Generator) -> np.ndarray:
+        """Expected information (nats) of each of ``actions`` (flat indices) about ``tracks``; (len(actions),)."""
+        poses = self.grid.poses[actions]
+        reward = np.zeros(len(actions))
+        if len(tracks):
+            mean_m = tracks.mean[:, :2]
+            position_cov_m2 = tracks.covariance[:, :2, :2]
+            feet_px, cov_px, in_front = predicted_observations(self.camera, poses, mean_m, position_cov_m2, self.V)
+            if self.method == "intg":
+                alpha = detection_weight_integral(
+                    self.camera, poses, self.detector, feet_px, cov_px, in_front, self.control.person_height_m
+                )
+            else:
+                reference_pose = look_at(self.camera, mean_m.mean(axis=0), zoom=1.0)
+                alpha = detection_weight_sampled(
+                    self.camera,
+                    poses,
+                    self.detector,
+                    mean_m,
+                    position_cov_m2,
+                    self.control.person_height_m,
+                    self.person_width_m,
+                    reference_pose,
+                    rng,
+                    self.control.samples,
+                )
+            reward += np.sum(np.where(in_front, information_gain_nats(alpha, cov_px, self.V), 0.0), axis=-1)
+        if self.exploration is not None:
+            reward += self.control.beta * self.exploration.information_nats(actions)
+        return reward
+
+    def choose(self, context: DecisionContext) -> int:
+        reward = self.rewards(context.reachable, context.tracks, context.rng)
+        best = int(np.argmax(reward))
+        staying = np.flatnonzero(context.reachable == context.current_action)
+        if len(staying) and reward[staying[0]] >= reward[best]:
+            action = context.current_action
+        else:
+            action = int(context.reachable[best])
+        if self.exploration is not None:
+            self.exploration.advance(action)
+        return action
