@@ -11,20 +11,27 @@ Poisson process of rate ``lambda`` per m^2 per second, so between two steps
 
 Looking with action ``a``, a person in cell c is detected with probability
 ``q_c(a) = recall(r_c(a))`` if it stands fully in view (head and feet in the
-image), 0 otherwise. The observation ``d_c`` of the cell is "detected" with
-probability ``p_c q_c`` (then b_c is known: entropy 0) or "not detected",
-after which Bayes gives ``p_c' = p_c (1 - q_c) / (1 - p_c q_c)``. The mutual
-information between ``b_c`` and ``d_c`` is therefore
+image), 0 otherwise. The reward models the look as the paper's equation 7
+models a track's observation: with probability ``q_c(a)`` the camera learns
+the cell's state (entropy ``H_b(p_c)`` removed), otherwise it learns nothing
+(an erasure channel). The mutual information between ``b_c`` and the
+observation is then
 
-    I_c(a) = H_b(p_c) - (1 - p_c q_c) H_b(p_c'),
+    I_c(a) = q_c(a) H_b(p_c),
 
 with ``H_b`` the binary entropy in nats, and cells are independent, so
-``I_p(a) = sum_c I_c(a)``. It is zero for a cell the camera cannot see
-(``q_c = 0``) and for a cell it has just cleared (``p_c`` near 0), and it grows
-the longer a cell goes unobserved: the camera is drawn back to places it has
-not looked at for a while, and more to views where it would actually detect
-(larger people, so zoom matters as well). After the camera looks, each
-cell's belief takes the no-detection posterior (a detection becomes a track).
+``I_p(a) = sum_c q_c(a) H_b(p_c)``: one matrix-vector product over all
+actions. (The exact information of our detector, which cannot report a
+person who is not there, is ``H_b(p) - (1 - p q) H_b(p (1 - q) / (1 - p q))``;
+it agrees at q = 0 and q = 1 and lies within 20 % in between for small p,
+but is not linear in q and cost ten times the rest of a decision.)
+It is zero for a cell the camera cannot see and for a cell it has just
+cleared (``p_c`` near 0), and it grows the longer a cell goes unobserved:
+the camera is drawn back to places it has not looked at for a while, and
+more to views where it would actually detect (larger people, so zoom
+matters as well). After the camera looks, each cell's belief takes the exact
+Bayes posterior of no detection, ``p_c' = p_c (1 - q_c) / (1 - p_c q_c)``
+(a detection becomes a track, so it does not stay in the map).
 """
 
 from dataclasses import dataclass, field
@@ -49,14 +56,6 @@ def cell_detection_probability(
     return np.where(person_in_view(camera, people), recall(people.height_px, detector), 0.0)
 
 
-def exploration_information_nats(occupancy, detection_probability) -> np.ndarray:
-    """``I_p(a)`` for beliefs ``occupancy`` (C,) and ``q`` (L, C): returns (L,) nats."""
-    p, q = occupancy, detection_probability
-    no_detection = 1.0 - p * q
-    posterior = p * (1.0 - q) / no_detection
-    return np.sum(binary_entropy_nats(p) - no_detection * binary_entropy_nats(posterior), axis=-1)
-
-
 @dataclass
 class ExplorationMap:
     """Beliefs that cells hold people not yet tracked, and how each action would observe them.
@@ -72,7 +71,7 @@ class ExplorationMap:
 
     def information_nats(self, actions) -> np.ndarray:
         """``I_p(a)`` for the given flat action indices; (len(actions),)."""
-        return exploration_information_nats(self.occupancy, self.detection_probability[actions])
+        return self.detection_probability[actions] @ binary_entropy_nats(self.occupancy)
 
     def advance(self, action: int) -> None:
         """One step: people may arrive anywhere, then the camera looks with ``action``."""

@@ -8,63 +8,176 @@ if it is detected, which happens with probability ``alpha(a)``; then
     I(a) = alpha(a) (H(P-) - H(P+(a))) = alpha(a) * 1/2 log(det Sigma_o / det V)   (equations 4, 7)
 
 because ``det P+ / det P- = det V / det Sigma_o`` for the Kalman update (the
-matrix determinant lemma), so no update need be computed. Everything is
-vectorised over actions (L) x tracks (n), and for ``smpl`` x samples (M).
+matrix determinant lemma), so no update need be computed.
+
+The rewards are evaluated for every action (L) x track (n), and for ``smpl``
+x sample (M), in Numba kernels: each pair costs some sixty scalar operations,
+and as NumPy array operations their per-call overhead, not their arithmetic,
+kept decisions ten times slower than a PTZ head moves. The kernels share one
+camera model: they take the per-action homographies of
+:mod:`ptztrack.geometry.ptz`, computed once per grid.
 """
 
+import math
+from dataclasses import dataclass
+
+import numba
 import numpy as np
 from scipy.stats import norm, qmc
 
 from ptztrack.config import Detector
-from ptztrack.control.gaussian_rectangle import gaussian_rectangle_probability
-from ptztrack.detect.simulated import occluded_fraction, recall
+from ptztrack.control.gaussian_rectangle import rectangle_probability_scalar
+from ptztrack.detect.simulated import occluded_fraction, realistic_recall
 from ptztrack.geometry.ptz import (
     PTZCamera,
-    apply_homography,
     ground_to_image,
     head_from_feet_homology,
-    homography_jacobian,
-    person_in_view,
+    plane_homography,
     project_people,
 )
 
 
-def predicted_observations(camera: PTZCamera, poses, mean_m, position_cov_m2, V):
-    """Equation 9 for every action and track.
+@dataclass(frozen=True)
+class ActionGeometry:
+    """The per-action matrices the rewards need, computed once per grid.
 
-    poses : (L, 3); mean_m : (n, 2) predicted ground positions;
-    position_cov_m2 : (n, 2, 2) their covariance; V : (2, 2) pixel noise.
-    Returns o- (L, n, 2) px, Sigma_o (L, n, 2, 2) px^2, and in_front (L, n) bool.
+    ground_to_image : (L, 3, 3) ground-plane homographies.
+    head_to_image : (L, 3, 3) homographies of the plane at the assumed head height.
+    head_from_feet : (L, 3, 3) the homologies ``W`` for that height.
     """
-    H = ground_to_image(camera, poses)
-    in_front = np.einsum("nj,lj->ln", mean_m, H[:, 2, :2]) + H[:, 2, 2, None] > 0
-    feet_px = apply_homography(H, mean_m)
-    J = homography_jacobian(H, mean_m)
-    cov_px = J @ position_cov_m2 @ np.swapaxes(J, -1, -2) + V
-    return feet_px, cov_px, in_front
+
+    ground_to_image: np.ndarray
+    head_to_image: np.ndarray
+    head_from_feet: np.ndarray
+
+    def take(self, actions) -> "ActionGeometry":
+        return ActionGeometry(self.ground_to_image[actions], self.head_to_image[actions], self.head_from_feet[actions])
 
 
-def _log_det_2x2(cov):
-    return np.log(cov[..., 0, 0] * cov[..., 1, 1] - cov[..., 0, 1] * cov[..., 1, 0])
+def action_geometry(camera: PTZCamera, poses, person_height_m: float) -> ActionGeometry:
+    return ActionGeometry(
+        ground_to_image(camera, poses),
+        plane_homography(camera, poses, person_height_m),
+        head_from_feet_homology(camera, poses, person_height_m),
+    )
 
 
-def information_gain_nats(alpha, cov_px, V) -> np.ndarray:
-    """Equation 7 for every action and track: ``alpha * 1/2 log(det Sigma_o / det V)`` in nats."""
-    return alpha * 0.5 * (_log_det_2x2(cov_px) - _log_det_2x2(np.asarray(V)))
+@numba.njit
+def _predict(H, x_m, y_m, var_x, cov_xy, var_y, V):
+    """Equation 9 for one action and track: (u, v, var_u, cov_uv, var_v, w), w > 0 in front.
+
+    ``C_x(a)`` is the homography's Jacobian at the prediction (zero for the velocity).
+    """
+    X = H[0, 0] * x_m + H[0, 1] * y_m + H[0, 2]
+    Y = H[1, 0] * x_m + H[1, 1] * y_m + H[1, 2]
+    w = H[2, 0] * x_m + H[2, 1] * y_m + H[2, 2]
+    u, v = X / w, Y / w
+    a, b = (H[0, 0] - u * H[2, 0]) / w, (H[0, 1] - u * H[2, 1]) / w
+    c, d = (H[1, 0] - v * H[2, 0]) / w, (H[1, 1] - v * H[2, 1]) / w
+    var_u = a * a * var_x + 2 * a * b * cov_xy + b * b * var_y + V[0, 0]
+    cov_uv = a * c * var_x + (a * d + b * c) * cov_xy + b * d * var_y + V[0, 1]
+    var_v = c * c * var_x + 2 * c * d * cov_xy + d * d * var_y + V[1, 1]
+    return u, v, var_u, cov_uv, var_v, w
+
+
+@numba.njit
+def _information_if_detected(ground_to_image, mean_m, position_cov_m2, V):
+    L, n = ground_to_image.shape[0], mean_m.shape[0]
+    log_det_V = math.log(V[0, 0] * V[1, 1] - V[0, 1] * V[1, 0])
+    gain = np.zeros((L, n))
+    for action in range(L):
+        for track in range(n):
+            _, _, var_u, cov_uv, var_v, w = _predict(
+                ground_to_image[action],
+                mean_m[track, 0],
+                mean_m[track, 1],
+                position_cov_m2[track, 0, 0],
+                position_cov_m2[track, 0, 1],
+                position_cov_m2[track, 1, 1],
+                V,
+            )
+            if w > 0:
+                gain[action, track] = 0.5 * (math.log(var_u * var_v - cov_uv * cov_uv) - log_det_V)
+    return gain
+
+
+def information_if_detected_nats(geometry: ActionGeometry, mean_m, position_cov_m2, V) -> np.ndarray:
+    """``H(P-) - H(P+(a)) = 1/2 log(det Sigma_o / det V)`` (nats) for every action and track; (L, n).
+
+    0 for a track behind the camera. mean_m : (n, 2); position_cov_m2 : (n, 2, 2); V : (2, 2).
+    """
+    return _information_if_detected(
+        geometry.ground_to_image, np.asarray(mean_m, float), np.asarray(position_cov_m2, float), np.asarray(V, float)
+    )
+
+
+@numba.njit
+def _detection_weight_integral(
+    ground_to_image, head_from_feet, mean_m, position_cov_m2, V, width_px, height_px, realistic, kd, r0_px
+):
+    L, n = ground_to_image.shape[0], mean_m.shape[0]
+    alpha = np.zeros((L, n))
+    for action in range(L):
+        W = head_from_feet[action]
+        for track in range(n):
+            u, v, var_u, cov_uv, var_v, w = _predict(
+                ground_to_image[action],
+                mean_m[track, 0],
+                mean_m[track, 1],
+                position_cov_m2[track, 0, 0],
+                position_cov_m2[track, 0, 1],
+                position_cov_m2[track, 1, 1],
+                V,
+            )
+            if w <= 0:
+                continue
+            head_w = W[2, 0] * u + W[2, 1] * v + W[2, 2]
+            head_u = (W[0, 0] * u + W[0, 1] * v + W[0, 2]) / head_w
+            head_v = (W[1, 0] * u + W[1, 1] * v + W[1, 2]) / head_w
+            slope = (W[1, 1] - head_v * W[2, 1]) / head_w
+            if abs(slope) < 1e-9:
+                slope = 1e-9
+            lean_u = head_u - u
+            head_offset = head_v - slope * v
+            edge_a = -head_offset / slope
+            edge_b = (height_px - head_offset) / slope
+            v_low = max(0.0, min(edge_a, edge_b))
+            v_high = min(height_px, max(edge_a, edge_b))
+            u_low = max(0.0, -lean_u)
+            u_high = min(width_px, width_px - lean_u)
+            height_slope, height_offset = 1.0 - slope, -head_offset
+            if realistic:
+                v_at_r0 = (r0_px - height_offset) / height_slope
+                if height_slope > 0:
+                    v_low = max(v_low, v_at_r0)
+                else:
+                    v_high = min(v_high, v_at_r0)
+            value = rectangle_probability_scalar(u, v, var_u, cov_uv, var_v, u_low, u_high, v_low, v_high)
+            if realistic and value > 0:
+                b_v = -kd * height_slope
+                log_scale = -kd * (height_offset - r0_px) + b_v * v + 0.5 * b_v * b_v * var_v
+                shifted = rectangle_probability_scalar(
+                    u + cov_uv * b_v, v + var_v * b_v, var_u, cov_uv, var_v, u_low, u_high, v_low, v_high
+                )
+                if shifted > 0:
+                    value -= math.exp(log_scale + math.log(shifted))
+            alpha[action, track] = min(max(value, 0.0), 1.0)
+    return alpha
 
 
 def detection_weight_integral(
-    camera: PTZCamera, poses, detector: Detector, feet_px, cov_px, in_front, person_height_m: float
+    camera: PTZCamera, geometry: ActionGeometry, detector: Detector, mean_m, position_cov_m2, V
 ) -> np.ndarray:
     """``alpha(a)`` of equation 8 in closed form: 'intg'.
 
-    The visibility domain (equation 10) asks feet and head inside the image.
-    The head row follows the feet row through the homology linearised at
-    ``o-`` (equations 11-12): ``v_head = v_head(o-) + s (v - v-)``, with
-    ``s = dW_v / dv``. The paper drops the head's horizontal offset; a tilted
-    camera makes people lean in the image (30 px and more at steep tilts),
-    so we keep it at its predicted value ``lean = u_head(o-) - u-``, which
-    still leaves a rectangle: ``max(0, -lean) <= u <= min(w, w - lean)`` by
+    The prediction is ``o ~ N(o-, Sigma_o)`` (equation 9). The visibility
+    domain (equation 10) asks feet and head inside the image. The head row
+    follows the feet row through the homology linearised at ``o-`` (equations
+    11-12): ``v_head = v_head(o-) + s (v - v-)``, with ``s = dW_v / dv``. The
+    paper drops the head's horizontal offset; a tilted camera makes people
+    lean in the image (30 px and more at steep tilts), so we keep it at its
+    predicted value ``lean = u_head(o-) - u-``, which still leaves a
+    rectangle: ``max(0, -lean) <= u <= min(w, w - lean)`` by
     ``v_low <= v <= v_high``.
     The pixel height ``r = v - v_head = D v + d`` is linear in ``v`` (equation
     13); recall is zero below ``r0``, which only moves ``v_low``, and above it
@@ -74,45 +187,52 @@ def detection_weight_integral(
     with ``b = (0, -Kd D)``: an exponential times a Gaussian is a scaled
     Gaussian. The ideal detector has recall 1 and ``alpha = P_rect(N(mu, S))``.
 
-    feet_px, cov_px, in_front : from :func:`predicted_observations` for ``poses`` (L, 3).
-    Returns alpha (L, n) in [0, 1].
+    mean_m : (n, 2) predicted ground positions; position_cov_m2 : (n, 2, 2);
+    V : (2, 2) pixel noise. Returns alpha (L, n) in [0, 1], 0 behind the camera.
     """
-    W = head_from_feet_homology(camera, poses, person_height_m)
-    head_px = apply_homography(W, feet_px)
-    lean_u = head_px[..., 0] - feet_px[..., 0]
-    head_v = head_px[..., 1]
-    slope = homography_jacobian(W, feet_px)[..., 1, 1]
-    slope = np.where(np.abs(slope) < 1e-9, 1e-9, slope)
-    mean_v = feet_px[..., 1]
-    head_offset = head_v - slope * mean_v
-    edge_a = -head_offset / slope
-    edge_b = (camera.image_height_px - head_offset) / slope
-    v_low = np.maximum(0.0, np.minimum(edge_a, edge_b))
-    v_high = np.minimum(float(camera.image_height_px), np.maximum(edge_a, edge_b))
-    height_slope, height_offset = 1.0 - slope, -head_offset
-    if detector.kind == "realistic":
-        v_at_r0 = (detector.recall_r0_px - height_offset) / height_slope
-        v_low = np.where(height_slope > 0, np.maximum(v_low, v_at_r0), v_low)
-        v_high = np.where(height_slope > 0, v_high, np.minimum(v_high, v_at_r0))
-    low = np.stack([np.maximum(0.0, -lean_u), v_low], axis=-1)
-    high = np.stack([np.minimum(camera.image_width_px, camera.image_width_px - lean_u), v_high], axis=-1)
-    alpha = gaussian_rectangle_probability(feet_px, cov_px, low, high)
-    if detector.kind == "realistic":
-        kd = detector.recall_kd
-        b_v = -kd * height_slope
-        cov_vv = cov_px[..., 1, 1]
-        shifted = feet_px + cov_px[..., :, 1] * b_v[..., None]
-        log_scale = -kd * (height_offset - detector.recall_r0_px) + b_v * mean_v + 0.5 * b_v**2 * cov_vv
-        shifted_probability = gaussian_rectangle_probability(shifted, cov_px, low, high)
-        with np.errstate(divide="ignore", over="ignore"):
-            missed = np.where(shifted_probability > 0, np.exp(log_scale + np.log(shifted_probability)), 0.0)
-        alpha = alpha - missed
-    return np.where(in_front, np.clip(alpha, 0.0, 1.0), 0.0)
+    return _detection_weight_integral(
+        geometry.ground_to_image,
+        geometry.head_from_feet,
+        np.asarray(mean_m, float),
+        np.asarray(position_cov_m2, float),
+        np.asarray(V, float),
+        float(camera.image_width_px),
+        float(camera.image_height_px),
+        detector.kind == "realistic",
+        detector.recall_kd,
+        detector.recall_r0_px,
+    )
+
+
+@numba.njit
+def _detection_weight_sampled(ground_to_image, head_to_image, ground_m, visible_fraction, width_px, height_px, realistic, kd, r0_px):
+    L, (M, n) = ground_to_image.shape[0], ground_m.shape[:2]
+    alpha = np.zeros((L, n))
+    for action in range(L):
+        G, E = ground_to_image[action], head_to_image[action]
+        for sample in range(M):
+            for track in range(n):
+                x, y = ground_m[sample, track, 0], ground_m[sample, track, 1]
+                feet_w = G[2, 0] * x + G[2, 1] * y + G[2, 2]
+                head_w = E[2, 0] * x + E[2, 1] * y + E[2, 2]
+                if feet_w <= 0 or head_w <= 0:
+                    continue
+                feet_u = (G[0, 0] * x + G[0, 1] * y + G[0, 2]) / feet_w
+                feet_v = (G[1, 0] * x + G[1, 1] * y + G[1, 2]) / feet_w
+                head_u = (E[0, 0] * x + E[0, 1] * y + E[0, 2]) / head_w
+                head_v = (E[1, 0] * x + E[1, 1] * y + E[1, 2]) / head_w
+                if not (0 <= feet_u <= width_px and 0 <= head_u <= width_px):
+                    continue
+                if not (0 <= feet_v <= height_px and 0 <= head_v <= height_px):
+                    continue
+                p = realistic_recall(feet_v - head_v, kd, r0_px) if realistic else 1.0
+                alpha[action, track] += p * visible_fraction[sample, track]
+    return alpha / M
 
 
 def detection_weight_sampled(
     camera: PTZCamera,
-    poses,
+    geometry: ActionGeometry,
     detector: Detector,
     mean_m,
     position_cov_m2,
@@ -148,6 +268,14 @@ def detection_weight_sampled(
     ground_m = mean_m + np.einsum("nij,mnj->mni", chol, standard)
     at_reference = project_people(camera, reference_pose, ground_m, person_height_m, person_width_m)
     hidden = occluded_fraction(at_reference.box_px, at_reference.depth_m, at_reference.depth_m > 0)
-    people = project_people(camera, np.asarray(poses)[:, None, :], ground_m, person_height_m, person_width_m)
-    detected = np.where(person_in_view(camera, people), recall(people.height_px, detector) * (1.0 - hidden), 0.0)
-    return detected.mean(axis=1)
+    return _detection_weight_sampled(
+        geometry.ground_to_image,
+        geometry.head_to_image,
+        ground_m,
+        1.0 - hidden,
+        float(camera.image_width_px),
+        float(camera.image_height_px),
+        detector.kind == "realistic",
+        detector.recall_kd,
+        detector.recall_r0_px,
+    )

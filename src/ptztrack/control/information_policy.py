@@ -9,7 +9,7 @@ with ``alpha`` in closed form ('intg') or by sampling with occlusions
 exploration term), the camera stays.
 """
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Literal
 
 import numpy as np
@@ -18,10 +18,11 @@ from ptztrack.camera.actions import ActionGrid
 from ptztrack.config import Control, Detector
 from ptztrack.control.exploration import ExplorationMap
 from ptztrack.control.information_gain import (
+    ActionGeometry,
+    action_geometry,
     detection_weight_integral,
     detection_weight_sampled,
-    information_gain_nats,
-    predicted_observations,
+    information_if_detected_nats,
 )
 from ptztrack.control.policy import DecisionContext
 from ptztrack.geometry.ptz import PTZCamera, look_at
@@ -43,24 +44,27 @@ class InformationGainPolicy:
     person_width_m: float
     method: Literal["intg", "smpl"]
     exploration: ExplorationMap | None = None
+    geometry: ActionGeometry = field(init=False, repr=False)
+
+    def __post_init__(self):
+        self.geometry = action_geometry(self.camera, self.grid.poses, self.control.person_height_m)
 
     def rewards(self, actions, tracks, rng: np.random.Generator) -> np.ndarray:
         """Expected information (nats) of each of ``actions`` (flat indices) about ``tracks``; (len(actions),)."""
-        poses = self.grid.poses[actions]
+        geometry = self.geometry.take(actions)
         reward = np.zeros(len(actions))
         if len(tracks):
             mean_m = tracks.mean[:, :2]
             position_cov_m2 = tracks.covariance[:, :2, :2]
-            feet_px, cov_px, in_front = predicted_observations(self.camera, poses, mean_m, position_cov_m2, self.V)
             if self.method == "intg":
                 alpha = detection_weight_integral(
-                    self.camera, poses, self.detector, feet_px, cov_px, in_front, self.control.person_height_m
+                    self.camera, geometry, self.detector, mean_m, position_cov_m2, self.V
                 )
             else:
                 reference_pose = look_at(self.camera, mean_m.mean(axis=0), zoom=1.0)
                 alpha = detection_weight_sampled(
                     self.camera,
-                    poses,
+                    geometry,
                     self.detector,
                     mean_m,
                     position_cov_m2,
@@ -70,7 +74,8 @@ class InformationGainPolicy:
                     rng,
                     self.control.samples,
                 )
-            reward += np.sum(np.where(in_front, information_gain_nats(alpha, cov_px, self.V), 0.0), axis=-1)
+            information = information_if_detected_nats(geometry, mean_m, position_cov_m2, self.V)
+            reward += np.sum(alpha * information, axis=-1)
         if self.exploration is not None:
             reward += self.control.beta * self.exploration.information_nats(actions)
         return reward

@@ -13,8 +13,10 @@ hidden by people nearer the camera:
   (equation 13, HOG on Caltech).
 """
 
+import math
 from dataclasses import dataclass
 
+import numba
 import numpy as np
 
 from ptztrack.config import Detector
@@ -38,13 +40,20 @@ class Detections:
         return len(self.feet_px)
 
 
+@numba.vectorize(["float64(float64, float64, float64)"], nopython=True)
+def realistic_recall(height_px, recall_kd, recall_r0_px):
+    """``1 - exp(-Kd (r - r0))`` for ``r >= r0``, else 0 (a ufunc that compiled code can call too)."""
+    if height_px < recall_r0_px:
+        return 0.0
+    return -math.expm1(-recall_kd * (height_px - recall_r0_px))
+
+
 def recall(height_px, detector: Detector) -> np.ndarray:
     """Probability of detecting a fully visible person ``height_px`` tall."""
     height_px = np.asarray(height_px, dtype=float)
     if detector.kind == "ideal":
         return np.ones_like(height_px)
-    above = height_px >= detector.recall_r0_px
-    return np.where(above, -np.expm1(-detector.recall_kd * (height_px - detector.recall_r0_px)), 0.0)
+    return realistic_recall(height_px, detector.recall_kd, detector.recall_r0_px)
 
 
 def occluded_fraction(box_px, depth_m, valid) -> np.ndarray:
