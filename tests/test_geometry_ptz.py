@@ -289,21 +289,22 @@ def test_project_people_box(sample, height_m, width_m):
     people = project_people(CAMERA, pose, ground_xy, height_m, width_m)
     box = people.box_px
     np.testing.assert_allclose(people.height_px, np.abs(people.feet_px[:, 1] - people.head_px[:, 1]), rtol=1e-12)
-    for point in (people.feet_px, people.head_px):
-        assert np.all(box[:, 0] <= point[:, 0])
-        assert np.all(point[:, 0] <= box[:, 2])
-        assert np.all(box[:, 1] <= point[:, 1])
-        assert np.all(point[:, 1] <= box[:, 3])
+    # the box spans the rows of feet and head and is centred between them
+    np.testing.assert_allclose(box[:, 1], np.minimum(people.feet_px[:, 1], people.head_px[:, 1]), rtol=1e-12)
+    np.testing.assert_allclose(box[:, 3], np.maximum(people.feet_px[:, 1], people.head_px[:, 1]), rtol=1e-12)
+    np.testing.assert_allclose(
+        box[:, 0] + box[:, 2], people.feet_px[:, 0] + people.head_px[:, 0], rtol=1e-9, atol=1e-6
+    )
     # People shorter than the camera's 7 m who stand ahead of it (not past the nadir) have
     # the head above the feet in the image.
     pan = np.deg2rad(pose[0])
     ahead = (ground_xy - CAMERA.centre_m[:2]) @ np.array([np.sin(pan), np.cos(pan)]) > 0
     assert np.all(people.head_px[ahead, 1] < people.feet_px[ahead, 1])
     np.testing.assert_allclose(people.depth_m, camera_depth_m(CAMERA, pose, with_z(ground_xy)), rtol=1e-12)
-    # the box is as wide as width_m seen at the mean depth of feet and head, plus the head/feet offset
+    # the box is as wide as width_m seen at the mean depth of feet and head (the lean is not added)
     focal_px = pose[2] * CAMERA.f_min_px
     mean_depth = 0.5 * (people.depth_m + head_depth[keep])
-    expected_width = np.abs(people.feet_px[:, 0] - people.head_px[:, 0]) + focal_px * width_m / mean_depth
+    expected_width = focal_px * width_m / mean_depth
     np.testing.assert_allclose(box[:, 2] - box[:, 0], expected_width, rtol=1e-9)
 
     # Doubling the zoom at the same pan/tilt doubles the box (about the principal point).

@@ -165,13 +165,23 @@ class ProjectedPeople:
 
     feet_px, head_px : (*P, N, 2) pixels.
     box_px : (*P, N, 4) as (left, top, right, bottom) pixels.
-    depth_m : (*P, N) depth of the feet along the optical axis (> 0 in front).
+    depth_m, head_depth_m : (*P, N) depth of the feet and of the head along
+        the optical axis (> 0 in front).
+    range_m : (*P, N) distance from the optical centre to the middle of the
+        body: who hides whom along a ray, whatever the pose.
     """
 
     feet_px: np.ndarray
     head_px: np.ndarray
     box_px: np.ndarray
     depth_m: np.ndarray
+    head_depth_m: np.ndarray
+    range_m: np.ndarray
+
+    @property
+    def in_front(self) -> np.ndarray:
+        """Feet and head both in front of the camera: only then is the box meaningful."""
+        return (self.depth_m > 0) & (self.head_depth_m > 0)
 
     @property
     def height_px(self) -> np.ndarray:
@@ -182,8 +192,11 @@ def project_people(camera: PTZCamera, poses, ground_xy, height_m, width_m) -> Pr
     """Project people (feet at ``ground_xy``, ``height_m`` tall, ``width_m`` wide) to boxes.
 
     ground_xy : (*P, N, 2); height_m, width_m : (*P, N) or broadcastable.
-    The box spans the feet and head pixels and is as wide as the person seen
-    at the mean depth of feet and head.
+    The box spans the rows of the feet and the head and is as wide as the
+    person seen at the mean depth of feet and head, centred between them. A
+    person off the image centre leans in the image; the box then has the
+    area of the leaning outline (a parallelogram), where a bounding box
+    would be too wide by the lean, more so the farther from the centre.
     """
     poses = np.asarray(poses, dtype=float)
     ground_xy = np.asarray(ground_xy, dtype=float)
@@ -200,16 +213,26 @@ def project_people(camera: PTZCamera, poses, ground_xy, height_m, width_m) -> Pr
     head_px, head_depth_m = project(head_m)
     focal_px = poses[..., ZOOM, None] * camera.f_min_px
     half_width_px = 0.5 * focal_px * np.asarray(width_m, dtype=float) / (0.5 * (feet_depth_m + head_depth_m))
+    middle_u_px = 0.5 * (feet_px[..., 0] + head_px[..., 0])
     box_px = np.stack(
         [
-            np.minimum(feet_px[..., 0], head_px[..., 0]) - half_width_px,
+            middle_u_px - half_width_px,
             np.minimum(feet_px[..., 1], head_px[..., 1]),
-            np.maximum(feet_px[..., 0], head_px[..., 0]) + half_width_px,
+            middle_u_px + half_width_px,
             np.maximum(feet_px[..., 1], head_px[..., 1]),
         ],
         axis=-1,
     )
-    return ProjectedPeople(feet_px=feet_px, head_px=head_px, box_px=box_px, depth_m=feet_depth_m)
+    range_m = np.linalg.norm(0.5 * (feet_m + head_m) - camera.centre_m, axis=-1)
+    range_m = np.broadcast_to(range_m, feet_depth_m.shape)
+    return ProjectedPeople(
+        feet_px=feet_px,
+        head_px=head_px,
+        box_px=box_px,
+        depth_m=feet_depth_m,
+        head_depth_m=head_depth_m,
+        range_m=range_m,
+    )
 
 
 def inside_image(camera: PTZCamera, pixels) -> np.ndarray:
@@ -225,7 +248,7 @@ def inside_image(camera: PTZCamera, pixels) -> np.ndarray:
 
 def person_in_view(camera: PTZCamera, people: ProjectedPeople) -> np.ndarray:
     """Whether each person stands in front of the camera with head and feet in the image; (*P, N)."""
-    return (people.depth_m > 0) & inside_image(camera, people.feet_px) & inside_image(camera, people.head_px)
+    return people.in_front & inside_image(camera, people.feet_px) & inside_image(camera, people.head_px)
 
 
 def look_at(camera: PTZCamera, target_xy, zoom=1.0) -> np.ndarray:
