@@ -6,7 +6,13 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from ptztrack.config import Detector, Scenario
-from ptztrack.detect.simulated import detect, detection_probability, occluded_fraction, recall
+from ptztrack.detect.simulated import (
+    detect,
+    detection_probability,
+    occluded_fraction,
+    occlusion_in_centred_views,
+    recall,
+)
 from ptztrack.geometry.ptz import apply_homography, image_to_ground, inside_image, look_at, project_people
 
 CAMERA = Scenario().ptz_camera()
@@ -208,6 +214,11 @@ def scene():
     return project_people(CAMERA, POSE, xy, heights, 0.5)
 
 
+def hidden_of(people, present):
+    """Occluded fractions in the view the people were projected in (they stand near its centre)."""
+    return occluded_fraction(people.box_px, people.range_m, present & people.in_front)
+
+
 def box_area(box):
     return (box[2] - box[0]) * (box[3] - box[1])
 
@@ -222,12 +233,12 @@ def test_unoccluded_person_in_middle_has_recall_probability():
     people = project_people(CAMERA, POSE, np.array([[7.5, 8.0], [12.0, 8.0]]), 1.75, 0.5)
     np.testing.assert_allclose(people.feet_px[0], [320.0, 240.0], atol=1e-9)
     assert 80 < people.height_px[0] < 110
-    p = detection_probability(CAMERA, people, np.ones(2, dtype=bool), REALISTIC)
+    p = detection_probability(CAMERA, people, hidden_of(people, np.ones(2, dtype=bool)), np.ones(2, dtype=bool), REALISTIC)
     np.testing.assert_allclose(p, recall(people.height_px, REALISTIC), rtol=1e-14)
     assert 0.4 < p[0] < 0.6
-    np.testing.assert_array_equal(detection_probability(CAMERA, people, np.ones(2, dtype=bool), IDEAL), [1.0, 1.0])
+    np.testing.assert_array_equal(detection_probability(CAMERA, people, hidden_of(people, np.ones(2, dtype=bool)), np.ones(2, dtype=bool), IDEAL), [1.0, 1.0])
     # a person who is not present is never detected and does not count
-    np.testing.assert_array_equal(detection_probability(CAMERA, people, np.array([False, True]), IDEAL), [0.0, 1.0])
+    np.testing.assert_array_equal(detection_probability(CAMERA, people, hidden_of(people, np.array([False, True])), np.array([False, True]), IDEAL), [0.0, 1.0])
 
 
 def test_person_behind_another_is_reduced_by_visible_fraction():
@@ -240,13 +251,13 @@ def test_person_behind_another_is_reduced_by_visible_fraction():
     # person 2 (a 0.8 m child right behind person 0) is entirely inside person 0's box
     assert box[0, 0] <= box[2, 0] and box[2, 2] <= box[0, 2] and box[0, 1] <= box[2, 1] and box[2, 3] <= box[0, 3]
 
-    hidden = occluded_fraction(box, people.depth_m, ALL)
+    hidden = occluded_fraction(box, people.range_m, ALL)
     np.testing.assert_allclose(hidden[:3], [0.0, c1, 1.0], rtol=1e-12, atol=1e-12)
 
     r = recall(people.height_px, REALISTIC)
-    p = detection_probability(CAMERA, people, ALL, REALISTIC)
+    p = detection_probability(CAMERA, people, hidden_of(people, ALL), ALL, REALISTIC)
     np.testing.assert_allclose(p, [r[0], r[1] * (1 - c1), 0.0, r[3]], rtol=1e-12, atol=1e-12)
-    p_ideal = detection_probability(CAMERA, people, ALL, IDEAL)
+    p_ideal = detection_probability(CAMERA, people, hidden_of(people, ALL), ALL, IDEAL)
     np.testing.assert_allclose(p_ideal, [1.0, 1 - c1, 0.0, 1.0], rtol=1e-12, atol=1e-12)
 
     # without the front person, the child is fully visible and now it alone hides part of person 1
@@ -254,11 +265,11 @@ def test_person_behind_another_is_reduced_by_visible_fraction():
     c1_child = intersection_area(box[1], box[2]) / box_area(box[1])
     assert 0 < c1_child < c1
     present = np.array([False, True, True, True])
-    p_alone = detection_probability(CAMERA, people, present, REALISTIC)
+    p_alone = detection_probability(CAMERA, people, hidden_of(people, present), present, REALISTIC)
     np.testing.assert_allclose(p_alone, [0.0, r[1] * (1 - c1_child), r[2], r[3]], rtol=1e-12)
     # and without both, person 1 is fully visible
     present = np.array([False, True, False, True])
-    p_free = detection_probability(CAMERA, people, present, REALISTIC)
+    p_free = detection_probability(CAMERA, people, hidden_of(people, present), present, REALISTIC)
     np.testing.assert_allclose(p_free, [0.0, r[1], 0.0, r[3]], rtol=1e-12)
 
 
@@ -268,20 +279,20 @@ def test_person_outside_image_or_cut_off_is_never_detected():
     zoom2 = project_people(CAMERA, POSE, xy, 1.75, 0.5)
     zoom3 = project_people(CAMERA, POSE * [1, 1, 1.5], xy, 1.75, 0.5)
     assert inside_image(CAMERA, zoom2.feet_px).all() and not inside_image(CAMERA, zoom3.feet_px).any()
-    assert detection_probability(CAMERA, zoom2, np.ones(1, bool), IDEAL)[0] == 1.0
-    assert detection_probability(CAMERA, zoom3, np.ones(1, bool), IDEAL)[0] == 0.0
+    assert detection_probability(CAMERA, zoom2, hidden_of(zoom2, np.ones(1, bool)), np.ones(1, bool), IDEAL)[0] == 1.0
+    assert detection_probability(CAMERA, zoom3, hidden_of(zoom3, np.ones(1, bool)), np.ones(1, bool), IDEAL)[0] == 0.0
 
     to_ground = image_to_ground(CAMERA, POSE)
     # feet 10 px below the top border: the head is above the image
     top = apply_homography(to_ground, np.array([[320.0, 10.0]]))
     cut = project_people(CAMERA, POSE, top, 1.75, 0.5)
     assert inside_image(CAMERA, cut.feet_px).all() and cut.head_px[0, 1] < 0
-    assert detection_probability(CAMERA, cut, np.ones(1, bool), IDEAL)[0] == 0.0
+    assert detection_probability(CAMERA, cut, hidden_of(cut, np.ones(1, bool)), np.ones(1, bool), IDEAL)[0] == 0.0
     # feet just below the bottom border: head inside, feet outside
     bottom = apply_homography(to_ground, np.array([[320.0, 485.0]]))
     low = project_people(CAMERA, POSE, bottom, 1.75, 0.5)
     assert inside_image(CAMERA, low.head_px).all() and not inside_image(CAMERA, low.feet_px).any()
-    assert detection_probability(CAMERA, low, np.ones(1, bool), IDEAL)[0] == 0.0
+    assert detection_probability(CAMERA, low, hidden_of(low, np.ones(1, bool)), np.ones(1, bool), IDEAL)[0] == 0.0
 
 
 def test_person_behind_the_camera_is_never_detected():
@@ -290,7 +301,7 @@ def test_person_behind_the_camera_is_never_detected():
     behind = project_people(CAMERA, pose, np.array([[7.5, -104.0]]), 1.75, 0.5)
     assert behind.depth_m[0] < 0
     assert inside_image(CAMERA, behind.feet_px).all() and inside_image(CAMERA, behind.head_px).all()
-    assert detection_probability(CAMERA, behind, np.ones(1, bool), IDEAL)[0] == 0.0
+    assert detection_probability(CAMERA, behind, hidden_of(behind, np.ones(1, bool)), np.ones(1, bool), IDEAL)[0] == 0.0
 
 
 def test_detection_probability_batched_over_poses():
@@ -299,11 +310,11 @@ def test_detection_probability_batched_over_poses():
     heights = np.array([1.75, 1.75, 0.8, 1.75])
     present = np.array([True, True, True, False])
     batch = project_people(CAMERA, poses, np.broadcast_to(xy, (3, 4, 2)), heights, 0.5)
-    p = detection_probability(CAMERA, batch, np.broadcast_to(present, (3, 4)), REALISTIC)
+    p = detection_probability(CAMERA, batch, hidden_of(batch, np.broadcast_to(present, (3, 4))), np.broadcast_to(present, (3, 4)), REALISTIC)
     assert p.shape == (3, 4)
     for k, pose in enumerate(poses):
         single = project_people(CAMERA, pose, xy, heights, 0.5)
-        np.testing.assert_allclose(p[k], detection_probability(CAMERA, single, present, REALISTIC), rtol=1e-12)
+        np.testing.assert_allclose(p[k], detection_probability(CAMERA, single, hidden_of(single, present), present, REALISTIC), rtol=1e-12)
 
 
 # ---------------------------------------------------------------------------
@@ -325,13 +336,13 @@ def many_draws():
     people = project_people(CAMERA, POSE, xy, 1.75, 0.5)
     present = np.ones(ROW, dtype=bool)
     rng = np.random.default_rng(20240611)
-    frames = [detect(CAMERA, people, present, REALISTIC, rng) for _ in range(FRAMES)]
+    frames = [detect(CAMERA, people, hidden_of(people, present), present, REALISTIC, rng) for _ in range(FRAMES)]
     return people, present, frames
 
 
 def test_empirical_detection_rate_matches_probability(many_draws):
     people, present, frames = many_draws
-    p = detection_probability(CAMERA, people, present, REALISTIC)
+    p = detection_probability(CAMERA, people, hidden_of(people, present), present, REALISTIC)
     np.testing.assert_allclose(p, p[0], rtol=1e-12)
     assert 0.4 < p[0] < 0.6
     np.testing.assert_array_equal(occluded_fraction(people.box_px, people.depth_m, present), 0.0)
@@ -363,7 +374,8 @@ def test_pixel_noise_matches_detector(many_draws):
 def test_noise_free_detector_reports_exact_feet():
     people = scene()
     detector = Detector(kind="ideal", pixel_noise_px=0.0)
-    found = detect(CAMERA, people, np.ones(4, dtype=bool), detector, np.random.default_rng(3))
+    everyone = np.ones(4, dtype=bool)
+    found = detect(CAMERA, people, hidden_of(people, everyone), everyone, detector, np.random.default_rng(3))
     # ideal detector: everyone except the fully hidden child (2); person 1 with probability 1 - c
     assert 0 in found.person_index and 3 in found.person_index and 2 not in found.person_index
     np.testing.assert_array_equal(found.feet_px, people.feet_px[found.person_index])
@@ -376,7 +388,7 @@ def test_false_positives():
     people = scene()
     absent = np.zeros(4, dtype=bool)
     rng = np.random.default_rng(99)
-    frames = [detect(CAMERA, people, absent, detector, rng) for _ in range(4000)]
+    frames = [detect(CAMERA, people, hidden_of(people, absent), absent, detector, rng) for _ in range(4000)]
     counts = np.array([len(f) for f in frames])
     standard_error = np.sqrt(rate / len(counts))
     assert abs(counts.mean() - rate) < 4 * standard_error
@@ -393,7 +405,7 @@ def test_false_positives():
     # with a true person present, false positives come after the hits
     present = np.array([True, False, False, True])
     ideal = Detector(kind="ideal", false_positives_per_frame=rate)
-    mixed = [detect(CAMERA, people, present, ideal, rng) for _ in range(50)]
+    mixed = [detect(CAMERA, people, hidden_of(people, present), present, ideal, rng) for _ in range(50)]
     for frame in mixed:
         true = frame.person_index >= 0
         assert np.all(true[: true.sum()]) and not np.any(true[true.sum():])
@@ -405,8 +417,8 @@ def test_same_seed_gives_identical_detections():
     people = scene()
     detector = Detector(false_positives_per_frame=2.0)
     present = np.ones(4, dtype=bool)
-    first = [detect(CAMERA, people, present, detector, np.random.default_rng(7)) for _ in range(3)]
-    again = detect(CAMERA, people, present, detector, np.random.default_rng(7))
+    first = [detect(CAMERA, people, hidden_of(people, present), present, detector, np.random.default_rng(7)) for _ in range(3)]
+    again = detect(CAMERA, people, hidden_of(people, present), present, detector, np.random.default_rng(7))
     for frame in first:
         np.testing.assert_array_equal(frame.feet_px, again.feet_px)
         np.testing.assert_array_equal(frame.height_px, again.height_px)
@@ -414,7 +426,26 @@ def test_same_seed_gives_identical_detections():
     # a stream of draws is reproducible too, and different seeds differ
     def stream(seed):
         rng = np.random.default_rng(seed)
-        return np.concatenate([detect(CAMERA, people, present, detector, rng).feet_px.ravel() for _ in range(20)])
+        return np.concatenate([detect(CAMERA, people, hidden_of(people, present), present, detector, rng).feet_px.ravel() for _ in range(20)])
 
     np.testing.assert_array_equal(stream(11), stream(11))
     assert not np.array_equal(stream(11), stream(12))
+
+
+def test_occlusion_in_centred_views_matches_the_view_on_the_scene():
+    xy = np.array([[7.5, 8.0], [7.5, 10.0], [7.5, 9.6], [12.0, 8.0]])
+    heights = np.array([1.75, 1.75, 0.8, 1.75])
+    centred = occlusion_in_centred_views(CAMERA, xy, heights, np.full(4, 0.5), ALL)
+    np.testing.assert_allclose(centred, hidden_of(scene(), ALL), atol=0.05)
+    assert centred[2] == pytest.approx(1.0) and centred[0] == 0.0 and centred[3] == 0.0
+    nobody_in_front = occlusion_in_centred_views(CAMERA, xy, heights, np.full(4, 0.5), np.array([False, True, True, True]))
+    assert nobody_in_front[2] == 0.0
+
+
+def test_a_person_seen_at_a_grazing_angle_hides_nobody():
+    """At pan 45, tilt 15 the head of a person far to the left lies almost in the image plane:
+    its box is thousands of pixels wide, but it cannot hide people in the centre of the view."""
+    xy = np.array([[0.5, 1.0], [13.0, 12.0]])
+    heights = np.full(2, 1.75)
+    centred = occlusion_in_centred_views(CAMERA, xy, heights, np.full(2, 0.5), np.ones(2, bool))
+    np.testing.assert_array_equal(centred, 0.0)

@@ -3,7 +3,9 @@
 Both detectors of the paper are one model, ``p(d=1) = recall(r) * (1 - c)``
 for a person whose head and feet are inside the image (0 otherwise), where
 ``r`` is the person's height in pixels and ``c`` the fraction of its box
-hidden by people nearer the camera:
+hidden by the boxes of people nearer the camera (nearer: closer to the
+optical centre, which decides who hides whom along a ray, however the camera
+is turned):
 
 * ideal: ``recall(r) = 1``. The issue asks that an occluded person not be
   detected; we read "occluded" through the paper's own linear model
@@ -20,7 +22,7 @@ import numba
 import numpy as np
 
 from ptztrack.config import Detector
-from ptztrack.geometry.ptz import ProjectedPeople, PTZCamera, person_in_view
+from ptztrack.geometry.ptz import ProjectedPeople, PTZCamera, look_at, person_in_view, project_people
 
 
 @dataclass(frozen=True)
@@ -59,7 +61,8 @@ def recall(height_px, detector: Detector) -> np.ndarray:
 def occluded_fraction(box_px, depth_m, valid) -> np.ndarray:
     """Exact fraction of each box covered by the union of the boxes of nearer people.
 
-    box_px : (..., N, 4) (left, top, right, bottom); depth_m : (..., N);
+    box_px : (..., N, 4) (left, top, right, bottom); depth_m : (..., N) the
+    distance that orders people (nearer hides farther);
     valid : (..., N) bool, people that exist and are in front of the camera.
     Returns (..., N) in [0, 1]. The union is measured exactly by cutting each
     box along every occluder edge into at most (2N - 1)^2 cells.
@@ -95,25 +98,45 @@ def occluded_fraction(box_px, depth_m, valid) -> np.ndarray:
         return np.where(box_area > 0, np.clip(covered_area / box_area, 0.0, 1.0), 0.0)
 
 
-def detection_probability(camera: PTZCamera, people: ProjectedPeople, present, detector: Detector) -> np.ndarray:
-    """p(d=1) for every person; people and present have leading axes (..., N)."""
+def occlusion_in_centred_views(camera: PTZCamera, ground_xy, height_m, width_m, present) -> np.ndarray:
+    """The occluded fraction ``c`` of each person (N,), measured in the zoom-1 view centred on it.
+
+    Who hides whom is decided by the rays through the optical centre, so any
+    pose gives the same answer in principle; but a bounding box is a fair
+    outline of a person only near the optical axis (a person seen at a
+    grazing angle projects to a box thousands of pixels wide). Centring the
+    view on the person keeps every box that can touch its own near the axis.
+    ground_xy : (N, 2); height_m, width_m, present : (N,).
+    """
+    ground_xy = np.asarray(ground_xy, dtype=float)
+    centred = look_at(camera, ground_xy, 1.0)
+    people = project_people(camera, centred, ground_xy, height_m, width_m)
+    hidden = occluded_fraction(people.box_px, people.range_m, present & people.in_front)
+    return np.diagonal(hidden).copy()
+
+
+def detection_probability(camera: PTZCamera, people: ProjectedPeople, hidden, present, detector: Detector) -> np.ndarray:
+    """p(d=1) = recall(r) (1 - c) for every person in view, else 0.
+
+    people : projected at the pose; hidden : occluded fractions ``c``;
+    present : bool; all with leading axes (..., N).
+    """
     visible = present & person_in_view(camera, people)
-    hidden = occluded_fraction(people.box_px, people.depth_m, present & (people.depth_m > 0))
     return np.where(visible, recall(people.height_px, detector) * (1.0 - hidden), 0.0)
 
 
 def detect(
-    camera: PTZCamera, people: ProjectedPeople, present, detector: Detector, rng: np.random.Generator
+    camera: PTZCamera, people: ProjectedPeople, hidden, present, detector: Detector, rng: np.random.Generator
 ) -> Detections:
     """Draw one image's detections: hits with feet-pixel noise, plus Poisson false positives.
 
     people : the (N,) people of this frame projected at the current pose;
-    present : (N,) bool.
+    hidden : (N,) their occluded fractions; present : (N,) bool.
     The draws for every person are made whether or not it is in view, in a
     fixed order, so that for one generator state the luck of each person
     does not depend on the pose (common random numbers across policies).
     """
-    probability = detection_probability(camera, people, present, detector)
+    probability = detection_probability(camera, people, hidden, present, detector)
     luck = rng.random(probability.shape)
     noise_px = rng.normal(0.0, detector.pixel_noise_px, size=people.feet_px.shape)
     index = np.flatnonzero(luck < probability)
