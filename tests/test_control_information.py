@@ -1,0 +1,242 @@
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from scipy.stats import multivariate_normal
+
+from ptztrack.config import Control, Detector, Scenario, scenario_from_dict
+from ptztrack.control.gaussian_rectangle import bivariate_normal_cdf, gaussian_rectangle_probability
+from ptztrack.control.information_gain import (
+    action_geometry,
+    detection_weight_integral,
+    detection_weight_sampled,
+    information_if_detected_nats,
+)
+from ptztrack.control.policy import DecisionContext
+from ptztrack.detect.simulated import occluded_fraction, occlusion_in_centred_views, recall
+from ptztrack.episode import make_policy
+from ptztrack.geometry.ptz import (
+    apply_homography,
+    feet_jacobian,
+    ground_to_image,
+    head_from_feet_homology,
+    homography_jacobian,
+    look_at,
+    project_people,
+)
+from ptztrack.track import kalman
+from ptztrack.track.tracker import Tracks
+
+SCENARIO = Scenario()
+CAMERA, GRID = SCENARIO.ptz_camera(), SCENARIO.action_grid()
+V = 4.0 * np.eye(2)
+HEIGHT_M = 1.75
+
+
+@settings(deadline=None, max_examples=60)
+@given(
+    mean=st.tuples(st.floats(-3, 3), st.floats(-3, 3)),
+    scales=st.tuples(st.floats(0.1, 3), st.floats(0.1, 3)),
+    rho=st.floats(-0.95, 0.95),
+    low=st.tuples(st.floats(-4, 2), st.floats(-4, 2)),
+    size=st.tuples(st.floats(0, 6), st.floats(0, 6)),
+)
+def test_rectangle_probability_matches_scipys_numerical_cdf(mean, scales, rho, low, size):
+    cov = np.array([[scales[0] ** 2, rho * scales[0] * scales[1]], [rho * scales[0] * scales[1], scales[1] ** 2]])
+    high = np.add(low, size)
+    expected = multivariate_normal(mean, cov).cdf(high, lower_limit=low) if min(size) > 0 else 0.0
+    value = gaussian_rectangle_probability(*mean, cov[0, 0], cov[0, 1], cov[1, 1], low[0], high[0], low[1], high[1])
+    assert value == pytest.approx(expected, abs=1e-7)
+
+
+def test_bivariate_cdf_special_values():
+    assert bivariate_normal_cdf(0.0, 0.0, 0.0) == pytest.approx(0.25)
+    assert bivariate_normal_cdf(0.0, 0.0, 0.5) == pytest.approx(0.25 + np.arcsin(0.5) / (2 * np.pi))
+    assert bivariate_normal_cdf(20.0, 0.3, 0.7) == pytest.approx(0.6179114222)
+    assert bivariate_normal_cdf(-20.0, 0.3, 0.7) == 0.0
+
+
+def alpha_monte_carlo(pose, mean_m, cov_m2, detector, rng, samples=400_000):
+    """Equation 8 by sampling o ~ N(o-, Sigma_o), with the same linearised homology as the closed form."""
+    H = ground_to_image(CAMERA, pose)
+    o = apply_homography(H, mean_m[None])[0]
+    J = feet_jacobian(CAMERA, pose, mean_m[None])[0]
+    sigma_o = J @ cov_m2 @ J.T + V
+    W = head_from_feet_homology(CAMERA, pose, HEIGHT_M)
+    head = apply_homography(W, o[None])[0]
+    slope = homography_jacobian(W, o[None])[0, 1, 1]
+    draws = rng.multivariate_normal(o, sigma_o, size=samples)
+    head_u = draws[:, 0] + (head[0] - o[0])
+    head_v = head[1] + slope * (draws[:, 1] - o[1])
+    inside = (
+        (draws[:, 0] >= 0)
+        & (draws[:, 0] <= CAMERA.image_width_px)
+        & (head_u >= 0)
+        & (head_u <= CAMERA.image_width_px)
+        & (draws[:, 1] >= 0)
+        & (draws[:, 1] <= CAMERA.image_height_px)
+        & (head_v >= 0)
+        & (head_v <= CAMERA.image_height_px)
+    )
+    return np.mean(inside * recall(draws[:, 1] - head_v, detector))
+
+
+@pytest.mark.parametrize("kind", ["ideal", "realistic"])
+def test_closed_form_alpha_agrees_with_monte_carlo_of_equation_8(kind):
+    rng = np.random.default_rng(7)
+    detector = Detector(kind=kind)
+    checked = 0
+    for _ in range(30):
+        mean_m = rng.uniform(0, 15, size=2)
+        # aim near the person, so that many draws leave it partly in view
+        pose = look_at(CAMERA, mean_m + rng.normal(0, 3.0, size=2), rng.choice(GRID.zoom))
+        root = rng.normal(size=(2, 2)) * rng.uniform(0.05, 0.6)
+        cov_m2 = root @ root.T + 1e-4 * np.eye(2)
+        geometry = action_geometry(CAMERA, pose[None], HEIGHT_M)
+        alpha = detection_weight_integral(CAMERA, geometry, detector, mean_m[None], cov_m2[None], V)[0, 0]
+        expected = alpha_monte_carlo(pose, mean_m, cov_m2, detector, rng)
+        assert alpha == pytest.approx(expected, abs=0.01), (pose, mean_m)
+        checked += 0.02 < expected < 0.98
+    assert checked >= 5, "the draws must include people partly in view"
+
+
+def test_alpha_is_the_recall_well_inside_a_wide_view_and_zero_far_outside():
+    detector = Detector()
+    mean_m = np.array([[7.5, 4.0]])
+    cov_m2 = np.eye(2)[None] * 0.01**2
+    inside = look_at(CAMERA, mean_m[0], 1.0)
+    away = np.array([GRID.pan_deg[0], GRID.tilt_deg[0], GRID.zoom[-1]])
+    geometry = action_geometry(CAMERA, np.stack([inside, away]), HEIGHT_M)
+    alpha = detection_weight_integral(CAMERA, geometry, detector, mean_m, cov_m2, V)
+    height_px = project_people(CAMERA, inside, mean_m, HEIGHT_M, 0.5).height_px[0]
+    assert alpha[0, 0] == pytest.approx(recall(height_px, detector), abs=0.01)
+    assert alpha[1, 0] < 1e-6
+
+
+def test_information_if_detected_is_the_entropy_drop_of_the_kalman_update():
+    rng = np.random.default_rng(3)
+    mean = np.array([[6.0, 8.0, 1.0, 0.0], [10.0, 3.0, 0.0, -1.0]])
+    P = np.stack([np.diag([0.2, 0.1, 0.5, 0.5]), np.diag([0.05, 0.3, 0.4, 0.4])])
+    P[:, 0, 1] = P[:, 1, 0] = 0.03
+    actions = rng.choice(GRID.size, size=12, replace=False)
+    geometry = action_geometry(CAMERA, GRID.poses[actions], HEIGHT_M)
+    information = information_if_detected_nats(geometry, mean[:, :2], P[:, :2, :2], V)
+    for row, action in enumerate(actions):
+        J = feet_jacobian(CAMERA, GRID.poses[action], mean[:, :2])
+        C = np.concatenate([J, np.zeros_like(J)], axis=-1)
+        _, P_plus = kalman.update(mean, P, np.zeros((2, 2)), C, V)
+        drop = 0.5 * (np.linalg.slogdet(P)[1] - np.linalg.slogdet(P_plus)[1])
+        np.testing.assert_allclose(information[row], drop, rtol=1e-9)
+
+
+def single_track(mean_xy, sigma_m):
+    return Tracks(
+        ids=np.array([0]),
+        mean=np.array([[*mean_xy, 0.0, 0.0]]),
+        covariance=np.diag([sigma_m**2, sigma_m**2, 0.1, 0.1])[None],
+        missed_steps=np.array([0]),
+        next_id=1,
+    )
+
+
+@pytest.mark.parametrize("kind", ["ideal", "realistic"])
+def test_with_one_person_and_no_occluders_smpl_and_intg_choose_the_same_action(kind):
+    """Same action, up to ties: where both choices are worth the same to intg (within 0.1 %),
+    the sampled estimate may pick either."""
+    scenario = scenario_from_dict({"detector": {"kind": kind}, "control": {"beta": 0.0}})
+    rng = np.random.default_rng(11)
+    agreements = 0
+    for trial in range(12):
+        position = rng.uniform(1, 14, size=2)
+        tracks = single_track(position, rng.uniform(0.05, 0.3))
+        # start where the person can be seen from some reachable pose: a real choice to make
+        distance = np.abs(GRID.poses[:, :2] - look_at(CAMERA, position)[:2]).sum(axis=1)
+        current = int(np.argmin(distance + 100 * (GRID.axis_indices[:, 2] != rng.integers(4))))
+        context = DecisionContext(0, current, GRID.reachable(current), tracks, np.random.default_rng(trial))
+        intg_policy = make_policy("intg", scenario)
+        intg = intg_policy.choose(context)
+        smpl = make_policy("smpl", scenario).choose(context)
+        agreements += intg == smpl
+        worth = intg_policy.rewards(np.array([intg, smpl]), tracks, context.rng)
+        assert worth[1] >= 0.999 * worth[0]
+    assert agreements >= 10
+
+
+def test_smpl_does_not_count_on_a_person_hidden_behind_another_but_intg_does():
+    """Section 4.2: occlusion is what sampling adds."""
+    front = np.array([7.5, 3.0])
+    direction = front - CAMERA.centre_m[:2]
+    behind = front + 0.3 * direction / np.linalg.norm(direction)
+    mean_m = np.stack([front, behind])
+    cov_m2 = np.eye(2)[None].repeat(2, 0) * 0.02**2
+    pose = look_at(CAMERA, behind, 2.0)
+    geometry = action_geometry(CAMERA, pose[None], HEIGHT_M)
+    detector = Detector(kind="ideal")
+    intg = detection_weight_integral(CAMERA, geometry, detector, mean_m, cov_m2, V)[0]
+    smpl = detection_weight_sampled(
+        CAMERA, geometry, detector, mean_m, cov_m2, HEIGHT_M, 0.5, pose, np.random.default_rng(0), 100
+    )[0]
+    hidden = project_people(CAMERA, pose, mean_m, HEIGHT_M, 0.5)
+    c = occluded_fraction(hidden.box_px, hidden.range_m, hidden.in_front)
+    assert c[1] > 0.8
+    assert intg[1] > 0.99
+    assert smpl[0] > 0.99
+    assert smpl[1] == pytest.approx(1 - c[1], abs=0.1)
+
+
+def test_one_reference_view_gives_the_detectors_occlusion_on_average():
+    """smpl measures who hides whom once per sample in the view centred on the tracks;
+    the simulated detector in the view centred on each person. Same rays, slightly different boxes."""
+    rng = np.random.default_rng(5)
+    ground_m = rng.uniform(0, 15, size=(100, 7, 2))
+    reference = project_people(CAMERA, look_at(CAMERA, [7.5, 7.5], 1.0), ground_m, HEIGHT_M, 0.5)
+    at_reference = occluded_fraction(reference.box_px, reference.range_m, reference.in_front)
+    centred = np.stack(
+        [occlusion_in_centred_views(CAMERA, g, np.full(7, HEIGHT_M), np.full(7, 0.5), np.ones(7, bool)) for g in ground_m]
+    )
+    assert np.mean(np.abs(at_reference - centred)) < 0.01
+    assert np.mean(at_reference) == pytest.approx(np.mean(centred), rel=0.15)
+
+
+def test_zoom_leaves_occluded_fractions_exactly_unchanged():
+    rng = np.random.default_rng(6)
+    ground_m = rng.uniform(0, 15, size=(10, 7, 2))
+    fractions = []
+    for zoom in (1.0, 2.5, 4.0):
+        people = project_people(CAMERA, look_at(CAMERA, [6.0, 9.0], zoom), ground_m, HEIGHT_M, 0.5)
+        fractions.append(occluded_fraction(people.box_px, people.range_m, people.in_front))
+    np.testing.assert_allclose(fractions[0], fractions[1], atol=1e-9)
+    np.testing.assert_allclose(fractions[0], fractions[2], atol=1e-9)
+
+
+def test_patrolling_term_grows_while_unobserved_and_clears_where_the_camera_looks():
+    scenario = scenario_from_dict({"detector": {"kind": "ideal"}, "control": {"beta": 1.0}})
+    policy = make_policy("intg", scenario)
+    exploration = policy.exploration
+    wide = int(np.argmax(exploration.detection_probability.sum(axis=1)))
+    elsewhere = int(np.argmin(exploration.detection_probability[:, exploration.detection_probability[wide] > 0.5].sum(axis=1)))
+    before = exploration.information_nats(np.array([wide]))[0]
+    for _ in range(10):
+        exploration.advance(elsewhere)
+    grown = exploration.information_nats(np.array([wide]))[0]
+    exploration.advance(wide)
+    cleared = exploration.information_nats(np.array([wide]))[0]
+    assert grown > before > 0
+    assert cleared < 0.5 * grown
+    never_seen = exploration.detection_probability.max(axis=0) == 0
+    assert not never_seen.all()
+
+
+def test_without_tracks_the_patrolling_term_moves_the_camera_and_without_it_the_camera_stays():
+    empty = Tracks(np.zeros(0, int), np.zeros((0, 4)), np.zeros((0, 4, 4)), np.zeros(0, int))
+    start = int(GRID.index(3, 4, 1))
+    context = DecisionContext(0, start, GRID.reachable(start), empty, np.random.default_rng(0))
+    assert make_policy("intg", scenario_from_dict({"control": {"beta": 0.0}})).choose(context) == start
+    explorer = make_policy("intg", scenario_from_dict({"control": {"beta": 1.0}}))
+    moves = [explorer.choose(context) for _ in range(3)]
+    assert any(move != start for move in moves)
+
+
+def test_control_defaults_are_documented():
+    assert Control().samples == 100
+    assert Control().beta == 1.0
