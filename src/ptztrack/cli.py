@@ -5,10 +5,21 @@ import os
 import sys
 from pathlib import Path
 
+import json
+
 from ptztrack.config import Scenario, ScenarioError, load_scenario, scenario_from_dict
 from ptztrack.episode import POLICIES, run_episode
+from ptztrack.evaluate.experiment import (
+    EXECUTORS,
+    STRATEGIES,
+    format_table,
+    print_progress,
+    run_cells,
+    summarise,
+    synthetic_cells,
+)
 from ptztrack.evaluate.metrics import episode_metrics
-from ptztrack.evaluate.report import write_outputs
+from ptztrack.evaluate.report import write_atomically, write_outputs
 
 TABLE_ROWS = (
     ("MOTA", "mota", "{:.1%}"),
@@ -54,25 +65,64 @@ def run_command(args: argparse.Namespace) -> int:
     return 0
 
 
+def experiment_command(args: argparse.Namespace) -> int:
+    scenario = build_scenario(args.scenario, args.detector, args.frames)
+    cells = synthetic_cells(scenario, args.sequences, args.strategies)
+    print(
+        f"{len(cells)} episodes: {args.sequences} sequences x {len(args.strategies)} strategies, "
+        f"{scenario.frames} frames, {scenario.action_grid().size} actions, {args.executor} executor",
+        file=sys.stderr,
+    )
+    summary = summarise(run_cells(cells, args.executor, args.workers, print_progress), args.strategies)
+    title = (
+        f"{args.scenario} scene, {scenario.detector.kind} detector, beta {scenario.control.beta:g}, "
+        f"{args.sequences} sequences of {scenario.frames} frames (means over sequences)"
+    )
+    print(format_table(summary, title))
+    if args.json is not None:
+        write_atomically(args.json, (json.dumps(summary, indent=2) + "\n").encode())
+        print(f"wrote {args.json}")
+    return 0
+
+
 def parser() -> argparse.ArgumentParser:
     root = argparse.ArgumentParser(prog="ptztrack", description="Multi-person tracking with a PTZ camera.")
     commands = root.add_subparsers(dest="command", required=True)
     run = commands.add_parser("run", help="run one closed-loop episode and print its metrics")
     run.add_argument("--scenario", default="synthetic", help="'synthetic' (built in) or a scenario YAML file")
-    run.add_argument("--policy", choices=POLICIES, default="fix")
+    run.add_argument("--policy", choices=POLICIES, default="smpl")
     run.add_argument("--detector", choices=("ideal", "realistic"), help="overrides the scenario's detector")
     run.add_argument("--seed", type=int, default=0)
-    run.add_argument("--frames", type=int, help="overrides the scenario's number of frames")
+    run.add_argument("--frames", type=_positive_int, help="overrides the scenario's number of frames")
     run.add_argument("--out", type=Path, help="directory for metrics.json, tracks.csv and episode.png")
     run.set_defaults(handler=run_command)
+
+    experiment = commands.add_parser("experiment", help="run one of the paper's experiments and print its table")
+    experiment.add_argument("name", choices=("synthetic",), help="the experiment (Tables 1-2 of the PTZ paper)")
+    experiment.add_argument("--scenario", default="synthetic", help="'synthetic' (built in) or a scenario YAML file")
+    experiment.add_argument("--detector", choices=("ideal", "realistic"), default="realistic")
+    experiment.add_argument("--sequences", type=_positive_int, default=12)
+    experiment.add_argument("--frames", type=_positive_int, help="overrides the scenario's number of frames")
+    experiment.add_argument("--strategies", nargs="+", choices=STRATEGIES, default=list(STRATEGIES))
+    experiment.add_argument("--executor", choices=EXECUTORS, default="local")
+    experiment.add_argument("--workers", type=_positive_int, help="processes of the local executor (default: all cores)")
+    experiment.add_argument("--json", type=Path, help="write one row per strategy here")
+    experiment.set_defaults(handler=experiment_command)
     return root
+
+
+def _positive_int(text: str) -> int:
+    value = int(text)
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be at least 1 (got {value})")
+    return value
 
 
 def main(argv: list[str] | None = None) -> int:
     args = parser().parse_args(argv)
     try:
         return args.handler(args)
-    except ScenarioError as error:
+    except (ScenarioError, RuntimeError) as error:
         print(f"ptztrack: error: {error}", file=sys.stderr)
         return 2
     except BrokenPipeError:

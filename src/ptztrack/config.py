@@ -99,7 +99,7 @@ class Control(_Strict):
     """Parameters of the information-gain policies (paper sections 4 and 4.4)."""
 
     samples: int = Field(100, ge=1)
-    beta: NonNegativeFloat = 0.0
+    beta: NonNegativeFloat = 1.0
     person_height_m: PositiveFloat = 1.75
     exploration_cell_m: PositiveFloat = 1.0
     prior_occupancy: float = Field(0.05, ge=0, lt=1)

@@ -1,0 +1,158 @@
+"""Experiments as data: a grid of (scenario, strategy, seed) cells, run by an executor, summarised as the paper's tables.
+
+Every cell is a pure function of its inputs (the seed fixes every draw), so
+the serial, the local-process and the Ray executors give identical rows, in
+cell order.
+"""
+
+import os
+import sys
+from collections.abc import Callable, Sequence
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from dataclasses import dataclass
+
+import numpy as np
+
+from ptztrack.config import Scenario
+from ptztrack.episode import run_episode
+from ptztrack.evaluate.metrics import episode_metrics
+
+STRATEGIES = ("fix", "patrol", "rnd", "intg", "smpl")
+# The paper's column names; 'rnd' is the 'random' policy.
+POLICY_OF_STRATEGY = {"rnd": "random"}
+EXECUTORS = ("local", "ray", "serial")
+TABLE_ROWS = (
+    ("MOTA", "mota", "{:.1%}"),
+    ("MOTP [m]", "motp_m", "{:.3f}"),
+    ("Height [px]", "height_px", "{:.1f}"),
+    ("# Dets", "detections", "{:.1f}"),
+    ("Zoom [x]", "zoom", "{:.2f}"),
+)
+SUMMARY_KEYS = ("mota", "motp_m", "height_px", "detections", "zoom")
+
+
+@dataclass(frozen=True)
+class Cell:
+    """One episode of an experiment: a scenario run with one strategy and one sequence seed."""
+
+    scenario: Scenario
+    strategy: str
+    seed: int
+
+
+def synthetic_cells(scenario: Scenario, sequences: int, strategies: Sequence[str] = STRATEGIES) -> list[Cell]:
+    """The paper's synthetic protocol: every strategy on the same ``sequences`` sequences (seeds 0..n-1)."""
+    unknown = sorted(set(strategies) - set(STRATEGIES))
+    if unknown:
+        raise ValueError(f"unknown strategies {unknown}; expected some of {', '.join(STRATEGIES)}")
+    return [Cell(scenario, strategy, seed) for strategy in strategies for seed in range(sequences)]
+
+
+def run_cell(cell: Cell) -> dict:
+    """Run one cell; returns its metrics with ``strategy`` and ``seed``."""
+    episode = run_episode(cell.scenario, POLICY_OF_STRATEGY.get(cell.strategy, cell.strategy), cell.seed)
+    return {"strategy": cell.strategy, "seed": cell.seed, **episode_metrics(episode)}
+
+
+def run_cells(
+    cells: Sequence[Cell],
+    executor: str = "local",
+    workers: int | None = None,
+    progress: Callable[[int, int], None] | None = None,
+) -> list[dict]:
+    """Run every cell and return their rows in cell order.
+
+    executor : 'local' (a process pool of ``workers``, default all cores),
+    'ray' (tasks on the Ray cluster ``ray.init()`` connects to, a local one
+    by default; needs the ``ray`` extra), or 'serial' (this process).
+    progress : called with (cells done, cells in all) as cells finish.
+    """
+    if executor not in EXECUTORS:
+        raise ValueError(f"unknown executor {executor!r}; expected one of {', '.join(EXECUTORS)}")
+    report = progress or (lambda done, total: None)
+    rows: list[dict | None] = [None] * len(cells)
+    if executor == "serial":
+        for index, cell in enumerate(cells):
+            rows[index] = run_cell(cell)
+            report(index + 1, len(cells))
+    elif executor == "local":
+        with ProcessPoolExecutor(max_workers=workers or os.cpu_count()) as pool:
+            futures = {pool.submit(run_cell, cell): index for index, cell in enumerate(cells)}
+            for done, future in enumerate(as_completed(futures), start=1):
+                rows[futures[future]] = future.result()
+                report(done, len(cells))
+    else:
+        rows = _run_on_ray(cells, report)
+    return rows
+
+
+# A local Ray cluster started by ptztrack stays on the loopback interface.
+# Ray would otherwise advertise the machine's network address (found by
+# "connecting" to 8.8.8.8); with cluster mode off it uses 127.0.0.1, as it
+# does on macOS and Windows. Its dashboard also probes cloud metadata servers
+# (169.254.169.254, metadata.google.internal) over HTTP even with usage
+# statistics off: the dead loopback proxy below turns those requests into
+# refused connections to 127.0.0.1, with no DNS lookup.
+LOOPBACK_RAY_ENVIRONMENT = {
+    "RAY_USAGE_STATS_ENABLED": "0",
+    "RAY_ENABLE_WINDOWS_OR_OSX_CLUSTER": "0",
+    "HTTP_PROXY": "http://127.0.0.1:9",
+    "HTTPS_PROXY": "http://127.0.0.1:9",
+    "NO_PROXY": "127.0.0.1,localhost",
+}
+
+
+def _run_on_ray(cells: Sequence[Cell], report: Callable[[int, int], None]) -> list[dict]:
+    start_local_cluster = "ray" not in sys.modules and not os.environ.get("RAY_ADDRESS")
+    if start_local_cluster:
+        # Ray reads these when it is imported.
+        os.environ.update(LOOPBACK_RAY_ENVIRONMENT)
+    try:
+        import ray
+    except ImportError:
+        raise RuntimeError("the ray executor needs Ray: pip install 'ptztrack[ray]'") from None
+    if not ray.is_initialized():
+        if start_local_cluster:
+            ray.init(
+                _node_ip_address="127.0.0.1", include_dashboard=False, logging_level="ERROR", log_to_driver=False
+            )
+        else:
+            ray.init(log_to_driver=False)
+    remote_cell = ray.remote(run_cell)
+    pending = {remote_cell.remote(cell): index for index, cell in enumerate(cells)}
+    rows: list[dict | None] = [None] * len(cells)
+    remaining = list(pending)
+    while remaining:
+        finished, remaining = ray.wait(remaining, num_returns=1)
+        rows[pending[finished[0]]] = ray.get(finished[0])
+        report(len(cells) - len(remaining), len(cells))
+    return rows
+
+
+def summarise(rows: Sequence[dict], strategies: Sequence[str] = STRATEGIES) -> list[dict]:
+    """Per strategy, the mean over sequences of the paper's figures (the paper averages per-sequence results)."""
+    summary = []
+    for strategy in strategies:
+        mine = [row for row in rows if row["strategy"] == strategy]
+        if mine:
+            means = {key: float(np.mean([row[key] for row in mine])) for key in SUMMARY_KEYS}
+            summary.append({"strategy": strategy, "sequences": len(mine), **means})
+    return summary
+
+
+def format_table(summary: Sequence[dict], title: str = "") -> str:
+    """The paper's layout: a row per figure, a column per strategy."""
+    width = max(len(label) for label, _, _ in TABLE_ROWS)
+    lines = [title] if title else []
+    lines.append(" " * width + "".join(f"{row['strategy']:>10}" for row in summary))
+    for label, key, fmt in TABLE_ROWS:
+        lines.append(f"{label:<{width}}" + "".join(f"{fmt.format(row[key]):>10}" for row in summary))
+    return "\n".join(lines)
+
+
+def print_progress(done: int, total: int) -> None:
+    """Progress on stderr: one line rewritten in a terminal, a line per tenth in a log."""
+    if sys.stderr.isatty():
+        print(f"\r{done}/{total} episodes", end="\n" if done == total else "", file=sys.stderr, flush=True)
+    elif done == total or done % max(1, total // 10) == 0:
+        print(f"{done}/{total} episodes", file=sys.stderr, flush=True)
