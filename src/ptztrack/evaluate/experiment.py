@@ -103,6 +103,11 @@ LOOPBACK_RAY_ENVIRONMENT = {
 
 
 def _run_on_ray(cells: Sequence[Cell], report: Callable[[int, int], None]) -> list[dict]:
+    """Run on the Ray cluster of ``RAY_ADDRESS`` or of an earlier ``ray.init()``; else start a local one.
+
+    A local cluster is kept on the loopback interface only if Ray is first
+    imported here (Ray reads its network settings at import).
+    """
     start_local_cluster = "ray" not in sys.modules and not os.environ.get("RAY_ADDRESS")
     if start_local_cluster:
         # Ray reads these when it is imported.
