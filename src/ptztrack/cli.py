@@ -18,18 +18,10 @@ from ptztrack.evaluate.experiment import (
     summarise,
     synthetic_cells,
 )
-from ptztrack.evaluate.metrics import episode_metrics
+from ptztrack.evaluate.metrics import DISPLAY, episode_metrics
 from ptztrack.evaluate.report import write_atomically, write_outputs
 
-TABLE_ROWS = (
-    ("MOTA", "mota", "{:.1%}"),
-    ("MOTP [m]", "motp_m", "{:.3f}"),
-    ("IDF1", "idf1", "{:.1%}"),
-    ("Height [px]", "height_px", "{:.1f}"),
-    ("# Dets", "detections", "{:d}"),
-    ("Zoom [x]", "zoom", "{:.2f}"),
-    ("ID switches", "switches", "{:d}"),
-)
+RUN_FIGURES = ("mota", "motp_m", "idf1", "height_px", "detections", "zoom", "switches")
 
 
 def build_scenario(name_or_path: str, detector: str | None = None, frames: int | None = None) -> Scenario:
@@ -45,8 +37,8 @@ def build_scenario(name_or_path: str, detector: str | None = None, frames: int |
 
 
 def format_metrics(metrics: dict) -> str:
-    width = max(len(label) for label, _, _ in TABLE_ROWS)
-    return "\n".join(f"{label:<{width}}  {fmt.format(metrics[key])}" for label, key, fmt in TABLE_ROWS)
+    width = max(len(DISPLAY[key][0]) for key in RUN_FIGURES)
+    return "\n".join(f"{DISPLAY[key][0]:<{width}}  {DISPLAY[key][1].format(metrics[key])}" for key in RUN_FIGURES)
 
 
 def run_command(args: argparse.Namespace) -> int:

@@ -63,11 +63,14 @@ def action_geometry(camera: PTZCamera, poses, person_height_m: float) -> ActionG
 
 
 @numba.njit
-def _predict(H, x_m, y_m, var_x, cov_xy, var_y, V):
+def _predict(H, mean_m, cov_m2, V):
     """Equation 9 for one action and track: (u, v, var_u, cov_uv, var_v, w), w > 0 in front.
 
-    ``C_x(a)`` is the homography's Jacobian at the prediction (zero for the velocity).
+    H : (3, 3) ground-to-image; mean_m : (2,); cov_m2 : (2, 2). ``C_x(a)`` is
+    the homography's Jacobian at the prediction (zero for the velocity).
     """
+    x_m, y_m = mean_m[0], mean_m[1]
+    var_x, cov_xy, var_y = cov_m2[0, 0], cov_m2[0, 1], cov_m2[1, 1]
     X = H[0, 0] * x_m + H[0, 1] * y_m + H[0, 2]
     Y = H[1, 0] * x_m + H[1, 1] * y_m + H[1, 2]
     w = H[2, 0] * x_m + H[2, 1] * y_m + H[2, 2]
@@ -87,15 +90,7 @@ def _information_if_detected(ground_to_image, mean_m, position_cov_m2, V):
     gain = np.zeros((L, n))
     for action in range(L):
         for track in range(n):
-            _, _, var_u, cov_uv, var_v, w = _predict(
-                ground_to_image[action],
-                mean_m[track, 0],
-                mean_m[track, 1],
-                position_cov_m2[track, 0, 0],
-                position_cov_m2[track, 0, 1],
-                position_cov_m2[track, 1, 1],
-                V,
-            )
+            _, _, var_u, cov_uv, var_v, w = _predict(ground_to_image[action], mean_m[track], position_cov_m2[track], V)
             if w > 0:
                 gain[action, track] = 0.5 * (math.log(var_u * var_v - cov_uv * cov_uv) - log_det_V)
     return gain
@@ -120,15 +115,7 @@ def _detection_weight_integral(
     for action in range(L):
         W = head_from_feet[action]
         for track in range(n):
-            u, v, var_u, cov_uv, var_v, w = _predict(
-                ground_to_image[action],
-                mean_m[track, 0],
-                mean_m[track, 1],
-                position_cov_m2[track, 0, 0],
-                position_cov_m2[track, 0, 1],
-                position_cov_m2[track, 1, 1],
-                V,
-            )
+            u, v, var_u, cov_uv, var_v, w = _predict(ground_to_image[action], mean_m[track], position_cov_m2[track], V)
             if w <= 0:
                 continue
             head_w = W[2, 0] * u + W[2, 1] * v + W[2, 2]
@@ -205,7 +192,9 @@ def detection_weight_integral(
 
 
 @numba.njit
-def _detection_weight_sampled(ground_to_image, head_to_image, ground_m, visible_fraction, width_px, height_px, realistic, kd, r0_px):
+def _detection_weight_sampled(
+    ground_to_image, head_to_image, ground_m, visible_fraction, width_px, height_px, realistic, kd, r0_px
+):
     L, (M, n) = ground_to_image.shape[0], ground_m.shape[:2]
     alpha = np.zeros((L, n))
     for action in range(L):

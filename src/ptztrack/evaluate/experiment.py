@@ -15,19 +15,13 @@ import numpy as np
 
 from ptztrack.config import Scenario
 from ptztrack.episode import run_episode
-from ptztrack.evaluate.metrics import episode_metrics
+from ptztrack.evaluate.metrics import DISPLAY, episode_metrics
 
 STRATEGIES = ("fix", "patrol", "rnd", "intg", "smpl")
 # The paper's column names; 'rnd' is the 'random' policy.
 POLICY_OF_STRATEGY = {"rnd": "random"}
 EXECUTORS = ("local", "ray", "serial")
-TABLE_ROWS = (
-    ("MOTA", "mota", "{:.1%}"),
-    ("MOTP [m]", "motp_m", "{:.3f}"),
-    ("Height [px]", "height_px", "{:.1f}"),
-    ("# Dets", "detections", "{:.1f}"),
-    ("Zoom [x]", "zoom", "{:.2f}"),
-)
+# The paper's rows.
 SUMMARY_KEYS = ("mota", "motp_m", "height_px", "detections", "zoom")
 
 
@@ -147,10 +141,11 @@ def summarise(rows: Sequence[dict], strategies: Sequence[str] = STRATEGIES) -> l
 
 def format_table(summary: Sequence[dict], title: str = "") -> str:
     """The paper's layout: a row per figure, a column per strategy."""
-    width = max(len(label) for label, _, _ in TABLE_ROWS)
+    width = max(len(DISPLAY[key][0]) for key in SUMMARY_KEYS)
     lines = [title] if title else []
     lines.append(" " * width + "".join(f"{row['strategy']:>10}" for row in summary))
-    for label, key, fmt in TABLE_ROWS:
+    for key in SUMMARY_KEYS:
+        label, fmt = DISPLAY[key]
         lines.append(f"{label:<{width}}" + "".join(f"{fmt.format(row[key]):>10}" for row in summary))
     return "\n".join(lines)
 

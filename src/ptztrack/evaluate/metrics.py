@@ -11,6 +11,16 @@ import numpy as np
 from ptztrack.episode import Episode
 
 GATE_M = 1.0
+# How each figure is shown in tables: label and format.
+DISPLAY = {
+    "mota": ("MOTA", "{:.1%}"),
+    "motp_m": ("MOTP [m]", "{:.3f}"),
+    "idf1": ("IDF1", "{:.1%}"),
+    "height_px": ("Height [px]", "{:.1f}"),
+    "detections": ("# Dets", "{:.1f}"),
+    "zoom": ("Zoom [x]", "{:.2f}"),
+    "switches": ("ID switches", "{:.0f}"),
+}
 
 
 def clear_metrics(truth_positions_m, track_ids, track_positions_m, gate_m: float = GATE_M) -> dict:
