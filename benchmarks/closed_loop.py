@@ -1,7 +1,7 @@
-"""Closed-loop speed and the baseline table on the default synthetic scene.
+"""Closed-loop speed and metrics of every policy on the default synthetic scene.
 
-Runs every baseline policy with both detectors over a number of seeds and
-prints, per cell, the mean metrics and the closed-loop steps per second
+Runs every policy with both detectors over a number of seeds and prints,
+per cell, the mean metrics and the closed-loop steps per second
 (scene, detection, tracking and decision together, metrics excluded, single
 process).
 
