@@ -1,0 +1,161 @@
+"""Calibration formats of recorded cameras: Tsai (PETS 2009 XML) and pinhole with OpenCV distortion (JSON).
+
+Both map world points in millimetres (ground plane z = 0) to pixels of the
+recorded image. A malformed file gets a :class:`CalibrationError` naming the
+file and what is wrong.
+"""
+
+import json
+from dataclasses import dataclass
+from pathlib import Path
+
+import cv2
+import defusedxml.ElementTree as ElementTree
+import numpy as np
+
+NEWTON_STEPS = 20
+
+
+class CalibrationError(ValueError):
+    """A calibration file that cannot be used; the message names the file and the problem."""
+
+
+@dataclass(frozen=True)
+class TsaiCalibration:
+    """Tsai's camera model (R. Tsai 1987, as in R. Willson's reference implementation).
+
+    image_size_px : (width, height).
+    dpx_mm, dy_mm : effective pixel pitch along x and y on the sensor.
+    focal_mm, kappa1 : focal length and first radial distortion coefficient (1/mm^2).
+    centre_px : (Cx, Cy) image centre; sx : horizontal scale factor.
+    rotation_xyz_rad : (Rx, Ry, Rz), the world-to-camera rotation R = Rz Ry Rx.
+    translation_mm : (Tx, Ty, Tz), camera = R world + T.
+    """
+
+    image_size_px: tuple[int, int]
+    dpx_mm: float
+    dy_mm: float
+    focal_mm: float
+    kappa1: float
+    centre_px: tuple[float, float]
+    sx: float
+    rotation_xyz_rad: tuple[float, float, float]
+    translation_mm: tuple[float, float, float]
+
+    @property
+    def rotation(self) -> np.ndarray:
+        rx, ry, rz = self.rotation_xyz_rad
+        cx, sx, cy, sy, cz, sz = np.cos(rx), np.sin(rx), np.cos(ry), np.sin(ry), np.cos(rz), np.sin(rz)
+        Rx = np.array([[1, 0, 0], [0, cx, -sx], [0, sx, cx]])
+        Ry = np.array([[cy, 0, sy], [0, 1, 0], [-sy, 0, cy]])
+        Rz = np.array([[cz, -sz, 0], [sz, cz, 0], [0, 0, 1]])
+        return Rz @ Ry @ Rx
+
+
+@dataclass(frozen=True)
+class PinholeCalibration:
+    """A pinhole camera with OpenCV's distortion model.
+
+    K : (3, 3) intrinsics in pixels; dist : (5,) k1 k2 p1 p2 k3;
+    R : (3, 3) world-to-camera rotation; t : (3,) translation in mm.
+    """
+
+    K: np.ndarray
+    dist: np.ndarray
+    R: np.ndarray
+    t: np.ndarray
+
+
+def project_tsai(calibration: TsaiCalibration, points_mm) -> np.ndarray:
+    """World points (N, 3) mm to distorted image pixels (N, 2).
+
+    The undistorted sensor radius ``r_u`` relates to the distorted one by
+    ``r_u = r_d (1 + kappa1 r_d^2)``; going from world to image means solving
+    that cubic for ``r_d``, done by Newton's method from ``r_d = r_u``.
+    """
+    camera_mm = np.asarray(points_mm, dtype=float) @ calibration.rotation.T + np.asarray(calibration.translation_mm)
+    undistorted = calibration.focal_mm * camera_mm[:, :2] / camera_mm[:, 2:]
+    radius_u = np.linalg.norm(undistorted, axis=1)
+    radius_d = radius_u.copy()
+    for _ in range(NEWTON_STEPS):
+        radius_d -= (calibration.kappa1 * radius_d**3 + radius_d - radius_u) / (
+            3 * calibration.kappa1 * radius_d**2 + 1
+        )
+    scale = np.divide(radius_d, radius_u, out=np.ones_like(radius_u), where=radius_u > 0)
+    distorted = undistorted * scale[:, None]
+    u = calibration.sx * distorted[:, 0] / calibration.dpx_mm + calibration.centre_px[0]
+    v = distorted[:, 1] / calibration.dy_mm + calibration.centre_px[1]
+    return np.stack([u, v], axis=-1)
+
+
+def project_pinhole(calibration: PinholeCalibration, points_mm) -> np.ndarray:
+    """World points (N, 3) mm to distorted image pixels (N, 2), with ``cv2.projectPoints``."""
+    rotation_vector, _ = cv2.Rodrigues(calibration.R)
+    pixels, _ = cv2.projectPoints(
+        np.asarray(points_mm, dtype=float).reshape(-1, 1, 3), rotation_vector, calibration.t, calibration.K, calibration.dist
+    )
+    return pixels[:, 0, :]
+
+
+def _attributes(root, tag: str, names: tuple[str, ...], path: Path) -> dict[str, float]:
+    element = root.find(tag)
+    if element is None:
+        raise CalibrationError(f"{path}: no <{tag}> element")
+    values = {}
+    for name in names:
+        text = element.get(name)
+        if text is None:
+            raise CalibrationError(f"{path}: <{tag}> has no attribute {name!r}")
+        try:
+            values[name] = float(text)
+        except ValueError:
+            raise CalibrationError(f"{path}: <{tag} {name}={text!r}> is not a number") from None
+    return values
+
+
+def load_tsai(path: str | Path) -> TsaiCalibration:
+    """Read a PETS 2009 Tsai calibration XML (``<Geometry>``, ``<Intrinsic>``, ``<Extrinsic>``)."""
+    path = Path(path)
+    try:
+        root = ElementTree.parse(path).getroot()
+    except FileNotFoundError:
+        raise CalibrationError(f"{path}: no such calibration file") from None
+    except ElementTree.ParseError as error:
+        raise CalibrationError(f"{path}: not valid XML ({error})") from None
+    geometry = _attributes(root, "Geometry", ("width", "height", "dy", "dpx"), path)
+    intrinsic = _attributes(root, "Intrinsic", ("focal", "kappa1", "cx", "cy", "sx"), path)
+    extrinsic = _attributes(root, "Extrinsic", ("tx", "ty", "tz", "rx", "ry", "rz"), path)
+    return TsaiCalibration(
+        image_size_px=(int(geometry["width"]), int(geometry["height"])),
+        dpx_mm=geometry["dpx"],
+        dy_mm=geometry["dy"],
+        focal_mm=intrinsic["focal"],
+        kappa1=intrinsic["kappa1"],
+        centre_px=(intrinsic["cx"], intrinsic["cy"]),
+        sx=intrinsic["sx"],
+        rotation_xyz_rad=(extrinsic["rx"], extrinsic["ry"], extrinsic["rz"]),
+        translation_mm=(extrinsic["tx"], extrinsic["ty"], extrinsic["tz"]),
+    )
+
+
+def load_pinhole(path: str | Path, view: str = "View_001") -> PinholeCalibration:
+    """Read one view of a pinhole calibration JSON (``{view: {K, dist, R, t}}``)."""
+    path = Path(path)
+    try:
+        views = json.loads(path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise CalibrationError(f"{path}: no such calibration file") from None
+    except json.JSONDecodeError as error:
+        raise CalibrationError(f"{path}: not valid JSON ({error.msg} at line {error.lineno})") from None
+    if not isinstance(views, dict) or view not in views:
+        raise CalibrationError(f"{path}: no view {view!r}")
+    shapes = {"K": (3, 3), "dist": (5,), "R": (3, 3), "t": (3,)}
+    arrays = {}
+    for name, shape in shapes.items():
+        try:
+            arrays[name] = np.asarray(views[view][name], dtype=float)
+        except (KeyError, TypeError, ValueError):
+            raise CalibrationError(f"{path}: {view}.{name} is missing or not numeric") from None
+        if arrays[name].shape != shape:
+            raise CalibrationError(f"{path}: {view}.{name} has shape {arrays[name].shape}, expected {shape}")
+    return PinholeCalibration(**arrays)
