@@ -1,0 +1,133 @@
+"""PETS 2009 S2.L1 and recordings like it: video frames and ground truth.
+
+Two ground-truth formats are read: MOTChallenge rows with world positions in
+metres (``frame,id,left,top,width,height,conf,x_m,y_m,z``, frames from 1),
+and CVML XML with pixel boxes (``<frame number>`` from 0). Any problem gets a
+:class:`DatasetError` naming the file and what is wrong.
+"""
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import cv2
+import defusedxml.ElementTree as ElementTree
+import numpy as np
+
+MOT_COLUMNS = 10
+
+
+class DatasetError(ValueError):
+    """A dataset file that cannot be used; the message names the file and the problem."""
+
+
+@dataclass(frozen=True)
+class Annotations:
+    """Annotated people, one row per person and frame.
+
+    frame : (K,) 0-based video frame; person_id : (K,);
+    box_px : (K, 4) as (left, top, width, height);
+    ground_m : (K, 2) feet on the ground plane in metres (NaN where the format has none).
+    """
+
+    frame: np.ndarray
+    person_id: np.ndarray
+    box_px: np.ndarray
+    ground_m: np.ndarray
+
+    @property
+    def feet_px(self) -> np.ndarray:
+        """(K, 2) bottom centre of each box."""
+        return np.stack([self.box_px[:, 0] + self.box_px[:, 2] / 2, self.box_px[:, 1] + self.box_px[:, 3]], axis=-1)
+
+    def select(self, keep) -> "Annotations":
+        return Annotations(self.frame[keep], self.person_id[keep], self.box_px[keep], self.ground_m[keep])
+
+
+def load_mot_ground_truth(path: str | Path) -> Annotations:
+    """Read MOTChallenge ground truth with world coordinates (frames from 1 become 0-based)."""
+    path = Path(path)
+    try:
+        lines = path.read_text(encoding="utf-8").splitlines()
+    except FileNotFoundError:
+        raise DatasetError(f"{path}: no such ground-truth file") from None
+    rows = []
+    for number, line in enumerate(lines, start=1):
+        if not line.strip():
+            continue
+        fields = line.split(",")
+        if len(fields) != MOT_COLUMNS:
+            raise DatasetError(f"{path}: line {number} has {len(fields)} fields, expected {MOT_COLUMNS}")
+        try:
+            rows.append([float(field) for field in fields])
+        except ValueError:
+            raise DatasetError(f"{path}: line {number} has a field that is not a number") from None
+    if not rows:
+        raise DatasetError(f"{path}: no ground-truth rows")
+    table = np.asarray(rows)
+    if np.any(table[:, 0] < 1):
+        raise DatasetError(f"{path}: frames are numbered from 1 in MOTChallenge files")
+    return Annotations(
+        frame=table[:, 0].astype(int) - 1,
+        person_id=table[:, 1].astype(int),
+        box_px=table[:, 2:6],
+        ground_m=table[:, 7:9],
+    )
+
+
+def load_cvml(path: str | Path) -> Annotations:
+    """Read CVML XML boxes (``<frame number><objectlist><object id><box h w xc yc>``)."""
+    path = Path(path)
+    try:
+        root = ElementTree.parse(path).getroot()
+    except FileNotFoundError:
+        raise DatasetError(f"{path}: no such annotation file") from None
+    except ElementTree.ParseError as error:
+        raise DatasetError(f"{path}: not valid XML ({error})") from None
+    rows = []
+    for frame in root.iter("frame"):
+        for person in frame.iter("object"):
+            box = person.find("box")
+            try:
+                values = [float(box.get(name)) for name in ("xc", "yc", "w", "h")]
+                rows.append([int(frame.get("number")), int(person.get("id")), *values])
+            except (AttributeError, TypeError, ValueError):
+                raise DatasetError(
+                    f"{path}: frame {frame.get('number')!r} object {person.get('id')!r} needs "
+                    "integer number and id and a <box> with numeric xc, yc, w, h"
+                ) from None
+    if not rows:
+        raise DatasetError(f"{path}: no annotated objects")
+    table = np.asarray(rows)
+    centre, size = table[:, 2:4], table[:, 4:6]
+    return Annotations(
+        frame=table[:, 0].astype(int),
+        person_id=table[:, 1].astype(int),
+        box_px=np.concatenate([centre - size / 2, size], axis=1),
+        ground_m=np.full((len(table), 2), np.nan),
+    )
+
+
+def read_video(path: str | Path, expected_frames: int | None = None, expected_size_px=None) -> np.ndarray:
+    """All frames of a video as (T, height, width, 3) uint8 BGR, checked against what is expected.
+
+    expected_size_px : (width, height), e.g. from the calibration.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise DatasetError(f"{path}: no such video file")
+    capture = cv2.VideoCapture(str(path))
+    frames = []
+    while True:
+        ok, frame = capture.read()
+        if not ok:
+            break
+        frames.append(frame)
+    capture.release()
+    if not frames:
+        raise DatasetError(f"{path}: OpenCV could not read any frame")
+    video = np.stack(frames)
+    if expected_frames is not None and len(video) != expected_frames:
+        raise DatasetError(f"{path}: {len(video)} frames, expected {expected_frames}")
+    if expected_size_px is not None and tuple(video.shape[2:0:-1]) != tuple(expected_size_px):
+        raise DatasetError(f"{path}: frames are {video.shape[2]}x{video.shape[1]} px, expected {expected_size_px[0]}x{expected_size_px[1]}")
+    return video

@@ -1,0 +1,134 @@
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from ptztrack.geometry.calibration import (
+    CalibrationError,
+    load_pinhole,
+    load_tsai,
+    project_pinhole,
+    project_tsai,
+)
+from ptztrack.scene.pets import DatasetError, load_cvml, load_mot_ground_truth, read_video
+
+EXCERPT = Path(__file__).parent / "data" / "pets_s2l1_excerpt"
+
+
+def ground_truth_points_mm():
+    truth = load_mot_ground_truth(EXCERPT / "gt_mot15.txt")
+    points_mm = np.concatenate([truth.ground_m * 1000.0, np.zeros((len(truth.frame), 1))], axis=1)
+    return truth, points_mm
+
+
+@pytest.mark.parametrize("project", ["tsai", "pinhole"])
+def test_both_calibrations_put_the_ground_truth_on_the_annotated_feet(project):
+    truth, points_mm = ground_truth_points_mm()
+    if project == "tsai":
+        pixels = project_tsai(load_tsai(EXCERPT / "View_001.xml"), points_mm)
+    else:
+        pixels = project_pinhole(load_pinhole(EXCERPT / "pinhole.json"), points_mm)
+    error_px = np.linalg.norm(pixels - truth.feet_px, axis=1)
+    assert np.median(error_px) < 3.0
+    assert np.percentile(error_px, 90) < 6.0
+
+
+def test_the_two_calibrations_agree_with_each_other():
+    _, points_mm = ground_truth_points_mm()
+    tsai = project_tsai(load_tsai(EXCERPT / "View_001.xml"), points_mm)
+    pinhole = project_pinhole(load_pinhole(EXCERPT / "pinhole.json"), points_mm)
+    assert np.median(np.linalg.norm(tsai - pinhole, axis=1)) < 3.0
+
+
+def test_tsai_without_distortion_is_a_pinhole_projection():
+    calibration = load_tsai(EXCERPT / "View_001.xml")
+    plain = type(calibration)(**{**calibration.__dict__, "kappa1": 0.0})
+    points_mm = np.array([[1000.0, -2000.0, 0.0], [-3000.0, 4000.0, 1700.0]])
+    camera_mm = points_mm @ plain.rotation.T + np.asarray(plain.translation_mm)
+    expected_u = plain.sx * plain.focal_mm * camera_mm[:, 0] / camera_mm[:, 2] / plain.dpx_mm + plain.centre_px[0]
+    expected_v = plain.focal_mm * camera_mm[:, 1] / camera_mm[:, 2] / plain.dy_mm + plain.centre_px[1]
+    np.testing.assert_allclose(project_tsai(plain, points_mm), np.stack([expected_u, expected_v], 1), rtol=1e-12)
+    np.testing.assert_allclose(plain.rotation @ plain.rotation.T, np.eye(3), atol=1e-12)
+
+
+def test_tsai_distortion_solves_the_radial_cubic():
+    calibration = load_tsai(EXCERPT / "View_001.xml")
+    pixels = project_tsai(calibration, np.array([[2000.0, 1000.0, 0.0]]))
+    distorted = np.array(
+        [
+            (pixels[0, 0] - calibration.centre_px[0]) * calibration.dpx_mm / calibration.sx,
+            (pixels[0, 1] - calibration.centre_px[1]) * calibration.dy_mm,
+        ]
+    )
+    undistorted = distorted * (1 + calibration.kappa1 * np.sum(distorted**2))
+    camera_mm = np.array([2000.0, 1000.0, 0.0]) @ calibration.rotation.T + np.asarray(calibration.translation_mm)
+    np.testing.assert_allclose(undistorted, calibration.focal_mm * camera_mm[:2] / camera_mm[2], rtol=1e-10)
+
+
+def test_the_two_annotation_formats_hold_the_same_boxes():
+    mot = load_mot_ground_truth(EXCERPT / "gt_mot15.txt")
+    cvml = load_cvml(EXCERPT / "PETS2009-S2L1.xml")
+    assert mot.frame.min() == 0 and mot.frame.max() == 29
+    assert set(zip(mot.frame, mot.person_id)) <= set(zip(cvml.frame, cvml.person_id))
+    by_key = {(f, i): box for f, i, box in zip(cvml.frame, cvml.person_id, cvml.box_px, strict=True)}
+    for frame, person, box in zip(mot.frame, mot.person_id, mot.box_px, strict=True):
+        np.testing.assert_allclose(by_key[(frame, person)], box, atol=0.6)
+    assert np.isnan(cvml.ground_m).all() and np.isfinite(mot.ground_m).all()
+
+
+def test_video_frames_are_read_and_checked():
+    video = read_video(EXCERPT / "View_001.avi", expected_frames=30, expected_size_px=(768, 576))
+    assert video.shape == (30, 576, 768, 3) and video.dtype == np.uint8
+    with pytest.raises(DatasetError, match="30 frames, expected 795"):
+        read_video(EXCERPT / "View_001.avi", expected_frames=795)
+    with pytest.raises(DatasetError, match="768x576 px, expected 640x480"):
+        read_video(EXCERPT / "View_001.avi", expected_size_px=(640, 480))
+    with pytest.raises(DatasetError, match="no such video file"):
+        read_video(EXCERPT / "missing.avi")
+
+
+@pytest.mark.parametrize(
+    "text, message",
+    [
+        ("1,2,3\n", "line 1 has 3 fields, expected 10"),
+        ("1,9,499,158,31,75,1,x,-7.3,0\n", "line 1 has a field that is not a number"),
+        ("0,9,499,158,31,75,1,-4.1,-7.3,0\n", "frames are numbered from 1"),
+        ("", "no ground-truth rows"),
+    ],
+)
+def test_malformed_mot_files_are_named_with_the_problem(tmp_path, text, message):
+    path = tmp_path / "gt.txt"
+    path.write_text(text)
+    with pytest.raises(DatasetError, match=message) as error:
+        load_mot_ground_truth(path)
+    assert str(path) in str(error.value)
+
+
+@pytest.mark.parametrize(
+    "text, message",
+    [
+        ("<dataset><frame number='0'><objectlist>", "not valid XML"),
+        ("<dataset><frame number='0'><objectlist><object id='3'/></objectlist></frame></dataset>", "frame '0' object '3'"),
+        ("<dataset></dataset>", "no annotated objects"),
+    ],
+)
+def test_malformed_cvml_files_are_named_with_the_problem(tmp_path, text, message):
+    path = tmp_path / "gt.xml"
+    path.write_text(text)
+    with pytest.raises(DatasetError, match=message):
+        load_cvml(path)
+
+
+def test_malformed_calibrations_are_named_with_the_problem(tmp_path):
+    bad_xml = tmp_path / "view.xml"
+    bad_xml.write_text("<Camera><Geometry width='768'/></Camera>")
+    with pytest.raises(CalibrationError, match="<Geometry> has no attribute 'height'"):
+        load_tsai(bad_xml)
+    bad_json = tmp_path / "pinhole.json"
+    bad_json.write_text('{"View_001": {"K": [[1, 0], [0, 1]], "dist": [0, 0, 0, 0, 0], "R": [[1,0,0],[0,1,0],[0,0,1]], "t": [0, 0, 0]}}')
+    with pytest.raises(CalibrationError, match=r"View_001.K has shape \(2, 2\), expected \(3, 3\)"):
+        load_pinhole(bad_json)
+    with pytest.raises(CalibrationError, match="no view 'View_009'"):
+        load_pinhole(EXCERPT / "pinhole.json", view="View_009")
+    with pytest.raises(CalibrationError, match="no such calibration file"):
+        load_tsai(tmp_path / "nothing.xml")
