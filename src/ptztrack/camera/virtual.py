@@ -1,0 +1,103 @@
+"""A virtual PTZ camera inside a calibrated recording (the paper's section 5.2).
+
+The virtual camera stands at the recording camera's optical centre and is an
+ordinary :class:`~ptztrack.geometry.ptz.PTZCamera` (level mount, pan about
+the vertical), so the tracker and the policies use it unchanged. Its image at
+a pose is the recorded frame resampled through the rays of the virtual
+pixels: virtual pixel -> ray ``R_v^T K_v^-1 p`` -> recorded pixel through the
+recording's full calibration, lens distortion included. This is the paper's
+``G_ptz = K_c R_ptz K_ptz^-1`` with the distortion handled exactly, so the
+virtual view is a true pinhole image and detections in it map to the ground
+through the virtual camera's own homography.
+
+Units: the recording's calibration is in millimetres, ptztrack's world in metres.
+"""
+
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+
+from ptztrack.geometry.calibration import PinholeCalibration
+from ptztrack.geometry.ptz import PTZCamera, intrinsics, rotation_world_to_camera
+
+MM_PER_M = 1000.0
+
+
+@dataclass(frozen=True)
+class VirtualPTZ:
+    """A virtual PTZ camera over a recording.
+
+    camera : the virtual camera (centre in metres, virtual image size, f_min).
+    recording : the recording camera's calibration (millimetres).
+    recorded_size_px : (width, height) of the recorded frames.
+    """
+
+    camera: PTZCamera
+    recording: PinholeCalibration
+    recorded_size_px: tuple[int, int]
+
+    def sampling_maps(self, pose) -> tuple[np.ndarray, np.ndarray]:
+        """Where each virtual pixel (centre) reads the recorded frame: two (h, w) float32 maps for cv2.remap."""
+        width, height = self.camera.image_width_px, self.camera.image_height_px
+        u, v = np.meshgrid(np.arange(width) + 0.5, np.arange(height) + 0.5)
+        pixels = np.stack([u.ravel(), v.ravel(), np.ones(u.size)], axis=-1)
+        pose = np.asarray(pose, dtype=float)
+        rays = pixels @ np.linalg.inv(intrinsics(self.camera, pose[2])).T @ rotation_world_to_camera(pose[0], pose[1])
+        recorded = _project_directions(self.recording, rays)
+        # The centre of recorded pixel (i, j) is at (i + 0.5, j + 0.5); remap indexes from 0.
+        maps = (recorded - 0.5).reshape(height, width, 2).astype(np.float32)
+        return maps[..., 0], maps[..., 1]
+
+    def render(self, frame, pose) -> np.ndarray:
+        """The virtual view (h, w, 3) of a recorded frame; black where the recording does not reach."""
+        map_u, map_v = self.sampling_maps(pose)
+        return cv2.remap(frame, map_u, map_v, cv2.INTER_AREA if pose[2] < 1 else cv2.INTER_LINEAR)
+
+    def recorded_to_virtual(self, recorded_px, pose) -> np.ndarray:
+        """Recorded (distorted) pixels (N, 2) to virtual pixels (N, 2) at ``pose``; NaN behind the virtual camera."""
+        normalised = cv2.undistortPoints(
+            np.asarray(recorded_px, dtype=float).reshape(-1, 1, 2), self.recording.K, self.recording.dist
+        )[:, 0, :]
+        rays = np.concatenate([normalised, np.ones((len(normalised), 1))], axis=-1) @ self.recording.R
+        pose = np.asarray(pose, dtype=float)
+        homogeneous = rays @ rotation_world_to_camera(pose[0], pose[1]).T @ intrinsics(self.camera, pose[2]).T
+        with np.errstate(divide="ignore", invalid="ignore"):
+            pixels = homogeneous[:, :2] / homogeneous[:, 2:]
+        return np.where(homogeneous[:, 2:] > 0, pixels, np.nan)
+
+
+def _project_directions(recording: PinholeCalibration, directions) -> np.ndarray:
+    """Recorded pixels (N, 2) of world directions (N, 3) seen from the recording's centre (distortion included)."""
+    camera_directions = directions @ recording.R.T
+    rotation_vector = np.zeros(3)
+    pixels, _ = cv2.projectPoints(
+        camera_directions.reshape(-1, 1, 3), rotation_vector, np.zeros(3), recording.K, recording.dist
+    )
+    behind = camera_directions[:, 2] <= 0
+    pixels = pixels[:, 0, :]
+    pixels[behind] = -1e6
+    return pixels
+
+
+def virtual_ptz(
+    recording: PinholeCalibration, recorded_size_px=(768, 576), image_size_px=(160, 120)
+) -> tuple[VirtualPTZ, np.ndarray]:
+    """The virtual PTZ camera over a recording, and the pose that reproduces the recorded view.
+
+    At zoom 1 the virtual camera has the recording's field of view at
+    ``image_size_px`` (the paper's 160 x 120 "zoom 1"): ``f_min`` is the
+    recording's focal length scaled by the width ratio. Returns the camera and
+    the (pan_deg, tilt_deg, 1) pose looking through the centre of the
+    recorded image, which the recording's principal point need not be (the
+    recording's small roll is not reproduced: the mount is level).
+    """
+    centre_m = -recording.R.T @ recording.t / MM_PER_M
+    focal_px = 0.5 * (recording.K[0, 0] + recording.K[1, 1]) * image_size_px[0] / recorded_size_px[0]
+    camera = PTZCamera(tuple(float(x) for x in centre_m), int(image_size_px[0]), int(image_size_px[1]), float(focal_px))
+    image_centre_px = np.array([[recorded_size_px[0] / 2, recorded_size_px[1] / 2]], dtype=float)
+    normalised = cv2.undistortPoints(image_centre_px.reshape(1, 1, 2), recording.K, recording.dist)[0, 0]
+    forward = np.array([*normalised, 1.0]) @ recording.R
+    forward /= np.linalg.norm(forward)
+    pose = np.array([np.rad2deg(np.arctan2(forward[0], forward[1])), np.rad2deg(np.arcsin(-forward[2])), 1.0])
+    return VirtualPTZ(camera, recording, tuple(recorded_size_px)), pose
