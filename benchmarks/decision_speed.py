@@ -32,7 +32,7 @@ from pathlib import Path  # noqa: E402
 import numpy as np  # noqa: E402
 
 from ptztrack.config import scenario_from_dict  # noqa: E402
-from ptztrack.episode import make_policy, run_episode  # noqa: E402
+from ptztrack.episode import build_world, make_policy, run_episode  # noqa: E402
 from ptztrack.track.tracker import Tracks  # noqa: E402
 
 SIZES = {
@@ -90,7 +90,7 @@ def main() -> None:
         rng = np.random.default_rng(0)
         rates = {}
         for method in ("intg", "smpl"):
-            policy = make_policy(method, scenario)
+            policy = make_policy(method, scenario, build_world(scenario, rng))
             policy.rewards(actions, states[0], rng)
             rates[method] = decisions_per_second(policy, states, actions, rng)
         pairs = track_count * len(actions)

@@ -10,18 +10,18 @@ CAMERA, GRID = SCENARIO.ptz_camera(), SCENARIO.action_grid()
 
 
 def test_fix_looks_at_the_area_at_the_widest_zoom():
-    action = widest_view_action(CAMERA, GRID, SCENARIO.area_m)
+    action = widest_view_action(CAMERA, GRID, SCENARIO.area_bounds_m)
     assert GRID.poses[action][2] == 1.0
-    coverage = area_coverage(CAMERA, GRID.poses, SCENARIO.area_m)
+    coverage = area_coverage(CAMERA, GRID.poses, SCENARIO.area_bounds_m)
     assert coverage[action] == coverage[GRID.axis_indices[:, 2] == 0].max()
     assert coverage[action] > 0.9
 
 
 def test_patrol_route_covers_the_area_at_one_zoom():
-    route = patrol_route(CAMERA, GRID, SCENARIO.area_m)
+    route = patrol_route(CAMERA, GRID, SCENARIO.area_bounds_m)
     assert len(set(GRID.poses[route][:, 2])) == 1
-    assert np.all(area_coverage(CAMERA, GRID.poses[route], SCENARIO.area_m) > 0)
-    samples = area_samples_m(SCENARIO.area_m)
+    assert np.all(area_coverage(CAMERA, GRID.poses[route], SCENARIO.area_bounds_m) > 0)
+    samples = area_samples_m(SCENARIO.area_bounds_m)
     seen = person_in_view(CAMERA, project_people(CAMERA, GRID.poses[route][:, None, :], samples, 1.75, 0.0))
     assert seen.any(axis=0).mean() > 0.95
 
@@ -31,7 +31,7 @@ def test_every_policy_moves_within_the_mechanical_limits():
         actions = run_episode(SCENARIO, policy, seed=2).actions
         steps = np.abs(np.diff(GRID.axis_indices[actions], axis=0))
         assert np.all(steps <= np.array(GRID.max_steps)), policy
-        start = widest_view_action(CAMERA, GRID, SCENARIO.area_m)
+        start = widest_view_action(CAMERA, GRID, SCENARIO.area_bounds_m)
         assert GRID.reachable_mask(start)[actions[0]]
 
 

@@ -14,7 +14,7 @@ from ptztrack.control.information_gain import (
 )
 from ptztrack.control.policy import DecisionContext
 from ptztrack.detect.simulated import occluded_fraction, occlusion_in_centred_views, recall
-from ptztrack.episode import make_policy
+from ptztrack.episode import build_world, make_policy
 from ptztrack.geometry.ptz import (
     apply_homography,
     feet_jacobian,
@@ -28,6 +28,10 @@ from ptztrack.track import kalman
 from ptztrack.track.tracker import Tracks
 
 SCENARIO = Scenario()
+
+
+def policy_for(name, scenario):
+    return make_policy(name, scenario, build_world(scenario, np.random.default_rng(0)))
 CAMERA, GRID = SCENARIO.ptz_camera(), SCENARIO.action_grid()
 V = 4.0 * np.eye(2)
 HEIGHT_M = 1.75
@@ -153,9 +157,9 @@ def test_with_one_person_and_no_occluders_smpl_and_intg_choose_the_same_action(k
         distance = np.abs(GRID.poses[:, :2] - look_at(CAMERA, position)[:2]).sum(axis=1)
         current = int(np.argmin(distance + 100 * (GRID.axis_indices[:, 2] != rng.integers(4))))
         context = DecisionContext(0, current, GRID.reachable(current), tracks, np.random.default_rng(trial))
-        intg_policy = make_policy("intg", scenario)
+        intg_policy = policy_for("intg", scenario)
         intg = intg_policy.choose(context)
-        smpl = make_policy("smpl", scenario).choose(context)
+        smpl = policy_for("smpl", scenario).choose(context)
         agreements += intg == smpl
         worth = intg_policy.rewards(np.array([intg, smpl]), tracks, context.rng)
         assert worth[1] >= 0.999 * worth[0]
@@ -211,7 +215,7 @@ def test_zoom_leaves_occluded_fractions_exactly_unchanged():
 
 def test_patrolling_term_grows_while_unobserved_and_clears_where_the_camera_looks():
     scenario = scenario_from_dict({"detector": {"kind": "ideal"}, "control": {"beta": 1.0}})
-    policy = make_policy("intg", scenario)
+    policy = policy_for("intg", scenario)
     exploration = policy.exploration
     wide = int(np.argmax(exploration.detection_probability.sum(axis=1)))
     elsewhere = int(np.argmin(exploration.detection_probability[:, exploration.detection_probability[wide] > 0.5].sum(axis=1)))
@@ -231,8 +235,8 @@ def test_without_tracks_the_patrolling_term_moves_the_camera_and_without_it_the_
     empty = Tracks(np.zeros(0, int), np.zeros((0, 4)), np.zeros((0, 4, 4)), np.zeros(0, int))
     start = int(GRID.index(3, 4, 1))
     context = DecisionContext(0, start, GRID.reachable(start), empty, np.random.default_rng(0))
-    assert make_policy("intg", scenario_from_dict({"control": {"beta": 0.0}})).choose(context) == start
-    explorer = make_policy("intg", scenario_from_dict({"control": {"beta": 1.0}}))
+    assert policy_for("intg", scenario_from_dict({"control": {"beta": 0.0}})).choose(context) == start
+    explorer = policy_for("intg", scenario_from_dict({"control": {"beta": 1.0}}))
     moves = [explorer.choose(context) for _ in range(3)]
     assert any(move != start for move in moves)
 

@@ -4,6 +4,7 @@ The defaults are the synthetic scene of the paper's section 5.1 with the
 camera mounting chosen in :mod:`ptztrack.scene.synthetic`.
 """
 
+from importlib import resources
 from pathlib import Path
 from typing import Annotated, Literal
 
@@ -106,6 +107,24 @@ class Control(_Strict):
     arrival_rate_per_m2_s: NonNegativeFloat = 0.002
 
 
+class Recording(_Strict):
+    """A calibrated recording with ground truth, seen through a virtual PTZ camera (paper section 5.2).
+
+    With a recording, the camera's position and focal length come from the
+    calibration (``camera.image_size_px`` sets the virtual view), and the
+    action grid's pan and tilt are offsets from the pose that shows the whole
+    recorded frame. Relative paths in a scenario file are relative to it.
+    """
+
+    ground_truth: str
+    calibration: str
+    view: str = "View_001"
+    video: str | None = None
+    recorded_size_px: tuple[Annotated[int, Field(gt=0)], Annotated[int, Field(gt=0)]] = (768, 576)
+    frame_step: int = Field(2, ge=1)
+    occluded_above: float = Field(0.25, ge=0, le=1)
+
+
 class Scenario(_Strict):
     """Everything a run needs besides the policy and the seed."""
 
@@ -118,6 +137,12 @@ class Scenario(_Strict):
     detector: Detector = Detector()
     tracker: Tracker = Tracker()
     control: Control = Control()
+    recording: Recording | None = None
+
+    @property
+    def area_bounds_m(self) -> np.ndarray:
+        """[[x0, y0], [x1, y1]] of the synthetic area, whose corner is the origin."""
+        return np.array([[0.0, 0.0], list(self.area_m)])
 
     def ptz_camera(self) -> PTZCamera:
         width_px, height_px = self.camera.image_size_px
@@ -161,6 +186,25 @@ def scenario_from_dict(data: dict, source: str = "scenario", **overrides) -> Sce
         raise ScenarioError(_first_error_line(error, source)) from None
 
 
+def pets_scenario(**overrides) -> Scenario:
+    """The built-in PETS 2009 S2.L1 scenario: the paper's realistic experiment (section 5.2)."""
+    data_dir = resources.files("ptztrack.data") / "pets2009_s2l1"
+    recording = {"ground_truth": str(data_dir / "gt_mot15.txt"), "calibration": str(data_dir / "pinhole.json")}
+    data = {
+        "frames": 398,
+        "frame_rate_hz": 5.0,
+        "camera": {"image_size_px": (160, 120)},
+        "actions": {
+            "pan_deg": {"start": -14.0, "stop": 14.0, "count": 7},
+            "tilt_deg": {"start": -10.0, "stop": 10.0, "count": 5},
+            "zoom": (1.0, 2.0, 3.0, 4.0),
+        },
+        "detector": {"kind": "ideal", "pixel_noise_px": 0.5},
+        "recording": recording,
+    }
+    return scenario_from_dict(data, "pets", **overrides)
+
+
 def load_scenario(path: str | Path, **overrides) -> Scenario:
     """Read and validate a YAML scenario file (see the README for the format)."""
     path = Path(path)
@@ -174,4 +218,16 @@ def load_scenario(path: str | Path, **overrides) -> Scenario:
         mark = getattr(error, "problem_mark", None)
         where = f" at line {mark.line + 1}" if mark else ""
         raise ScenarioError(f"{path}: not valid YAML{where}") from None
-    return scenario_from_dict({} if data is None else data, str(path), **overrides)
+    data = {} if data is None else data
+    recording = data.get("recording") if isinstance(data, dict) else None
+    if isinstance(recording, dict):
+        data = {**data, "recording": {**recording, **_resolved_paths(recording, path.parent)}}
+    return scenario_from_dict(data, str(path), **overrides)
+
+
+def _resolved_paths(recording: dict, base: Path) -> dict:
+    return {
+        key: str(base / value)
+        for key, value in recording.items()
+        if key in ("ground_truth", "calibration", "video") and isinstance(value, str)
+    }

@@ -12,18 +12,77 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from typing import Protocol
+
+from ptztrack.camera.actions import ActionGrid
+from ptztrack.camera.recorded import RecordedPTZ
 from ptztrack.camera.simulated import SimulatedPTZ
+from ptztrack.camera.virtual import virtual_ptz
 from ptztrack.config import Scenario
 from ptztrack.control.baselines import FixPolicy, PatrolPolicy, RandomPolicy, patrol_route, widest_view_action
 from ptztrack.control.exploration import exploration_map
 from ptztrack.control.information_policy import InformationGainPolicy
 from ptztrack.control.policy import DecisionContext, Policy
 from ptztrack.detect.simulated import Detections
+from ptztrack.geometry.calibration import load_pinhole
+from ptztrack.geometry.ptz import PTZCamera
+from ptztrack.scene.pets import load_mot_ground_truth, recorded_scene
 from ptztrack.scene.synthetic import GroundTruth, walk_people
 from ptztrack.track.kalman import constant_velocity_model
 from ptztrack.track.tracker import Tracks, no_tracks, pixel_noise_covariance, predict_tracks, update_tracks
 
 POLICIES = ("fix", "patrol", "random", "intg", "smpl")
+
+
+class CameraBackend(Protocol):
+    """Whatever gives detections for a step and a pose: simulated, recorded, or a real camera."""
+
+    def observe(self, step: int, pose, rng: np.random.Generator) -> Detections: ...
+
+
+@dataclass(frozen=True)
+class World:
+    """Everything a run's loop needs besides the policy.
+
+    camera, grid : the PTZ camera model and its action grid.
+    truth : the people, for the metrics.
+    backend : gives the detections.
+    area_bounds_m : [[x0, y0], [x1, y1]], where people can be.
+    """
+
+    camera: PTZCamera
+    grid: ActionGrid
+    truth: GroundTruth
+    backend: CameraBackend
+    area_bounds_m: np.ndarray
+
+
+def build_world(scenario: Scenario, scene_rng: np.random.Generator) -> World:
+    """The synthetic scene, or the recording of ``scenario.recording`` seen by a virtual PTZ camera."""
+    if scenario.recording is None:
+        camera, grid = scenario.ptz_camera(), scenario.action_grid()
+        truth = walk_people(scenario.people, scenario.area_m, scenario.frames, scenario.frame_rate_hz, scene_rng)
+        return World(camera, grid, truth, SimulatedPTZ(camera, truth, scenario.detector), scenario.area_bounds_m)
+    recording = scenario.recording
+    virtual, whole_frame_pose = virtual_ptz(
+        load_pinhole(recording.calibration, recording.view), recording.recorded_size_px, scenario.camera.image_size_px
+    )
+    offsets = scenario.action_grid()
+    grid = ActionGrid(
+        offsets.pan_deg + whole_frame_pose[0], offsets.tilt_deg + whole_frame_pose[1], offsets.zoom, offsets.max_steps
+    )
+    scene = recorded_scene(
+        load_mot_ground_truth(recording.ground_truth),
+        recording.frame_step,
+        scenario.frames,
+        scenario.frame_rate_hz,
+        scenario.people.width_m,
+    )
+    margin_m = 1.0
+    ground_m = scene.annotations.ground_m
+    area_bounds_m = np.array([ground_m.min(axis=0) - margin_m, ground_m.max(axis=0) + margin_m])
+    backend = RecordedPTZ(virtual, scene, scenario.detector, recording.occluded_above)
+    return World(virtual.camera, grid, scene.truth, backend, area_bounds_m)
 
 
 @dataclass(frozen=True)
@@ -44,20 +103,25 @@ class Episode:
     detections: list[Detections]
 
 
-def make_policy(name: str, scenario: Scenario) -> Policy:
-    """A fresh policy of the given name for one episode."""
-    camera, grid = scenario.ptz_camera(), scenario.action_grid()
+def make_policy(name: str, scenario: Scenario, world: World) -> Policy:
+    """A fresh policy of the given name for one episode in ``world``."""
+    camera, grid = world.camera, world.grid
     if name == "fix":
-        return FixPolicy(widest_view_action(camera, grid, scenario.area_m))
+        return FixPolicy(widest_view_action(camera, grid, world.area_bounds_m))
     if name == "patrol":
-        return PatrolPolicy(grid, patrol_route(camera, grid, scenario.area_m))
+        return PatrolPolicy(grid, patrol_route(camera, grid, world.area_bounds_m))
     if name == "random":
         return RandomPolicy()
     if name in ("intg", "smpl"):
         exploration = None
         if scenario.control.beta > 0:
             exploration = exploration_map(
-                camera, grid.poses, scenario.area_m, scenario.detector, scenario.control, 1.0 / scenario.frame_rate_hz
+                camera,
+                grid.poses,
+                world.area_bounds_m,
+                scenario.detector,
+                scenario.control,
+                1.0 / scenario.frame_rate_hz,
             )
         return InformationGainPolicy(
             camera,
@@ -73,31 +137,28 @@ def make_policy(name: str, scenario: Scenario) -> Policy:
 
 
 def run_episode(scenario: Scenario, policy_name: str, seed: int) -> Episode:
-    """Run one closed-loop episode of ``scenario.frames`` steps on the synthetic scene."""
+    """Run one closed-loop episode of the scenario: at most ``scenario.frames`` steps."""
     scene_seed, detector_seed, policy_seed = np.random.SeedSequence(seed).spawn(3)
-    camera, grid = scenario.ptz_camera(), scenario.action_grid()
-    truth = walk_people(
-        scenario.people, scenario.area_m, scenario.frames, scenario.frame_rate_hz, np.random.default_rng(scene_seed)
-    )
-    backend = SimulatedPTZ(camera, truth, scenario.detector)
-    policy = make_policy(policy_name, scenario)
-    frame_seeds = detector_seed.spawn(scenario.frames)
+    world = build_world(scenario, np.random.default_rng(scene_seed))
+    steps = world.truth.positions_m.shape[0]
+    policy = make_policy(policy_name, scenario, world)
+    frame_seeds = detector_seed.spawn(steps)
     policy_rng = np.random.default_rng(policy_seed)
     F, U = constant_velocity_model(1.0 / scenario.frame_rate_hz, scenario.tracker.acceleration_sigma_m_s2)
     V = pixel_noise_covariance(scenario.detector)
 
-    action = widest_view_action(camera, grid, scenario.area_m)
+    action = widest_view_action(world.camera, world.grid, world.area_bounds_m)
     tracks = no_tracks()
     actions, track_history, detection_history = [], [], []
-    for step in range(scenario.frames):
+    for step in range(steps):
         tracks = predict_tracks(tracks, F, U)
-        context = DecisionContext(step, action, grid.reachable(action), tracks, policy_rng)
+        context = DecisionContext(step, action, world.grid.reachable(action), tracks, policy_rng)
         action = policy.choose(context)
-        pose = grid.poses[action]
-        detections = backend.observe(step, pose, np.random.default_rng(frame_seeds[step]))
-        tracks = update_tracks(tracks, detections.feet_px, camera, pose, V, scenario.tracker)
+        pose = world.grid.poses[action]
+        detections = world.backend.observe(step, pose, np.random.default_rng(frame_seeds[step]))
+        tracks = update_tracks(tracks, detections.feet_px, world.camera, pose, V, scenario.tracker)
         actions.append(action)
         track_history.append(tracks)
         detection_history.append(detections)
     actions = np.asarray(actions)
-    return Episode(truth, actions, grid.poses[actions], track_history, detection_history)
+    return Episode(world.truth, actions, world.grid.poses[actions], track_history, detection_history)

@@ -56,6 +56,8 @@ class VirtualPTZ:
 
     def recorded_to_virtual(self, recorded_px, pose) -> np.ndarray:
         """Recorded (distorted) pixels (N, 2) to virtual pixels (N, 2) at ``pose``; NaN behind the virtual camera."""
+        if len(recorded_px) == 0:
+            return np.zeros((0, 2))
         normalised = cv2.undistortPoints(
             np.asarray(recorded_px, dtype=float).reshape(-1, 1, 2), self.recording.K, self.recording.dist
         )[:, 0, :]

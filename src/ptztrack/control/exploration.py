@@ -81,12 +81,13 @@ class ExplorationMap:
 
 
 def exploration_map(
-    camera: PTZCamera, poses, area_m, detector: Detector, control: Control, dt_s: float
+    camera: PTZCamera, poses, area_bounds_m, detector: Detector, control: Control, dt_s: float
 ) -> ExplorationMap:
-    """A fresh map over the area with cells of ``control.exploration_cell_m``."""
+    """A fresh map over the area ``[[x0, y0], [x1, y1]]`` with cells of ``control.exploration_cell_m``."""
     cell_m = control.exploration_cell_m
-    xs = np.arange(cell_m / 2, area_m[0], cell_m)
-    ys = np.arange(cell_m / 2, area_m[1], cell_m)
+    (x0, y0), (x1, y1) = np.asarray(area_bounds_m, dtype=float)
+    xs = np.arange(x0 + cell_m / 2, x1, cell_m)
+    ys = np.arange(y0 + cell_m / 2, y1, cell_m)
     centres = np.stack(np.meshgrid(xs, ys), axis=-1).reshape(-1, 2)
     arrival = -np.expm1(-control.arrival_rate_per_m2_s * cell_m**2 * dt_s)
     return ExplorationMap(

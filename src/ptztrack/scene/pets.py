@@ -13,6 +13,8 @@ import cv2
 import defusedxml.ElementTree as ElementTree
 import numpy as np
 
+from ptztrack.scene.synthetic import GroundTruth
+
 MOT_COLUMNS = 10
 
 
@@ -131,3 +133,43 @@ def read_video(path: str | Path, expected_frames: int | None = None, expected_si
     if expected_size_px is not None and tuple(video.shape[2:0:-1]) != tuple(expected_size_px):
         raise DatasetError(f"{path}: frames are {video.shape[2]}x{video.shape[1]} px, expected {expected_size_px[0]}x{expected_size_px[1]}")
     return video
+
+
+@dataclass(frozen=True)
+class RecordedScene:
+    """The people of a recording, step by step, for the closed loop.
+
+    truth : positions (T, N, 2) metres, NaN where absent, for the metrics.
+    video_frame : (T,) the recorded frame of each step.
+    person_id : (N,) the annotation id of each column of ``truth``.
+    annotations : the annotations of those frames.
+    """
+
+    truth: GroundTruth
+    video_frame: np.ndarray
+    person_id: np.ndarray
+    annotations: Annotations
+
+
+def recorded_scene(
+    annotations: Annotations, frame_step: int, steps: int, frame_rate_hz: float, width_m: float = 0.5
+) -> RecordedScene:
+    """Every ``frame_step``-th annotated frame, from the first, for ``steps`` steps (fewer if the recording ends).
+
+    The people's heights are not annotated; ``GroundTruth.heights_m`` holds
+    NaN, which nothing on this path reads (detections come from the boxes).
+    """
+    video_frame = np.arange(0, annotations.frame.max() + 1, frame_step)[:steps]
+    kept = annotations.select(np.isin(annotations.frame, video_frame))
+    person_id = np.unique(kept.person_id)
+    positions_m = np.full((len(video_frame), len(person_id), 2), np.nan)
+    step = np.searchsorted(video_frame, kept.frame)
+    column = np.searchsorted(person_id, kept.person_id)
+    positions_m[step, column] = kept.ground_m
+    truth = GroundTruth(
+        positions_m=positions_m,
+        heights_m=np.full(len(person_id), np.nan),
+        widths_m=np.full(len(person_id), width_m),
+        frame_rate_hz=frame_rate_hz,
+    )
+    return RecordedScene(truth, video_frame, person_id, kept)

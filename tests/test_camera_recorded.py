@@ -1,0 +1,63 @@
+import os
+from pathlib import Path
+
+import numpy as np
+
+from ptztrack.config import load_scenario, pets_scenario
+from ptztrack.episode import build_world, run_episode
+from ptztrack.evaluate.metrics import episode_metrics
+from ptztrack.geometry.ptz import apply_homography, ground_to_image
+
+EXCERPT = Path(__file__).parent / "data" / "pets_s2l1_excerpt"
+
+
+def excerpt_scenario(tmp_path, **overrides):
+    path = tmp_path / "pets.yaml"
+    path.write_text(
+        f"""
+frames: 15
+frame_rate_hz: 5.0
+camera: {{image_size_px: [160, 120]}}
+actions:
+  pan_deg: {{start: -14, stop: 14, count: 7}}
+  tilt_deg: {{start: -10, stop: 10, count: 5}}
+  zoom: [1, 2, 3, 4]
+detector: {{kind: ideal, pixel_noise_px: 0.0}}
+recording:
+  ground_truth: {os.path.relpath(EXCERPT / "gt_mot15.txt", tmp_path)}
+  calibration: {EXCERPT / "pinhole.json"}
+"""
+    )
+    return load_scenario(path, **overrides)
+
+
+def test_a_scenario_file_names_its_recording_relative_to_itself(tmp_path):
+    scenario = excerpt_scenario(tmp_path)
+    assert Path(scenario.recording.ground_truth).resolve() == (EXCERPT / "gt_mot15.txt").resolve()
+    world = build_world(scenario, np.random.default_rng(0))
+    assert world.grid.size == 140
+    assert world.truth.positions_m.shape[0] == 15
+
+
+def test_the_ideal_detector_reports_annotated_feet_where_the_virtual_camera_sees_them(tmp_path):
+    world = build_world(excerpt_scenario(tmp_path), np.random.default_rng(0))
+    wide = int(np.argmin(np.abs(world.grid.axis_indices - [3, 2, 0]).sum(axis=1)))
+    pose = world.grid.poses[wide]
+    found = world.backend.observe(0, pose, np.random.default_rng(0))
+    present = np.flatnonzero(~np.isnan(world.truth.positions_m[0, :, 0]))
+    assert len(found) >= 0.7 * len(present)
+    expected = apply_homography(ground_to_image(world.camera, pose), world.truth.positions_m[0, found.person_index])
+    # the annotations sit about 2 px from the calibrated feet in the 768 px frame: 0.5 px at 160 px
+    assert np.median(np.linalg.norm(found.feet_px - expected, axis=1)) < 1.0
+    narrow = np.flatnonzero(world.grid.axis_indices[:, 2] == 3)
+    views = [world.backend.observe(0, world.grid.poses[a], np.random.default_rng(0)) for a in narrow]
+    zoomed = max(views, key=len)
+    assert 0 < len(zoomed) < len(found)
+    assert np.mean(zoomed.height_px) > 2.5 * np.mean(found.height_px)
+
+
+def test_the_built_in_pets_scenario_runs_from_the_package_data():
+    scenario = pets_scenario(frames=40)
+    metrics = episode_metrics(run_episode(scenario, "fix", 0))
+    assert metrics["mota"] > 0.6
+    assert 10 < metrics["height_px"] < 30
