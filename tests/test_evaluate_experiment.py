@@ -29,16 +29,25 @@ def test_ray_executor_gives_the_same_rows():
 
 
 def test_summary_is_the_mean_over_sequences_in_the_papers_layout():
+    common = {"beta": None}
     rows = [
-        {"strategy": "fix", "mota": 0.5, "motp_m": 0.2, "height_px": 50.0, "detections": 10, "zoom": 1.0},
-        {"strategy": "fix", "mota": 0.7, "motp_m": 0.4, "height_px": 60.0, "detections": 20, "zoom": 1.0},
-        {"strategy": "smpl", "mota": 0.9, "motp_m": 0.1, "height_px": 90.0, "detections": 30, "zoom": 2.5},
+        {"strategy": "fix", "label": "fix", "mota": 0.5, "motp_m": 0.2, "height_px": 50.0, "detections": 10, "zoom": 1.0},
+        {"strategy": "fix", "label": "fix", "mota": 0.7, "motp_m": 0.4, "height_px": 60.0, "detections": 20, "zoom": 1.0},
+        {"strategy": "smpl", "label": "smpl", "mota": 0.9, "motp_m": 0.1, "height_px": 90.0, "detections": 30, "zoom": 2.5},
     ]
-    summary = summarise(rows)
+    summary = summarise([{**row, **common} for row in rows])
     assert [row["strategy"] for row in summary] == ["fix", "smpl"]
-    assert summary[0] == pytest.approx(
-        {"strategy": "fix", "sequences": 2, "mota": 0.6, "motp_m": 0.3, "height_px": 55.0, "detections": 15.0, "zoom": 1.0}
-    )
+    assert summary[0] == {
+        "strategy": "fix",
+        "label": "fix",
+        "beta": None,
+        "sequences": 2,
+        "mota": pytest.approx(0.6),
+        "motp_m": pytest.approx(0.3),
+        "height_px": pytest.approx(55.0),
+        "detections": pytest.approx(15.0),
+        "zoom": pytest.approx(1.0),
+    }
     lines = format_table(summary).splitlines()
     assert lines[0].split() == ["fix", "smpl"]
     assert lines[1].split() == ["MOTA", "60.0%", "90.0%"]
@@ -66,7 +75,7 @@ def test_experiment_command_prints_the_table_and_writes_one_row_per_strategy(tmp
 
 def table(detector):
     scenario = scenario_from_dict({"detector": {"kind": detector}})
-    return {row["strategy"]: row for row in summarise(run_cells(synthetic_cells(scenario, 12), "local"))}
+    return {row["label"]: row for row in summarise(run_cells(synthetic_cells(scenario, 12), "local"))}
 
 
 def test_the_papers_synthetic_tables_qualitatively():
@@ -83,3 +92,17 @@ def test_the_papers_synthetic_tables_qualitatively():
         assert realistic[strategy]["motp_m"] < realistic["fix"]["motp_m"]
     assert realistic["fix"]["mota"] < ideal["fix"]["mota"] - 0.2
     assert np.isclose(realistic["fix"]["zoom"], 1.0)
+
+
+def test_the_pets_experiment_has_a_column_per_strategy_and_beta(tmp_path, capsys):
+    path = tmp_path / "pets.json"
+    assert main(["experiment", "pets", "--frames", "20", "--beta", "3", "--beta", "1", "--json", str(path)]) == 0
+    rows = json.loads(path.read_text())
+    assert [row["label"] for row in rows] == ["fix", "patrol", "rnd", "intg b3", "smpl b3", "intg b1", "smpl b1"]
+    assert [row["beta"] for row in rows] == [None, None, None, 3.0, 3.0, 1.0, 1.0]
+    assert "intg b3" in capsys.readouterr().out
+
+
+def test_the_pets_experiment_refuses_a_detector_it_does_not_have(capsys):
+    assert main(["experiment", "pets", "--detector", "realistic"]) == 2
+    assert "detector 'realistic' is not available" in capsys.readouterr().err

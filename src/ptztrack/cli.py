@@ -7,13 +7,14 @@ from pathlib import Path
 
 import json
 
-from ptztrack.config import Scenario, ScenarioError, load_scenario, scenario_from_dict
+from ptztrack.config import Scenario, ScenarioError, load_scenario, pets_scenario, scenario_from_dict
 from ptztrack.episode import POLICIES, run_episode
 from ptztrack.evaluate.experiment import (
     EXECUTORS,
     STRATEGIES,
     format_table,
     print_progress,
+    recording_cells,
     run_cells,
     summarise,
     synthetic_cells,
@@ -33,6 +34,8 @@ def build_scenario(name_or_path: str, detector: str | None = None, frames: int |
         overrides["frames"] = frames
     if name_or_path == "synthetic":
         return scenario_from_dict({}, "synthetic", **overrides)
+    if name_or_path == "pets":
+        return pets_scenario(**overrides)
     return load_scenario(name_or_path, **overrides)
 
 
@@ -47,29 +50,32 @@ def run_command(args: argparse.Namespace) -> int:
     metrics = episode_metrics(episode)
     print(
         f"scenario {args.scenario}, policy {args.policy}, detector {scenario.detector.kind}, "
-        f"seed {args.seed}, {scenario.frames} frames, {scenario.people.count} people"
+        f"seed {args.seed}, {len(episode.actions)} steps, {episode.truth.positions_m.shape[1]} people"
     )
     print(format_metrics(metrics))
     if args.out is not None:
         title = f"{args.policy}, {scenario.detector.kind} detector, seed {args.seed}: MOTA {metrics['mota']:.1%}"
-        write_outputs(args.out, episode, metrics, scenario.ptz_camera(), scenario.area_m, title)
+        write_outputs(args.out, episode, metrics, title)
         print(f"wrote {args.out / 'metrics.json'}, {args.out / 'tracks.csv'}, {args.out / 'episode.png'}")
     return 0
 
 
 def experiment_command(args: argparse.Namespace) -> int:
-    scenario = build_scenario(args.scenario, args.detector, args.frames)
-    cells = synthetic_cells(scenario, args.sequences, args.strategies)
-    print(
-        f"{len(cells)} episodes: {args.sequences} sequences x {len(args.strategies)} strategies, "
-        f"{scenario.frames} frames, {scenario.action_grid().size} actions, {args.executor} executor",
-        file=sys.stderr,
-    )
-    summary = summarise(run_cells(cells, args.executor, args.workers, print_progress), args.strategies)
-    title = (
-        f"{args.scenario} scene, {scenario.detector.kind} detector, beta {scenario.control.beta:g}, "
-        f"{args.sequences} sequences of {scenario.frames} frames (means over sequences)"
-    )
+    if args.name == "pets":
+        if args.detector not in (None, "ideal"):
+            raise ScenarioError(f"experiment pets: detector {args.detector!r} is not available; expected 'ideal'")
+        scenario = pets_scenario(**{"detector.kind": args.detector or "ideal"} | ({"frames": args.frames} if args.frames else {}))
+        cells = recording_cells(scenario, args.beta or [9.0, 1.0], args.strategies)
+        title = f"PETS 2009 S2.L1 View_001, {scenario.detector.kind} detector, every 2nd frame"
+    else:
+        scenario = build_scenario(args.scenario, args.detector or "realistic", args.frames)
+        cells = synthetic_cells(scenario, args.sequences, args.strategies)
+        title = (
+            f"{args.scenario} scene, {scenario.detector.kind} detector, beta {scenario.control.beta:g}, "
+            f"{args.sequences} sequences of {scenario.frames} frames (means over sequences)"
+        )
+    print(f"{len(cells)} episodes, {args.executor} executor", file=sys.stderr)
+    summary = summarise(run_cells(cells, args.executor, args.workers, print_progress))
     print(format_table(summary, title))
     if args.json is not None:
         write_atomically(args.json, (json.dumps(summary, indent=2) + "\n").encode())
@@ -81,7 +87,7 @@ def parser() -> argparse.ArgumentParser:
     root = argparse.ArgumentParser(prog="ptztrack", description="Multi-person tracking with a PTZ camera.")
     commands = root.add_subparsers(dest="command", required=True)
     run = commands.add_parser("run", help="run one closed-loop episode and print its metrics")
-    run.add_argument("--scenario", default="synthetic", help="'synthetic' (built in) or a scenario YAML file")
+    run.add_argument("--scenario", default="synthetic", help="'synthetic' or 'pets' (built in), or a scenario YAML file")
     run.add_argument("--policy", choices=POLICIES, default="smpl")
     run.add_argument("--detector", choices=("ideal", "realistic"), help="overrides the scenario's detector")
     run.add_argument("--seed", type=int, default=0)
@@ -90,9 +96,16 @@ def parser() -> argparse.ArgumentParser:
     run.set_defaults(handler=run_command)
 
     experiment = commands.add_parser("experiment", help="run one of the paper's experiments and print its table")
-    experiment.add_argument("name", choices=("synthetic",), help="the experiment (Tables 1-2 of the PTZ paper)")
+    experiment.add_argument(
+        "name", choices=("synthetic", "pets"), help="synthetic (the PTZ paper's Tables 1-2) or pets (Tables 3-4)"
+    )
     experiment.add_argument("--scenario", default="synthetic", help="'synthetic' (built in) or a scenario YAML file")
-    experiment.add_argument("--detector", choices=("ideal", "realistic"), default="realistic")
+    experiment.add_argument(
+        "--detector", choices=("ideal", "realistic"), help="synthetic: ideal or realistic (default); pets: ideal"
+    )
+    experiment.add_argument(
+        "--beta", type=float, action="append", help="pets: a weight of the patrolling term (repeatable; default 9 and 1)"
+    )
     experiment.add_argument("--sequences", type=_positive_int, default=12)
     experiment.add_argument("--frames", type=_positive_int, help="overrides the scenario's number of frames")
     experiment.add_argument("--strategies", nargs="+", choices=STRATEGIES, default=list(STRATEGIES))

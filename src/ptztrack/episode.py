@@ -90,6 +90,7 @@ class Episode:
     """What happened in one run.
 
     truth : the people.
+    camera : the PTZ camera that looked; area_bounds_m : [[x0, y0], [x1, y1]] where people can be.
     actions : (T,) flat action index taken at each step.
     poses : (T, 3) those actions as (pan_deg, tilt_deg, zoom).
     tracks : per step, the tracks after that step's update.
@@ -97,6 +98,8 @@ class Episode:
     """
 
     truth: GroundTruth
+    camera: PTZCamera
+    area_bounds_m: np.ndarray
     actions: np.ndarray
     poses: np.ndarray
     tracks: list[Tracks]
@@ -161,4 +164,12 @@ def run_episode(scenario: Scenario, policy_name: str, seed: int) -> Episode:
         track_history.append(tracks)
         detection_history.append(detections)
     actions = np.asarray(actions)
-    return Episode(world.truth, actions, world.grid.poses[actions], track_history, detection_history)
+    return Episode(
+        world.truth,
+        world.camera,
+        world.area_bounds_m,
+        actions,
+        world.grid.poses[actions],
+        track_history,
+        detection_history,
+    )

@@ -27,11 +27,19 @@ SUMMARY_KEYS = ("mota", "motp_m", "height_px", "detections", "zoom")
 
 @dataclass(frozen=True)
 class Cell:
-    """One episode of an experiment: a scenario run with one strategy and one sequence seed."""
+    """One episode of an experiment: a scenario run with one strategy and one sequence seed.
+
+    label : the table column it belongs to (the strategy, with beta where the table has several).
+    """
 
     scenario: Scenario
     strategy: str
     seed: int
+    label: str = ""
+
+    @property
+    def column(self) -> str:
+        return self.label or self.strategy
 
 
 def synthetic_cells(scenario: Scenario, sequences: int, strategies: Sequence[str] = STRATEGIES) -> list[Cell]:
@@ -42,10 +50,23 @@ def synthetic_cells(scenario: Scenario, sequences: int, strategies: Sequence[str
     return [Cell(scenario, strategy, seed) for strategy in strategies for seed in range(sequences)]
 
 
+def recording_cells(scenario: Scenario, betas: Sequence[float], strategies: Sequence[str] = STRATEGIES) -> list[Cell]:
+    """The paper's realistic protocol (section 5.2): one run of each strategy over the recording,
+    the information-gain ones once per ``beta`` of the patrolling term."""
+    cells = [Cell(scenario, strategy, 0) for strategy in strategies if strategy not in ("intg", "smpl")]
+    for beta in betas:
+        with_beta = scenario.model_copy(update={"control": scenario.control.model_copy(update={"beta": beta})})
+        for strategy in strategies:
+            if strategy in ("intg", "smpl"):
+                cells.append(Cell(with_beta, strategy, 0, f"{strategy} b{beta:g}"))
+    return cells
+
+
 def run_cell(cell: Cell) -> dict:
-    """Run one cell; returns its metrics with ``strategy`` and ``seed``."""
+    """Run one cell; returns its metrics with ``strategy``, ``label``, ``beta`` (None for baselines) and ``seed``."""
     episode = run_episode(cell.scenario, POLICY_OF_STRATEGY.get(cell.strategy, cell.strategy), cell.seed)
-    return {"strategy": cell.strategy, "seed": cell.seed, **episode_metrics(episode)}
+    beta = cell.scenario.control.beta if cell.strategy in ("intg", "smpl") else None
+    return {"strategy": cell.strategy, "label": cell.column, "beta": beta, "seed": cell.seed, **episode_metrics(episode)}
 
 
 def run_cells(
@@ -128,14 +149,15 @@ def _run_on_ray(cells: Sequence[Cell], report: Callable[[int, int], None]) -> li
     return rows
 
 
-def summarise(rows: Sequence[dict], strategies: Sequence[str] = STRATEGIES) -> list[dict]:
-    """Per strategy, the mean over sequences of the paper's figures (the paper averages per-sequence results)."""
+def summarise(rows: Sequence[dict]) -> list[dict]:
+    """Per table column, in the order of first appearance, the mean over sequences of the paper's figures
+    (the paper averages per-sequence results)."""
     summary = []
-    for strategy in strategies:
-        mine = [row for row in rows if row["strategy"] == strategy]
-        if mine:
-            means = {key: float(np.mean([row[key] for row in mine])) for key in SUMMARY_KEYS}
-            summary.append({"strategy": strategy, "sequences": len(mine), **means})
+    for label in dict.fromkeys(row["label"] for row in rows):
+        mine = [row for row in rows if row["label"] == label]
+        means = {key: float(np.mean([row[key] for row in mine])) for key in SUMMARY_KEYS}
+        first = mine[0]
+        summary.append({"strategy": first["strategy"], "label": label, "beta": first["beta"], "sequences": len(mine), **means})
     return summary
 
 
@@ -143,7 +165,7 @@ def format_table(summary: Sequence[dict], title: str = "") -> str:
     """The paper's layout: a row per figure, a column per strategy."""
     width = max(len(DISPLAY[key][0]) for key in SUMMARY_KEYS)
     lines = [title] if title else []
-    lines.append(" " * width + "".join(f"{row['strategy']:>10}" for row in summary))
+    lines.append(" " * width + "".join(f"{row['label']:>10}" for row in summary))
     for key in SUMMARY_KEYS:
         label, fmt = DISPLAY[key]
         lines.append(f"{label:<{width}}" + "".join(f"{fmt.format(row[key]):>10}" for row in summary))

@@ -13,7 +13,7 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Rectangle
 
 from ptztrack.episode import Episode
-from ptztrack.geometry.ptz import PTZCamera, ground_footprint
+from ptztrack.geometry.ptz import ground_footprint
 
 TRACK_COLUMNS = ("frame", "id", "x_m", "y_m", "vx_m_s", "vy_m_s", "var_x_m2", "cov_xy_m2", "var_y_m2")
 
@@ -51,15 +51,17 @@ def tracks_csv(episode: Episode) -> bytes:
     return text.getvalue().encode()
 
 
-def episode_figure(episode: Episode, camera: PTZCamera, area_m, title: str = "") -> Figure:
+def episode_figure(episode: Episode, title: str = "") -> Figure:
     """Ground-plane picture: true paths (grey), tracks (coloured by id), camera footprints over time (outlines)."""
     figure = Figure(figsize=(7, 7))
     axes = figure.add_subplot()
+    camera = episode.camera
+    (x0, y0), (x1, y1) = episode.area_bounds_m
     footprints = ground_footprint(camera, episode.poses, max_range_m=40.0)
     for footprint in footprints:
         axes.fill(*footprint.T, facecolor="none", edgecolor="tab:blue", alpha=0.25, lw=0.8)
     axes.fill(*footprints[-1].T, color="tab:blue", alpha=0.08, lw=0)
-    axes.add_patch(Rectangle((0, 0), *area_m, fill=False, ls="--", color="black", lw=1))
+    axes.add_patch(Rectangle((x0, y0), x1 - x0, y1 - y0, fill=False, ls="--", color="black", lw=1))
     for path in np.swapaxes(episode.truth.positions_m, 0, 1):
         axes.plot(*path.T, color="0.55", lw=3, alpha=0.6, solid_capstyle="round")
     colours = matplotlib.colormaps["tab20"]
@@ -74,8 +76,8 @@ def episode_figure(episode: Episode, camera: PTZCamera, area_m, title: str = "")
     axes.plot(*camera.centre_m[:2], "k^", ms=9)
     axes.annotate("camera", camera.centre_m[:2], xytext=(6, -3), textcoords="offset points", fontsize=8)
     margin_m = 2.0
-    axes.set_xlim(min(-margin_m, camera.centre_m[0] - margin_m), max(area_m[0], camera.centre_m[0]) + margin_m)
-    axes.set_ylim(min(-margin_m, camera.centre_m[1] - margin_m), max(area_m[1], camera.centre_m[1]) + margin_m)
+    axes.set_xlim(min(x0, camera.centre_m[0]) - margin_m, max(x1, camera.centre_m[0]) + margin_m)
+    axes.set_ylim(min(y0, camera.centre_m[1]) - margin_m, max(y1, camera.centre_m[1]) + margin_m)
     axes.set_aspect("equal")
     axes.set_xlabel("x [m]")
     axes.set_ylabel("y [m]")
@@ -84,13 +86,13 @@ def episode_figure(episode: Episode, camera: PTZCamera, area_m, title: str = "")
     return figure
 
 
-def write_outputs(directory: Path, episode: Episode, metrics: dict, camera: PTZCamera, area_m, title: str = "") -> None:
+def write_outputs(directory: Path, episode: Episode, metrics: dict, title: str = "") -> None:
     """Write metrics.json, tracks.csv and episode.png into ``directory`` (created if needed)."""
     directory = Path(directory)
     directory.mkdir(parents=True, exist_ok=True)
     write_atomically(directory / "metrics.json", metrics_json(metrics))
     write_atomically(directory / "tracks.csv", tracks_csv(episode))
-    figure = episode_figure(episode, camera, area_m, title)
+    figure = episode_figure(episode, title)
     png = io.BytesIO()
     figure.savefig(png, format="png", dpi=110, metadata={"Software": None})
     write_atomically(directory / "episode.png", png.getvalue())
