@@ -25,7 +25,7 @@ def test_the_default_grid_is_the_papers_280_actions():
         ("area_m: [-15, 15]\n", "area_m.0: Input should be greater than 0 (got -15)"),
         ("frames: many\n", "frames: Input should be a valid integer"),
         ("people: {count: -1}\n", "people.count: Input should be greater than or equal to 0 (got -1)"),
-        ("detector: {kind: perfect}\n", "detector.kind: Input should be 'ideal' or 'realistic' (got 'perfect')"),
+        ("detector: {kind: perfect}\n", "detector.kind: Input should be 'ideal', 'realistic' or 'hog' (got 'perfect')"),
         ("people: {speed_m_s: [2.0, 1.0]}\n", "people: Value error, speed_m_s must be [low, high]"),
         ("actions: {zoom: [2, 1]}\n", "actions: Value error, zoom must be a non-empty increasing list"),
         ("- 1\n- 2\n", "expected a mapping of scenario fields (got list)"),

@@ -35,7 +35,7 @@ def build_scenario(name_or_path: str, detector: str | None = None, frames: int |
     if name_or_path == "synthetic":
         return scenario_from_dict({}, "synthetic", **overrides)
     if name_or_path == "pets":
-        return pets_scenario(**overrides)
+        return pets_scenario(overrides.pop("detector.kind", "ideal"), **overrides)
     return load_scenario(name_or_path, **overrides)
 
 
@@ -62,9 +62,7 @@ def run_command(args: argparse.Namespace) -> int:
 
 def experiment_command(args: argparse.Namespace) -> int:
     if args.name == "pets":
-        if args.detector not in (None, "ideal"):
-            raise ScenarioError(f"experiment pets: detector {args.detector!r} is not available; expected 'ideal'")
-        scenario = pets_scenario(**{"detector.kind": args.detector or "ideal"} | ({"frames": args.frames} if args.frames else {}))
+        scenario = pets_scenario(args.detector or "ideal", **({"frames": args.frames} if args.frames else {}))
         cells = recording_cells(scenario, args.beta or [9.0, 1.0], args.strategies)
         title = f"PETS 2009 S2.L1 View_001, {scenario.detector.kind} detector, every 2nd frame"
     else:
@@ -89,7 +87,7 @@ def parser() -> argparse.ArgumentParser:
     run = commands.add_parser("run", help="run one closed-loop episode and print its metrics")
     run.add_argument("--scenario", default="synthetic", help="'synthetic' or 'pets' (built in), or a scenario YAML file")
     run.add_argument("--policy", choices=POLICIES, default="smpl")
-    run.add_argument("--detector", choices=("ideal", "realistic"), help="overrides the scenario's detector")
+    run.add_argument("--detector", choices=("ideal", "realistic", "hog"), help="overrides the scenario's detector")
     run.add_argument("--seed", type=int, default=0)
     run.add_argument("--frames", type=_positive_int, help="overrides the scenario's number of frames")
     run.add_argument("--out", type=Path, help="directory for metrics.json, tracks.csv and episode.png")
@@ -101,7 +99,9 @@ def parser() -> argparse.ArgumentParser:
     )
     experiment.add_argument("--scenario", default="synthetic", help="'synthetic' (built in) or a scenario YAML file")
     experiment.add_argument(
-        "--detector", choices=("ideal", "realistic"), help="synthetic: ideal or realistic (default); pets: ideal"
+        "--detector",
+        choices=("ideal", "realistic", "hog"),
+        help="synthetic: ideal or realistic (default); pets: ideal (default) or hog",
     )
     experiment.add_argument(
         "--beta", type=float, action="append", help="pets: a weight of the patrolling term (repeatable; default 9 and 1)"

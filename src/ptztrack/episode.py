@@ -26,7 +26,8 @@ from ptztrack.control.policy import DecisionContext, Policy
 from ptztrack.detect.simulated import Detections
 from ptztrack.geometry.calibration import load_pinhole
 from ptztrack.geometry.ptz import PTZCamera
-from ptztrack.scene.pets import load_mot_ground_truth, recorded_scene
+from ptztrack.detect.hog import HogPeopleDetector
+from ptztrack.scene.pets import RecordedVideo, load_mot_ground_truth, recorded_scene
 from ptztrack.scene.synthetic import GroundTruth, walk_people
 from ptztrack.track.kalman import constant_velocity_model
 from ptztrack.track.tracker import Tracks, no_tracks, pixel_noise_covariance, predict_tracks, update_tracks
@@ -81,7 +82,12 @@ def build_world(scenario: Scenario, scene_rng: np.random.Generator) -> World:
     margin_m = 1.0
     ground_m = scene.annotations.ground_m
     area_bounds_m = np.array([ground_m.min(axis=0) - margin_m, ground_m.max(axis=0) + margin_m])
-    backend = RecordedPTZ(virtual, scene, scenario.detector, recording.occluded_above)
+    detector = scenario.detector
+    hog, video = None, None
+    if detector.kind == "hog":
+        hog = HogPeopleDetector(detector.hog_upsample, detector.hog_hit_threshold, detector.hog_nms_iou)
+        video = RecordedVideo(recording.video, recording.recorded_size_px)
+    backend = RecordedPTZ(virtual, scene, detector, recording.occluded_above, video, hog)
     return World(virtual.camera, grid, scene.truth, backend, area_bounds_m)
 
 

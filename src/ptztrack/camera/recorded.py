@@ -1,5 +1,10 @@
 """Camera backend over a recording: a virtual PTZ camera seeing annotated people (paper section 5.2).
 
+With the HOG detector, the virtual view of the step's recorded frame is
+rendered and OpenCV's people detector runs on it (:mod:`ptztrack.detect.hog`),
+which gives each box's feet and height; nobody knows which person a box is
+(``person_index`` -1).
+
 The ideal detector of the paper's Table 3: the annotated boxes of the step's
 frame are moved into the virtual view; a person is detected when the whole
 box is inside the view and no more than ``occluded_above`` of it is hidden
@@ -15,19 +20,35 @@ import numpy as np
 
 from ptztrack.camera.virtual import VirtualPTZ
 from ptztrack.config import Detector
+from ptztrack.detect.hog import HogPeopleDetector, feet_and_height_px
 from ptztrack.detect.simulated import Detections, occluded_fraction
-from ptztrack.scene.pets import RecordedScene
+from ptztrack.scene.pets import RecordedScene, RecordedVideo
 
 
 @dataclass(frozen=True)
 class RecordedPTZ:
+    """virtual : the camera; scene : the annotated people; video : the frames (needed by HOG only)."""
+
     virtual: VirtualPTZ
     scene: RecordedScene
     detector: Detector
     occluded_above: float
+    video: RecordedVideo | None = None
+    hog: HogPeopleDetector | None = None
 
     def observe(self, step: int, pose, rng: np.random.Generator) -> Detections:
-        """Detections (virtual-view feet pixels) of the annotated people of ``step`` seen at ``pose``."""
+        """Detections (virtual-view feet pixels) of the people of ``step`` seen at ``pose``."""
+        if self.hog is not None:
+            return self._observe_hog(step, pose)
+        return self._observe_annotations(step, pose, rng)
+
+    def _observe_hog(self, step: int, pose) -> Detections:
+        view = self.virtual.render(self.video.frame(int(self.scene.video_frame[step])), pose)
+        boxes, _ = self.hog.detect(view)
+        feet_px, height_px = feet_and_height_px(boxes)
+        return Detections(feet_px=feet_px, height_px=height_px, person_index=np.full(len(boxes), -1))
+
+    def _observe_annotations(self, step: int, pose, rng: np.random.Generator) -> Detections:
         annotations = self.scene.annotations
         people = annotations.select(annotations.frame == self.scene.video_frame[step])
         left, top, width, height = people.box_px.T

@@ -185,7 +185,7 @@ def detection_weight_integral(
         np.asarray(V, float),
         float(camera.image_width_px),
         float(camera.image_height_px),
-        detector.kind == "realistic",
+        detector.kind != "ideal",
         detector.recall_kd,
         detector.recall_r0_px,
     )
@@ -267,7 +267,7 @@ def detection_weight_sampled(
         1.0 - hidden,
         float(camera.image_width_px),
         float(camera.image_height_px),
-        detector.kind == "realistic",
+        detector.kind != "ideal",
         detector.recall_kd,
         detector.recall_r0_px,
     )

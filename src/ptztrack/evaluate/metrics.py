@@ -60,7 +60,7 @@ def episode_metrics(episode: Episode) -> dict:
     """The paper's figures for one episode.
 
     Besides :func:`clear_metrics`: ``height_px``, the mean pixel height of the
-    people that were detected; ``detections``, the number of detections the
+    detections whose height is known (a simulated false positive has none); ``detections``, the number of detections the
     detector reported (false positives included); ``zoom``, the mean zoom.
     """
     metrics = clear_metrics(
@@ -68,7 +68,7 @@ def episode_metrics(episode: Episode) -> dict:
         [tracks.ids for tracks in episode.tracks],
         [tracks.mean[:, :2] for tracks in episode.tracks],
     )
-    detected_heights_px = np.concatenate([d.height_px[d.person_index >= 0] for d in episode.detections])
+    detected_heights_px = np.concatenate([d.height_px[np.isfinite(d.height_px)] for d in episode.detections])
     metrics["height_px"] = float(np.mean(detected_heights_px)) if len(detected_heights_px) else float("nan")
     metrics["detections"] = int(sum(len(d) for d in episode.detections))
     metrics["zoom"] = float(np.mean(episode.poses[:, 2]))

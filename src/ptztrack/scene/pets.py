@@ -173,3 +173,42 @@ def recorded_scene(
         frame_rate_hz=frame_rate_hz,
     )
     return RecordedScene(truth, video_frame, person_id, kept)
+
+
+class RecordedVideo:
+    """Frames of a video read forwards on demand, so that a long recording is never held in memory.
+
+    The closed loop asks for increasing frame indices; asking for an earlier
+    frame reopens the video.
+    """
+
+    def __init__(self, path: str | Path, expected_size_px=None):
+        self.path = Path(path)
+        if not self.path.is_file():
+            raise DatasetError(f"{self.path}: no such video file")
+        self.expected_size_px = expected_size_px
+        self._open()
+
+    def _open(self) -> None:
+        self._capture = cv2.VideoCapture(str(self.path))
+        self._next = 0
+
+    def frame(self, index: int) -> np.ndarray:
+        """Frame ``index`` (0-based) as (height, width, 3) uint8 BGR."""
+        if index < self._next:
+            self._capture.release()
+            self._open()
+        while self._next < index:
+            if not self._capture.grab():
+                raise DatasetError(f"{self.path}: the video ends before frame {index}")
+            self._next += 1
+        ok, image = self._capture.read()
+        if not ok:
+            raise DatasetError(f"{self.path}: the video ends before frame {index}")
+        self._next += 1
+        if self.expected_size_px is not None and tuple(image.shape[1::-1]) != tuple(self.expected_size_px):
+            raise DatasetError(
+                f"{self.path}: frames are {image.shape[1]}x{image.shape[0]} px, "
+                f"expected {self.expected_size_px[0]}x{self.expected_size_px[1]}"
+            )
+        return image
