@@ -39,16 +39,17 @@ class RecordedPTZ:
     def observe(self, step: int, pose, rng: np.random.Generator) -> Detections:
         """Detections (virtual-view feet pixels) of the people of ``step`` seen at ``pose``."""
         if self.hog is not None:
-            return self._observe_hog(step, pose)
-        return self._observe_annotations(step, pose, rng)
+            feet_px, height_px = feet_and_height_px(self.observe_hog_boxes(step, pose))
+            return Detections(feet_px=feet_px, height_px=height_px, person_index=np.full(len(feet_px), -1))
+        return self.observe_annotations(step, pose, rng)
 
-    def _observe_hog(self, step: int, pose) -> Detections:
+    def observe_hog_boxes(self, step: int, pose) -> np.ndarray:
+        """HOG boxes (K, 4) (left, top, width, height) in the virtual view of ``step`` at ``pose``."""
         view = self.virtual.render(self.video.frame(int(self.scene.video_frame[step])), pose)
-        boxes, _ = self.hog.detect(view)
-        feet_px, height_px = feet_and_height_px(boxes)
-        return Detections(feet_px=feet_px, height_px=height_px, person_index=np.full(len(boxes), -1))
+        return self.hog.detect(view)[0]
 
-    def _observe_annotations(self, step: int, pose, rng: np.random.Generator) -> Detections:
+    def observe_annotations(self, step: int, pose, rng: np.random.Generator, pixel_noise: bool = True) -> Detections:
+        """The ideal detector: annotated people fully in view and not occluded, feet with the detector's noise."""
         annotations = self.scene.annotations
         people = annotations.select(annotations.frame == self.scene.video_frame[step])
         left, top, width, height = people.box_px.T
@@ -63,7 +64,7 @@ class RecordedPTZ:
         range_m = np.linalg.norm(np.c_[people.ground_m, np.zeros(len(people.frame))] - centre_m, axis=1)
         boxes = np.stack([left, top, left + width, top + height], axis=-1)
         hidden = occluded_fraction(boxes, range_m, np.ones(len(boxes), dtype=bool))
-        luck_noise = rng.normal(0.0, self.detector.pixel_noise_px, size=(len(boxes), 2))
+        luck_noise = rng.normal(0.0, self.detector.pixel_noise_px if pixel_noise else 0.0, size=(len(boxes), 2))
         seen = np.flatnonzero(inside & (hidden <= self.occluded_above))
         feet_px = self.virtual.recorded_to_virtual(people.feet_px[seen], pose) + luck_noise[seen]
         heights_px = virtual_corners[seen, 2:, 1].mean(axis=1) - virtual_corners[seen, :2, 1].mean(axis=1)
