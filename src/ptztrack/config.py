@@ -204,6 +204,12 @@ def scenario_from_dict(data: dict, source: str = "scenario", **overrides) -> Sce
 # about 2 px from the calibrated feet in the 768 px frame (0.5 px here); HOG's
 # feet lie a median 1.6 px from them, which a 2-D Gaussian of 1.4 px gives.
 PETS_PIXEL_NOISE_PX = {"ideal": 0.5, "hog": 1.5}
+# The recall curve the policies plan with for HOG on these views, fitted by
+# benchmarks/fit_hog_recall.py (maximum likelihood over 2210 annotated people
+# in views of every 20th step at zoom 1-4): HOG on a 6x upsampled view finds
+# 84 % of the people 15-21 px tall, where the paper's Caltech curve
+# (Kd 0.0098, r0 21.29) predicts none.
+PETS_HOG_RECALL = {"recall_kd": 0.0795, "recall_r0_px": 1.83}
 
 
 def pets_scenario(detector: str = "ideal", **overrides) -> Scenario:
@@ -228,7 +234,11 @@ def pets_scenario(detector: str = "ideal", **overrides) -> Scenario:
             "tilt_deg": {"start": -10.0, "stop": 10.0, "count": 5},
             "zoom": (1.0, 2.0, 3.0, 4.0),
         },
-        "detector": {"kind": detector, "pixel_noise_px": PETS_PIXEL_NOISE_PX[detector]},
+        "detector": {
+            "kind": detector,
+            "pixel_noise_px": PETS_PIXEL_NOISE_PX[detector],
+            **(PETS_HOG_RECALL if detector == "hog" else {}),
+        },
         "recording": recording,
     }
     return scenario_from_dict(data, "pets", **overrides)
