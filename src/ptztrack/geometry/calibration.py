@@ -113,15 +113,20 @@ def _attributes(root, tag: str, names: tuple[str, ...], path: Path) -> dict[str,
     return values
 
 
+def read_xml_root(path: Path, error_type: type[ValueError], what: str):
+    """The root element of an XML file (parsed safely), or ``error_type`` naming the file and the problem."""
+    try:
+        return ElementTree.parse(path).getroot()
+    except FileNotFoundError:
+        raise error_type(f"{path}: no such {what} file") from None
+    except ElementTree.ParseError as error:
+        raise error_type(f"{path}: not valid XML ({error})") from None
+
+
 def load_tsai(path: str | Path) -> TsaiCalibration:
     """Read a PETS 2009 Tsai calibration XML (``<Geometry>``, ``<Intrinsic>``, ``<Extrinsic>``)."""
     path = Path(path)
-    try:
-        root = ElementTree.parse(path).getroot()
-    except FileNotFoundError:
-        raise CalibrationError(f"{path}: no such calibration file") from None
-    except ElementTree.ParseError as error:
-        raise CalibrationError(f"{path}: not valid XML ({error})") from None
+    root = read_xml_root(path, CalibrationError, "calibration")
     geometry = _attributes(root, "Geometry", ("width", "height", "dy", "dpx"), path)
     intrinsic = _attributes(root, "Intrinsic", ("focal", "kappa1", "cx", "cy", "sx"), path)
     extrinsic = _attributes(root, "Extrinsic", ("tx", "ty", "tz", "rx", "ry", "rz"), path)

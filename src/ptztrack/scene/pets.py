@@ -10,9 +10,9 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import cv2
-import defusedxml.ElementTree as ElementTree
 import numpy as np
 
+from ptztrack.geometry.calibration import read_xml_root
 from ptztrack.scene.synthetic import GroundTruth
 
 MOT_COLUMNS = 10
@@ -79,12 +79,7 @@ def load_mot_ground_truth(path: str | Path) -> Annotations:
 def load_cvml(path: str | Path) -> Annotations:
     """Read CVML XML boxes (``<frame number><objectlist><object id><box h w xc yc>``)."""
     path = Path(path)
-    try:
-        root = ElementTree.parse(path).getroot()
-    except FileNotFoundError:
-        raise DatasetError(f"{path}: no such annotation file") from None
-    except ElementTree.ParseError as error:
-        raise DatasetError(f"{path}: not valid XML ({error})") from None
+    root = read_xml_root(path, DatasetError, "annotation")
     rows = []
     for frame in root.iter("frame"):
         for person in frame.iter("object"):
