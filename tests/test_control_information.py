@@ -58,6 +58,9 @@ def test_bivariate_cdf_special_values():
     assert bivariate_normal_cdf(0.0, 0.0, 0.5) == pytest.approx(0.25 + np.arcsin(0.5) / (2 * np.pi))
     assert bivariate_normal_cdf(20.0, 0.3, 0.7) == pytest.approx(0.6179114222)
     assert bivariate_normal_cdf(-20.0, 0.3, 0.7) == 0.0
+    # a product of the two arguments would underflow to -0.0 here and lose the sign
+    assert bivariate_normal_cdf(0.0, -6e-49, 0.0) == pytest.approx(0.25)
+    assert bivariate_normal_cdf(-6e-49, 0.0, 0.3) == pytest.approx(0.25 + np.arcsin(0.3) / (2 * np.pi))
 
 
 def alpha_monte_carlo(pose, mean_m, cov_m2, detector, rng, samples=400_000):

@@ -60,7 +60,8 @@ def bivariate_normal_cdf_scalar(h, k, rho):
     root = math.sqrt(max(1.0 - rho * rho, 1e-300))
     a_h = (k - rho * h) / (h * root)
     a_k = (h - rho * k) / (k * root)
-    beta = 0.5 if h * k < 0 else 0.0
+    # Opposite signs; the product h * k could underflow to -0.0 and hide them.
+    beta = 0.5 if (h < 0.0) != (k < 0.0) else 0.0
     value = 0.5 * _ndtr(h) + 0.5 * _ndtr(k) - _owens_t(h, a_h) - _owens_t(k, a_k) - beta
     return min(max(value, 0.0), 1.0)
 
