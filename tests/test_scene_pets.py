@@ -88,35 +88,28 @@ def test_video_frames_are_read_and_checked():
 
 
 @pytest.mark.parametrize(
-    "text, message",
+    "loader, name, text, message",
     [
-        ("1,2,3\n", "line 1 has 3 fields, expected 10"),
-        ("1,9,499,158,31,75,1,x,-7.3,0\n", "line 1 has a field that is not a number"),
-        ("0,9,499,158,31,75,1,-4.1,-7.3,0\n", "frames are numbered from 1"),
-        ("", "no ground-truth rows"),
+        (load_mot_ground_truth, "gt.txt", "1,2,3\n", "line 1 has 3 fields, expected 10"),
+        (load_mot_ground_truth, "gt.txt", "1,9,499,158,31,75,1,x,-7.3,0\n", "line 1 has a field that is not a number"),
+        (load_mot_ground_truth, "gt.txt", "0,9,499,158,31,75,1,-4.1,-7.3,0\n", "frames are numbered from 1"),
+        (load_mot_ground_truth, "gt.txt", "", "no ground-truth rows"),
+        (load_cvml, "gt.xml", "<dataset><frame number='0'><objectlist>", "not valid XML"),
+        (
+            load_cvml,
+            "gt.xml",
+            "<dataset><frame number='0'><objectlist><object id='3'/></objectlist></frame></dataset>",
+            "frame '0' object '3'",
+        ),
+        (load_cvml, "gt.xml", "<dataset></dataset>", "no annotated objects"),
     ],
 )
-def test_malformed_mot_files_are_named_with_the_problem(tmp_path, text, message):
-    path = tmp_path / "gt.txt"
+def test_malformed_annotation_files_are_named_with_the_problem(tmp_path, loader, name, text, message):
+    path = tmp_path / name
     path.write_text(text)
     with pytest.raises(DatasetError, match=message) as error:
-        load_mot_ground_truth(path)
+        loader(path)
     assert str(path) in str(error.value)
-
-
-@pytest.mark.parametrize(
-    "text, message",
-    [
-        ("<dataset><frame number='0'><objectlist>", "not valid XML"),
-        ("<dataset><frame number='0'><objectlist><object id='3'/></objectlist></frame></dataset>", "frame '0' object '3'"),
-        ("<dataset></dataset>", "no annotated objects"),
-    ],
-)
-def test_malformed_cvml_files_are_named_with_the_problem(tmp_path, text, message):
-    path = tmp_path / "gt.xml"
-    path.write_text(text)
-    with pytest.raises(DatasetError, match=message):
-        load_cvml(path)
 
 
 def test_malformed_calibrations_are_named_with_the_problem(tmp_path):
