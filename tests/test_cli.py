@@ -2,6 +2,9 @@ import csv
 import json
 import subprocess
 import sys
+from pathlib import Path
+
+import pytest
 
 from ptztrack.cli import main
 
@@ -56,3 +59,39 @@ def test_an_output_path_that_cannot_be_a_directory_exits_2_naming_it(tmp_path, c
     assert main(["run", "--frames", "3", "--out", str(blocker / "out")]) == 2
     assert f"{blocker / 'out'}: Not a directory" in capsys.readouterr().err
     assert blocker.read_text() == "keep me"
+
+
+EXCERPT = Path(__file__).parent / "data" / "pets_s2l1_excerpt"
+
+
+def test_pets_runs_on_recording_files_given_on_the_command_line_either_calibration_format(tmp_path, capsys):
+    files = ["--video", str(EXCERPT / "View_001.avi"), "--gt", str(EXCERPT / "gt_mot15.txt")]
+    results = {}
+    for calibration in ("pinhole.json", "View_001.xml"):
+        out = tmp_path / calibration
+        arguments = ["run", "--scenario", "pets", "--policy", "fix", "--frames", "10", "--out", str(out)]
+        assert main(arguments + files + ["--calibration", str(EXCERPT / calibration)]) == 0
+        results[calibration] = json.loads((out / "metrics.json").read_text())
+    # The two calibrations of the same camera track the same people equally well.
+    assert results["pinhole.json"]["detections"] == results["View_001.xml"]["detections"] > 0
+    assert abs(results["pinhole.json"]["mota"] - results["View_001.xml"]["mota"]) < 0.05
+
+
+@pytest.mark.parametrize(
+    "option, name, problem",
+    [
+        ("--gt", "missing.txt", "no such ground-truth file"),
+        ("--calibration", "calibration.json", "not valid JSON"),
+        ("--video", "short.avi", "the video ends before frame"),
+    ],
+)
+def test_a_bad_recording_file_exits_2_naming_the_file_and_the_problem(tmp_path, capsys, option, name, problem):
+    path = tmp_path / name
+    if name == "calibration.json":
+        path.write_text("{not json")
+    if name == "short.avi":
+        path.write_bytes((EXCERPT / "View_001.avi").read_bytes())
+    arguments = ["run", "--scenario", "pets", "--policy", "fix", "--detector", "hog", "--frames", "40"]
+    assert main(arguments + [option, str(path)]) == 2
+    error = capsys.readouterr().err
+    assert str(path) in error and problem in error

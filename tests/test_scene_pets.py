@@ -5,8 +5,10 @@ import pytest
 
 from ptztrack.geometry.calibration import (
     CalibrationError,
+    load_calibration,
     load_pinhole,
     load_tsai,
+    pinhole_from_tsai,
     project_pinhole,
     project_tsai,
 )
@@ -38,6 +40,22 @@ def test_the_two_calibrations_agree_with_each_other():
     tsai = project_tsai(load_tsai(EXCERPT / "View_001.xml"), points_mm)
     pinhole = project_pinhole(load_pinhole(EXCERPT / "pinhole.json"), points_mm)
     assert np.median(np.linalg.norm(tsai - pinhole, axis=1)) < 3.0
+
+
+def test_a_tsai_calibration_becomes_a_pinhole_camera_that_projects_the_same_over_the_whole_image():
+    tsai = load_tsai(EXCERPT / "View_001.xml")
+    pinhole = load_calibration(EXCERPT / "View_001.xml")
+    width, height = tsai.image_size_px
+    # Ground points behind every pixel: project a wide grid and keep those that land in the image.
+    x_mm, y_mm = np.meshgrid(np.linspace(-30000, 30000, 121), np.linspace(-30000, 30000, 121))
+    points_mm = np.stack([x_mm.ravel(), y_mm.ravel(), np.zeros(x_mm.size)], axis=-1)
+    camera_z_mm = points_mm @ tsai.rotation[2] + tsai.translation_mm[2]
+    expected_px = project_tsai(tsai, points_mm[camera_z_mm > 0])
+    inside = np.all((expected_px >= 0) & (expected_px <= [width, height]), axis=1)
+    assert inside.sum() > 1000
+    converted_px = project_pinhole(pinhole, points_mm[camera_z_mm > 0][inside])
+    assert np.abs(converted_px - expected_px[inside]).max() < 0.01
+    np.testing.assert_array_equal(pinhole_from_tsai(tsai).dist[2:4], 0.0)
 
 
 def test_tsai_without_distortion_is_a_pinhole_projection():

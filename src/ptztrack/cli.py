@@ -8,7 +8,7 @@ from pathlib import Path
 import json
 
 from ptztrack.config import Scenario, ScenarioError, load_scenario, pets_scenario, scenario_from_dict
-from ptztrack.episode import POLICIES, run_episode
+from ptztrack.episode import POLICIES, episode_world, run_episode
 from ptztrack.evaluate.experiment import (
     EXECUTORS,
     STRATEGIES,
@@ -21,13 +21,21 @@ from ptztrack.evaluate.experiment import (
 )
 from ptztrack.evaluate.metrics import DISPLAY, episode_metrics
 from ptztrack.evaluate.report import write_atomically, write_outputs
+from ptztrack.geometry.calibration import CalibrationError
+from ptztrack.scene.pets import DatasetError
+from ptztrack.evaluate.video import view_renderer
 
 RUN_FIGURES = ("mota", "motp_m", "idf1", "height_px", "detections", "zoom", "switches")
 
 
-def build_scenario(name_or_path: str, detector: str | None = None, frames: int | None = None) -> Scenario:
-    """The built-in synthetic scene or a YAML file, with command-line overrides applied."""
-    overrides = {}
+def build_scenario(
+    name_or_path: str, detector: str | None = None, frames: int | None = None, recording_paths: dict | None = None
+) -> Scenario:
+    """The built-in synthetic or PETS scene or a YAML file, with command-line overrides applied.
+
+    recording_paths : {'video' | 'calibration' | 'ground_truth': path} replacing the recording's files.
+    """
+    overrides = {f"recording.{key}": str(path) for key, path in (recording_paths or {}).items() if path is not None}
     if detector is not None:
         overrides["detector.kind"] = detector
     if frames is not None:
@@ -39,13 +47,17 @@ def build_scenario(name_or_path: str, detector: str | None = None, frames: int |
     return load_scenario(name_or_path, **overrides)
 
 
+def recording_paths(args: argparse.Namespace) -> dict:
+    return {"video": args.video, "calibration": args.calibration, "ground_truth": args.gt}
+
+
 def format_metrics(metrics: dict) -> str:
     width = max(len(DISPLAY[key][0]) for key in RUN_FIGURES)
     return "\n".join(f"{DISPLAY[key][0]:<{width}}  {DISPLAY[key][1].format(metrics[key])}" for key in RUN_FIGURES)
 
 
 def run_command(args: argparse.Namespace) -> int:
-    scenario = build_scenario(args.scenario, args.detector, args.frames)
+    scenario = build_scenario(args.scenario, args.detector, args.frames, recording_paths(args))
     episode = run_episode(scenario, args.policy, args.seed)
     metrics = episode_metrics(episode)
     print(
@@ -55,18 +67,20 @@ def run_command(args: argparse.Namespace) -> int:
     print(format_metrics(metrics))
     if args.out is not None:
         title = f"{args.policy}, {scenario.detector.kind} detector, seed {args.seed}: MOTA {metrics['mota']:.1%}"
-        write_outputs(args.out, episode, metrics, title)
-        print(f"wrote {args.out / 'metrics.json'}, {args.out / 'tracks.csv'}, {args.out / 'episode.png'}")
+        # The video draws the episode's world, rebuilt from the seed: the run's own is not kept.
+        write_outputs(args.out, episode, metrics, title, view_renderer(scenario, episode_world(scenario, args.seed)))
+        names = ("metrics.json", "tracks.csv", "episode.png", "episode.mp4")
+        print(f"wrote {', '.join(str(args.out / name) for name in names)}")
     return 0
 
 
 def experiment_command(args: argparse.Namespace) -> int:
     if args.name == "pets":
-        scenario = pets_scenario(args.detector or "ideal", **({"frames": args.frames} if args.frames else {}))
+        scenario = build_scenario("pets", args.detector or "ideal", args.frames, recording_paths(args))
         cells = recording_cells(scenario, args.beta or [9.0, 1.0], args.strategies)
         title = f"PETS 2009 S2.L1 View_001, {scenario.detector.kind} detector, every 2nd frame"
     else:
-        scenario = build_scenario(args.scenario, args.detector or "realistic", args.frames)
+        scenario = build_scenario(args.scenario, args.detector or "realistic", args.frames, recording_paths(args))
         cells = synthetic_cells(scenario, args.sequences, args.strategies)
         title = (
             f"{args.scenario} scene, {scenario.detector.kind} detector, beta {scenario.control.beta:g}, "
@@ -90,7 +104,8 @@ def parser() -> argparse.ArgumentParser:
     run.add_argument("--detector", choices=("ideal", "realistic", "hog"), help="overrides the scenario's detector")
     run.add_argument("--seed", type=int, default=0)
     run.add_argument("--frames", type=_positive_int, help="overrides the scenario's number of frames")
-    run.add_argument("--out", type=Path, help="directory for metrics.json, tracks.csv and episode.png")
+    run.add_argument("--out", type=Path, help="directory for metrics.json, tracks.csv, episode.png and episode.mp4")
+    _add_recording_arguments(run)
     run.set_defaults(handler=run_command)
 
     experiment = commands.add_parser("experiment", help="run one of the paper's experiments and print its table")
@@ -112,8 +127,17 @@ def parser() -> argparse.ArgumentParser:
     experiment.add_argument("--executor", choices=EXECUTORS, default="local")
     experiment.add_argument("--workers", type=_positive_int, help="processes of the local executor (default: all cores)")
     experiment.add_argument("--json", type=Path, help="write one row per strategy here")
+    _add_recording_arguments(experiment)
     experiment.set_defaults(handler=experiment_command)
     return root
+
+
+def _add_recording_arguments(command: argparse.ArgumentParser) -> None:
+    """Files of a recording that replace the scenario's (the built-in PETS ones with ``pets``)."""
+    recording = command.add_argument_group("recording files (replace the scenario's)")
+    recording.add_argument("--video", type=Path, help="the recorded video")
+    recording.add_argument("--calibration", type=Path, help="pinhole JSON or Tsai XML calibration of the recording")
+    recording.add_argument("--gt", type=Path, help="MOTChallenge ground truth with world positions in metres")
 
 
 def _positive_int(text: str) -> int:
@@ -127,7 +151,7 @@ def main(argv: list[str] | None = None) -> int:
     args = parser().parse_args(argv)
     try:
         return args.handler(args)
-    except (ScenarioError, RuntimeError) as error:
+    except (ScenarioError, CalibrationError, DatasetError, RuntimeError) as error:
         print(f"ptztrack: error: {error}", file=sys.stderr)
         return 2
     except BrokenPipeError:

@@ -97,6 +97,45 @@ def project_pinhole(calibration: PinholeCalibration, points_mm) -> np.ndarray:
     return pixels[:, 0, :]
 
 
+def pinhole_from_tsai(calibration: TsaiCalibration) -> PinholeCalibration:
+    """The pinhole camera with OpenCV distortion that projects like a Tsai camera.
+
+    Tsai scales the undistorted sensor point by ``s(r) = r_d / r_u``, the
+    same factor in x and y, so OpenCV's radial polynomial
+    ``1 + k1 r^2 + k2 r^4 + k3 r^6`` of the normalised undistorted radius
+    ``r = r_u / f`` can represent it; the three coefficients are fitted by
+    linear least squares out to the image corners (tangential terms zero).
+    """
+    K = np.array(
+        [
+            [calibration.focal_mm * calibration.sx / calibration.dpx_mm, 0.0, calibration.centre_px[0]],
+            [0.0, calibration.focal_mm / calibration.dy_mm, calibration.centre_px[1]],
+            [0.0, 0.0, 1.0],
+        ]
+    )
+    width, height = calibration.image_size_px
+    corners_px = np.array([[0, 0], [width, 0], [0, height], [width, height]], dtype=float) - calibration.centre_px
+    corner_radius_d_mm = np.hypot(corners_px[:, 0] * calibration.dpx_mm / calibration.sx, corners_px[:, 1] * calibration.dy_mm)
+    radius_d_mm = np.linspace(0.0, corner_radius_d_mm.max(), 200)[1:]
+    radius_u_mm = radius_d_mm * (1 + calibration.kappa1 * radius_d_mm**2)
+    normalised_radius = radius_u_mm / calibration.focal_mm
+    powers = np.stack([normalised_radius**2, normalised_radius**4, normalised_radius**6], axis=-1)
+    (k1, k2, k3), *_ = np.linalg.lstsq(powers, radius_d_mm / radius_u_mm - 1.0, rcond=None)
+    return PinholeCalibration(
+        K=K,
+        dist=np.array([k1, k2, 0.0, 0.0, k3]),
+        R=calibration.rotation,
+        t=np.asarray(calibration.translation_mm, dtype=float),
+    )
+
+
+def load_calibration(path: str | Path, view: str = "View_001") -> PinholeCalibration:
+    """A recording's calibration as a pinhole camera: a Tsai XML (``.xml``) or one view of a pinhole JSON."""
+    if Path(path).suffix.lower() == ".xml":
+        return pinhole_from_tsai(load_tsai(path))
+    return load_pinhole(path, view)
+
+
 def _attributes(root, tag: str, names: tuple[str, ...], path: Path) -> dict[str, float]:
     element = root.find(tag)
     if element is None:
