@@ -25,7 +25,7 @@ from ptztrack.geometry.ptz import (
     project_people,
 )
 from ptztrack.track import kalman
-from ptztrack.track.tracker import Tracks
+from ptztrack.track.tracker import Tracks, no_tracks
 
 SCENARIO = Scenario()
 
@@ -142,6 +142,7 @@ def single_track(mean_xy, sigma_m):
         mean=np.array([[*mean_xy, 0.0, 0.0]]),
         covariance=np.diag([sigma_m**2, sigma_m**2, 0.1, 0.1])[None],
         missed_steps=np.array([0]),
+        hits=np.array([1]),
         next_id=1,
     )
 
@@ -235,7 +236,7 @@ def test_patrolling_term_grows_while_unobserved_and_clears_where_the_camera_look
 
 
 def test_without_tracks_the_patrolling_term_moves_the_camera_and_without_it_the_camera_stays():
-    empty = Tracks(np.zeros(0, int), np.zeros((0, 4)), np.zeros((0, 4, 4)), np.zeros(0, int))
+    empty = no_tracks()
     start = int(GRID.index(3, 4, 1))
     context = DecisionContext(0, start, GRID.reachable(start), empty, np.random.default_rng(0))
     assert policy_for("intg", scenario_from_dict({"control": {"beta": 0.0}})).choose(context) == start

@@ -91,3 +91,18 @@ def test_a_track_is_deleted_when_its_uncertainty_grows_too_large():
         assert alive < 100
     # position sd 0.9 m/s * t (initial velocity spread) passes 1 m between 1.0 s and 1.2 s
     assert alive in (5, 6)
+
+
+def test_with_confirmation_a_one_off_detection_is_never_reported_and_dies_at_its_first_miss():
+    F, U = constant_velocity_model(0.2, CONFIG.acceleration_sigma_m_s2)
+    config = Tracker(confirmation_hits=2)
+    person, false_positive = [7.5, 6.0], [10.0, 9.0]
+    tracks = update_tracks(no_tracks(), feet_px([person, false_positive]), CAMERA, POSE, V, config)
+    assert len(tracks) == 2 and len(tracks.confirmed(config)) == 0
+    tracks = update_tracks(predict_tracks(tracks, F, U), feet_px([person]), CAMERA, POSE, V, config)
+    np.testing.assert_array_equal(tracks.ids, [0])
+    np.testing.assert_array_equal(tracks.hits, [2])
+    np.testing.assert_array_equal(tracks.confirmed(config).ids, [0])
+    # Once confirmed, a track survives misses as before.
+    tracks = update_tracks(predict_tracks(tracks, F, U), np.zeros((0, 2)), CAMERA, POSE, V, config)
+    np.testing.assert_array_equal(tracks.confirmed(config).ids, [0])

@@ -42,6 +42,7 @@ class Tracks:
     mean : (n, 4) states [x_m, y_m, vx_m_s, vy_m_s].
     covariance : (n, 4, 4).
     missed_steps : (n,) consecutive steps without an associated detection.
+    hits : (n,) steps with an associated detection, the one that started the track included.
     next_id : the id the next new track gets.
     """
 
@@ -49,6 +50,7 @@ class Tracks:
     mean: np.ndarray
     covariance: np.ndarray
     missed_steps: np.ndarray
+    hits: np.ndarray
     next_id: int = 0
 
     def __len__(self) -> int:
@@ -61,7 +63,12 @@ class Tracks:
             mean=self.mean[keep],
             covariance=self.covariance[keep],
             missed_steps=self.missed_steps[keep],
+            hits=self.hits[keep],
         )
+
+    def confirmed(self, config: Tracker) -> "Tracks":
+        """The tracks the tracker reports: those detected at least ``config.confirmation_hits`` times."""
+        return self.select(self.hits >= config.confirmation_hits)
 
     @property
     def position_sigma_m(self) -> np.ndarray:
@@ -70,7 +77,9 @@ class Tracks:
 
 
 def no_tracks() -> Tracks:
-    return Tracks(np.zeros(0, dtype=int), np.zeros((0, 4)), np.zeros((0, 4, 4)), np.zeros(0, dtype=int))
+    return Tracks(
+        np.zeros(0, dtype=int), np.zeros((0, 4)), np.zeros((0, 4, 4)), np.zeros(0, dtype=int), np.zeros(0, dtype=int)
+    )
 
 
 def observation_matrix(camera: PTZCamera, pose, mean) -> np.ndarray:
@@ -137,6 +146,7 @@ def start_tracks(feet_px, camera: PTZCamera, pose, V, config: Tracker, first_id:
         mean=np.concatenate([ground_xy, np.zeros((count, 2))], axis=-1),
         covariance=covariance,
         missed_steps=np.zeros(count, dtype=int),
+        hits=np.ones(count, dtype=int),
         next_id=first_id + count,
     )
 
@@ -149,7 +159,9 @@ def update_tracks(tracks: Tracks, feet_px, camera: PTZCamera, pose, V, config: T
     camera that looks elsewhere has not missed anybody. A track is deleted
     after more than ``max_missed_steps`` missed steps, or when its position
     standard deviation exceeds ``max_position_sigma_m`` (which is what ends
-    a track the camera no longer looks at).
+    a track the camera no longer looks at). A track not yet confirmed (fewer
+    than ``confirmation_hits`` hits) is deleted at its first missed step:
+    a detector's false positive rarely repeats at the same ground point.
     """
     feet_px = np.asarray(feet_px, dtype=float).reshape(-1, 2)
     predicted_px, in_front = predicted_feet_px(camera, pose, tracks.mean)
@@ -166,9 +178,12 @@ def update_tracks(tracks: Tracks, feet_px, camera: PTZCamera, pose, V, config: T
     )
     missed = tracks.missed_steps + (in_front & inside_image(camera, predicted_px))
     missed[track_index] = 0
-    updated = replace(tracks, mean=mean, covariance=covariance, missed_steps=missed)
+    hits = tracks.hits.copy()
+    hits[track_index] += 1
+    updated = replace(tracks, mean=mean, covariance=covariance, missed_steps=missed, hits=hits)
+    allowed_missed_steps = np.where(hits >= config.confirmation_hits, config.max_missed_steps, 0)
     survivors = updated.select(
-        (updated.missed_steps <= config.max_missed_steps) & (updated.position_sigma_m <= config.max_position_sigma_m)
+        (updated.missed_steps <= allowed_missed_steps) & (updated.position_sigma_m <= config.max_position_sigma_m)
     )
     unmatched = np.setdiff1d(np.arange(len(feet_px)), detection_index)
     born = start_tracks(feet_px[unmatched], camera, pose, V, config, tracks.next_id)
@@ -177,5 +192,6 @@ def update_tracks(tracks: Tracks, feet_px, camera: PTZCamera, pose, V, config: T
         mean=np.concatenate([survivors.mean, born.mean]),
         covariance=np.concatenate([survivors.covariance, born.covariance]),
         missed_steps=np.concatenate([survivors.missed_steps, born.missed_steps]),
+        hits=np.concatenate([survivors.hits, born.hits]),
         next_id=born.next_id,
     )
