@@ -24,7 +24,7 @@ from ptztrack.control.exploration import exploration_map
 from ptztrack.control.information_policy import InformationGainPolicy
 from ptztrack.control.policy import DecisionContext, Policy
 from ptztrack.detect.simulated import Detections
-from ptztrack.geometry.calibration import load_pinhole
+from ptztrack.geometry.calibration import load_calibration
 from ptztrack.geometry.ptz import PTZCamera
 from ptztrack.detect.hog import HogPeopleDetector
 from ptztrack.scene.pets import RecordedVideo, load_mot_ground_truth, recorded_scene
@@ -66,7 +66,7 @@ def build_world(scenario: Scenario, scene_rng: np.random.Generator) -> World:
         return World(camera, grid, truth, SimulatedPTZ(camera, truth, scenario.detector), scenario.area_bounds_m)
     recording = scenario.recording
     virtual, whole_frame_pose = virtual_ptz(
-        load_pinhole(recording.calibration, recording.view), recording.recorded_size_px, scenario.camera.image_size_px
+        load_calibration(recording.calibration, recording.view), recording.recorded_size_px, scenario.camera.image_size_px
     )
     offsets = scenario.action_grid()
     grid = ActionGrid(
@@ -99,7 +99,7 @@ class Episode:
     camera : the PTZ camera that looked; area_bounds_m : [[x0, y0], [x1, y1]] where people can be.
     actions : (T,) flat action index taken at each step.
     poses : (T, 3) those actions as (pan_deg, tilt_deg, zoom).
-    tracks : per step, the tracks after that step's update.
+    tracks : per step, the tracks reported after that step's update (the confirmed ones).
     detections : per step, what the detector reported.
     """
 
@@ -145,10 +145,21 @@ def make_policy(name: str, scenario: Scenario, world: World) -> Policy:
     raise ValueError(f"unknown policy {name!r}; expected one of {', '.join(POLICIES)}")
 
 
+def _episode_seeds(seed: int) -> list[np.random.SeedSequence]:
+    """The independent streams of an episode: scene, detector, policy."""
+    return np.random.SeedSequence(seed).spawn(3)
+
+
+def episode_world(scenario: Scenario, seed: int) -> World:
+    """The world that ``run_episode(scenario, any_policy, seed)`` runs in, built again: the same people."""
+    scene_seed = _episode_seeds(seed)[0]
+    return build_world(scenario, np.random.default_rng(scene_seed))
+
+
 def run_episode(scenario: Scenario, policy_name: str, seed: int) -> Episode:
     """Run one closed-loop episode of the scenario: at most ``scenario.frames`` steps."""
-    scene_seed, detector_seed, policy_seed = np.random.SeedSequence(seed).spawn(3)
-    world = build_world(scenario, np.random.default_rng(scene_seed))
+    world = episode_world(scenario, seed)
+    _, detector_seed, policy_seed = _episode_seeds(seed)
     steps = world.truth.positions_m.shape[0]
     policy = make_policy(policy_name, scenario, world)
     frame_seeds = detector_seed.spawn(steps)
@@ -167,7 +178,7 @@ def run_episode(scenario: Scenario, policy_name: str, seed: int) -> Episode:
         detections = world.backend.observe(step, pose, np.random.default_rng(frame_seeds[step]))
         tracks = update_tracks(tracks, detections.feet_px, world.camera, pose, V, scenario.tracker)
         actions.append(action)
-        track_history.append(tracks)
+        track_history.append(tracks.confirmed(scenario.tracker))
         detection_history.append(detections)
     actions = np.asarray(actions)
     return Episode(

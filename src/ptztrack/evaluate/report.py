@@ -1,4 +1,4 @@
-"""What a run leaves behind: metrics.json, tracks.csv and episode.png, each written atomically."""
+"""What a run leaves behind: metrics.json, tracks.csv, episode.png and episode.mp4, each written atomically."""
 
 import csv
 import io
@@ -13,6 +13,7 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Rectangle
 
 from ptztrack.episode import Episode
+from ptztrack.evaluate.video import RenderView, write_episode_video
 from ptztrack.geometry.ptz import ground_footprint
 
 TRACK_COLUMNS = ("frame", "id", "x_m", "y_m", "vx_m_s", "vy_m_s", "var_x_m2", "cov_xy_m2", "var_y_m2")
@@ -86,8 +87,11 @@ def episode_figure(episode: Episode, title: str = "") -> Figure:
     return figure
 
 
-def write_outputs(directory: Path, episode: Episode, metrics: dict, title: str = "") -> None:
-    """Write metrics.json, tracks.csv and episode.png into ``directory`` (created if needed)."""
+def write_outputs(
+    directory: Path, episode: Episode, metrics: dict, title: str = "", render_view: RenderView | None = None
+) -> None:
+    """Write metrics.json, tracks.csv and episode.png into ``directory`` (created if needed),
+    and with ``render_view`` (see :mod:`ptztrack.evaluate.video`) episode.mp4, captioned with ``title``."""
     directory = Path(directory)
     directory.mkdir(parents=True, exist_ok=True)
     write_atomically(directory / "metrics.json", metrics_json(metrics))
@@ -96,3 +100,5 @@ def write_outputs(directory: Path, episode: Episode, metrics: dict, title: str =
     png = io.BytesIO()
     figure.savefig(png, format="png", dpi=110, metadata={"Software": None})
     write_atomically(directory / "episode.png", png.getvalue())
+    if render_view is not None:
+        write_episode_video(directory / "episode.mp4", episode, render_view, title)
