@@ -1,0 +1,100 @@
+"""The MSG's auxiliary data against the traversal reference, under random growth, labelling and untangling."""
+
+import networkx as nx
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from ptztrack.control import msg
+from ptztrack.control.msg_traversal import traversal_data
+
+# Weighted so that labels often come after joins and splits: untangling through compound vertices.
+OPERATIONS = ("enter", "enter", "extend", "join", "join", "split", "split", "blind_gap", "exit", "label", "label", "label")
+
+
+def total_length(graph):
+    return sum(node["count"] * node["length"] for _, node in graph.nodes(data=True))
+
+
+class Scene:
+    """Targets moving through the events a tracker reports, building an MSG as the tracker layer does."""
+
+    def __init__(self, untangling=True):
+        self.graph = msg.new_graph()
+        self.active = {}  # vertex -> the targets it holds
+        self.next_target = 0
+        self.step = 0
+        self.untangling = untangling
+
+    def start(self, events):
+        created = msg.add_tracklets(self.graph, events, self.step)
+        for (targets, parents), v in zip(events, created):
+            for p in parents:
+                self.active.pop(p, None)
+            self.active[v] = frozenset(targets)
+            msg.extend(self.graph, v, self.step)
+
+    def apply(self, operation, draw):
+        self.step += 1
+        active = sorted(self.active)
+        if operation == "enter" or not active:
+            self.start([(frozenset({self.next_target}), [])])
+            self.next_target += 1
+        elif operation == "extend":
+            msg.extend(self.graph, draw(st.sampled_from(active)), self.step, draw(st.integers(1, 5)))
+        elif operation == "join" and len(active) >= 2:
+            a, b = draw(st.lists(st.sampled_from(active), min_size=2, max_size=2, unique=True))
+            self.start([(self.active[a] | self.active[b], [a, b])])
+        elif operation == "split":
+            compounds = [v for v in active if len(self.active[v]) > 1]
+            if compounds:
+                v = draw(st.sampled_from(compounds))
+                targets = sorted(self.active[v])
+                cut = draw(st.integers(1, len(targets) - 1))
+                self.start([(frozenset(targets[:cut]), [v]), (frozenset(targets[cut:]), [v])])
+        elif operation == "blind_gap" and len(active) >= 2:
+            lost = draw(st.lists(st.sampled_from(active), min_size=2, max_size=4, unique=True))
+            # Every unit seen again gets an edge from each lost tracklet (the truth among them).
+            self.start([(self.active[v], lost) for v in lost])
+        elif operation == "exit":
+            v = draw(st.sampled_from(active))
+            del self.active[v]
+            self.graph.nodes[v]["active"] = False
+        elif operation == "label":
+            solos = [v for v in active if len(self.active[v]) == 1 and not self.graph.nodes[v]["labeled"]]
+            if solos:
+                v = draw(st.sampled_from(solos))
+                msg.refresh(self.graph, v)
+                merged_into = msg.label(self.graph, v, self.untangling)
+                self.active = {merged_into.get(u, u): targets for u, targets in self.active.items()}
+
+    def check_against_traversal(self):
+        for v in self.active:
+            msg.refresh(self.graph, v)
+        for v in self.graph:
+            expected = traversal_data(self.graph, v)
+            stored = {field: self.graph.nodes[v][field] for field in msg.AUX_FIELDS}
+            assert stored == {field: expected[field] for field in msg.AUX_FIELDS}, (v, stored, expected)
+
+
+@settings(max_examples=1000, deadline=None)
+@given(st.data())
+def test_auxiliary_data_equals_traversal_through_growth_labelling_and_untangling(data):
+    scene = Scene(untangling=data.draw(st.booleans()))
+    for _ in range(data.draw(st.integers(1, 40))):
+        before, had_active = total_length(scene.graph), bool(scene.active)
+        operation = data.draw(st.sampled_from(OPERATIONS))
+        scene.apply(operation, data.draw)
+        if operation == "label" and had_active:
+            assert total_length(scene.graph) == before
+        assert nx.is_directed_acyclic_graph(scene.graph)
+        scene.check_against_traversal()
+    for v, node in scene.graph.nodes(data=True):
+        assert node["count"] == len(node["targets"])
+        if node["labeled"]:
+            assert node["count"] == 1
+        # No true association is lost: every target of a tracklet came from one of its parents, unless it entered there.
+        parents = scene.graph.pred[v]
+        if parents:
+            assert node["targets"] <= frozenset().union(*(scene.graph.nodes[p]["targets"] for p in parents))
+        else:
+            assert node["count"] == 1
