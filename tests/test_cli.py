@@ -95,3 +95,16 @@ def test_a_bad_recording_file_exits_2_naming_the_file_and_the_problem(tmp_path, 
     assert main(arguments + [option, str(path)]) == 2
     error = capsys.readouterr().err
     assert str(path) in error and problem in error
+
+
+def test_msg_experiment_prints_the_table_and_writes_rows_plot_and_trails(tmp_path, capsys):
+    paths = {name: tmp_path / name for name in ("rows.json", "figure7.png", "trails.png")}
+    arguments = ["experiment", "msg", "--runs", "3", "--executor", "serial"]
+    arguments += ["--json", str(paths["rows.json"]), "--plot", str(paths["figure7.png"]), "--trails", str(paths["trails.png"])]
+    assert main(arguments) == 0
+    assert "N_j/s" in capsys.readouterr().out
+    rows = json.loads(paths["rows.json"].read_text())
+    assert len(rows) == 9 and {row["scheduler"] for row in rows} == {"msg", "msg-no-untangling", "naive"}
+    assert all({"scheduler", "nj_s", "m"} <= set(row) and 0 <= row["m"] <= 1 for row in rows)
+    for name in ("figure7.png", "trails.png"):
+        assert paths[name].read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"

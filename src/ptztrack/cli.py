@@ -1,13 +1,15 @@
 """The ``ptztrack`` command: a thin layer over the Python API."""
 
 import argparse
+import json
 import os
 import sys
 from pathlib import Path
 
-import json
+import numpy as np
 
 from ptztrack.config import Scenario, ScenarioError, load_scenario, pets_scenario, scenario_from_dict
+from ptztrack.control.msg_scheduler import CHOOSERS
 from ptztrack.episode import POLICIES, episode_world, run_episode
 from ptztrack.evaluate.experiment import (
     EXECUTORS,
@@ -20,10 +22,20 @@ from ptztrack.evaluate.experiment import (
     synthetic_cells,
 )
 from ptztrack.evaluate.metrics import DISPLAY, episode_metrics
-from ptztrack.evaluate.report import write_atomically, write_outputs
+from ptztrack.evaluate.msg import (
+    ambiguity_figure,
+    format_ambiguity_table,
+    msg_cells,
+    run_msg,
+    run_msg_cell,
+    summarise_by_ambiguity,
+    trails_figure,
+)
+from ptztrack.evaluate.report import write_atomically, write_figure, write_outputs
+from ptztrack.evaluate.video import view_renderer
 from ptztrack.geometry.calibration import CalibrationError
 from ptztrack.scene.pets import DatasetError
-from ptztrack.evaluate.video import view_renderer
+from ptztrack.scene.roads import walk_roads
 
 RUN_FIGURES = ("mota", "motp_m", "idf1", "height_px", "detections", "zoom", "switches")
 
@@ -74,7 +86,34 @@ def run_command(args: argparse.Namespace) -> int:
     return 0
 
 
+def msg_experiment_command(args: argparse.Namespace) -> int:
+    cells = msg_cells(args.runs)
+    print(f"{len(cells)} simulations x {len(CHOOSERS)} schedulers, {args.executor} executor", file=sys.stderr)
+    rows = [row for rows in run_cells(cells, args.executor, args.workers, print_progress, run_msg_cell) for row in rows]
+    print("Face capture on the MSG: M by N_j/s bin, mean +- standard deviation (runs)")
+    print(format_ambiguity_table(summarise_by_ambiguity(rows)))
+    written = []
+    if args.json is not None:
+        write_atomically(args.json, (json.dumps(rows, indent=2) + "\n").encode())
+        written.append(args.json)
+    if args.plot is not None:
+        write_figure(args.plot, ambiguity_figure(rows))
+        written.append(args.plot)
+    if args.trails is not None:
+        cell = cells[0]
+        scene = walk_roads(cell.scene, np.random.default_rng(cell.seed))
+        run = run_msg(scene, "msg", cell.tracklets, cell.zoom_out_score)
+        title = f"simulation {cell.seed}: {cell.scene.people} walkers, N_j/s {run.nj_s}, msg scheduler, M {run.m:.2f}"
+        write_figure(args.trails, trails_figure(scene, run, title))
+        written.append(args.trails)
+    if written:
+        print(f"wrote {', '.join(str(path) for path in written)}")
+    return 0
+
+
 def experiment_command(args: argparse.Namespace) -> int:
+    if args.name == "msg":
+        return msg_experiment_command(args)
     if args.name == "pets":
         scenario = build_scenario("pets", args.detector or "ideal", args.frames, recording_paths(args))
         cells = recording_cells(scenario, args.beta or [9.0, 1.0], args.strategies)
@@ -110,7 +149,9 @@ def parser() -> argparse.ArgumentParser:
 
     experiment = commands.add_parser("experiment", help="run one of the paper's experiments and print its table")
     experiment.add_argument(
-        "name", choices=("synthetic", "pets"), help="synthetic (the PTZ paper's Tables 1-2) or pets (Tables 3-4)"
+        "name",
+        choices=("synthetic", "pets", "msg"),
+        help="synthetic (the PTZ paper's Tables 1-2), pets (Tables 3-4) or msg (the face-capture paper's Figure 7)",
     )
     experiment.add_argument("--scenario", default="synthetic", help="'synthetic' (built in) or a scenario YAML file")
     experiment.add_argument(
@@ -126,7 +167,10 @@ def parser() -> argparse.ArgumentParser:
     experiment.add_argument("--strategies", nargs="+", choices=STRATEGIES, default=list(STRATEGIES))
     experiment.add_argument("--executor", choices=EXECUTORS, default="local")
     experiment.add_argument("--workers", type=_positive_int, help="processes of the local executor (default: all cores)")
-    experiment.add_argument("--json", type=Path, help="write one row per strategy here")
+    experiment.add_argument("--json", type=Path, help="write one row per strategy (msg: per run and scheduler) here")
+    experiment.add_argument("--runs", type=_positive_int, default=414, help="msg: simulations")
+    experiment.add_argument("--plot", type=Path, help="msg: M against N_j/s per scheduler (PNG)")
+    experiment.add_argument("--trails", type=Path, help="msg: one simulation's trails in (x, y, t) (PNG)")
     _add_recording_arguments(experiment)
     experiment.set_defaults(handler=experiment_command)
     return root

@@ -70,12 +70,14 @@ def run_cell(cell: Cell) -> dict:
 
 
 def run_cells(
-    cells: Sequence[Cell],
+    cells: Sequence,
     executor: str = "local",
     workers: int | None = None,
     progress: Callable[[int, int], None] | None = None,
-) -> list[dict]:
-    """Run every cell and return their rows in cell order.
+    run: Callable = run_cell,
+) -> list:
+    """Run every cell with ``run`` (a module-level function, so that it pickles) and return the results
+    in cell order.
 
     executor : 'local' (a process pool of ``workers``, default all cores),
     'ray' (tasks on the Ray cluster ``ray.init()`` connects to, a local one
@@ -85,19 +87,19 @@ def run_cells(
     if executor not in EXECUTORS:
         raise ValueError(f"unknown executor {executor!r}; expected one of {', '.join(EXECUTORS)}")
     report = progress or (lambda done, total: None)
-    rows: list[dict | None] = [None] * len(cells)
+    rows: list = [None] * len(cells)
     if executor == "serial":
         for index, cell in enumerate(cells):
-            rows[index] = run_cell(cell)
+            rows[index] = run(cell)
             report(index + 1, len(cells))
     elif executor == "local":
         with ProcessPoolExecutor(max_workers=workers or os.cpu_count()) as pool:
-            futures = {pool.submit(run_cell, cell): index for index, cell in enumerate(cells)}
+            futures = {pool.submit(run, cell): index for index, cell in enumerate(cells)}
             for done, future in enumerate(as_completed(futures), start=1):
                 rows[futures[future]] = future.result()
                 report(done, len(cells))
     else:
-        rows = _run_on_ray(cells, report)
+        rows = _run_on_ray(cells, report, run)
     return rows
 
 
@@ -117,7 +119,7 @@ LOOPBACK_RAY_ENVIRONMENT = {
 }
 
 
-def _run_on_ray(cells: Sequence[Cell], report: Callable[[int, int], None]) -> list[dict]:
+def _run_on_ray(cells: Sequence, report: Callable[[int, int], None], run: Callable) -> list:
     """Run on the Ray cluster of ``RAY_ADDRESS`` or of an earlier ``ray.init()``; else start a local one.
 
     A local cluster is kept on the loopback interface only if Ray is first
@@ -138,9 +140,9 @@ def _run_on_ray(cells: Sequence[Cell], report: Callable[[int, int], None]) -> li
             )
         else:
             ray.init(log_to_driver=False)
-    remote_cell = ray.remote(run_cell)
+    remote_cell = ray.remote(run)
     pending = {remote_cell.remote(cell): index for index, cell in enumerate(cells)}
-    rows: list[dict | None] = [None] * len(cells)
+    rows: list = [None] * len(cells)
     remaining = list(pending)
     while remaining:
         finished, remaining = ray.wait(remaining, num_returns=1)

@@ -87,6 +87,13 @@ def episode_figure(episode: Episode, title: str = "") -> Figure:
     return figure
 
 
+def write_figure(path: Path, figure: Figure) -> None:
+    """A Matplotlib figure as a PNG, written atomically and without a timestamp (same data, same bytes)."""
+    png = io.BytesIO()
+    figure.savefig(png, format="png", dpi=110, metadata={"Software": None})
+    write_atomically(Path(path), png.getvalue())
+
+
 def write_outputs(
     directory: Path, episode: Episode, metrics: dict, title: str = "", render_view: RenderView | None = None
 ) -> None:
@@ -96,9 +103,6 @@ def write_outputs(
     directory.mkdir(parents=True, exist_ok=True)
     write_atomically(directory / "metrics.json", metrics_json(metrics))
     write_atomically(directory / "tracks.csv", tracks_csv(episode))
-    figure = episode_figure(episode, title)
-    png = io.BytesIO()
-    figure.savefig(png, format="png", dpi=110, metadata={"Software": None})
-    write_atomically(directory / "episode.png", png.getvalue())
+    write_figure(directory / "episode.png", episode_figure(episode, title))
     if render_view is not None:
         write_episode_video(directory / "episode.mp4", episode, render_view, title)
