@@ -25,7 +25,9 @@ PROBABILITY_FLOOR = 1e-4
 
 
 def recall_curve(height_px, recall_kd: float, recall_r0_px: float) -> np.ndarray:
-    return np.where(height_px >= recall_r0_px, -np.expm1(-recall_kd * (height_px - recall_r0_px)), 0.0)
+    # Below r0 the curve is 0; clipping there keeps expm1 from overflowing for the discarded values.
+    above_r0_px = np.maximum(np.asarray(height_px, dtype=float) - recall_r0_px, 0.0)
+    return np.where(height_px >= recall_r0_px, -np.expm1(-recall_kd * above_r0_px), 0.0)
 
 
 def fit_recall(height_px, detected) -> tuple[float, float]:
