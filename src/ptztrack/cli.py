@@ -41,13 +41,20 @@ RUN_FIGURES = ("mota", "motp_m", "idf1", "height_px", "detections", "zoom", "swi
 
 
 def build_scenario(
-    name_or_path: str, detector: str | None = None, frames: int | None = None, recording_paths: dict | None = None
+    name_or_path: str,
+    detector: str | None = None,
+    frames: int | None = None,
+    recording_paths: dict | None = None,
+    association: str | None = None,
 ) -> Scenario:
     """The built-in synthetic or PETS scene or a YAML file, with command-line overrides applied.
 
     recording_paths : {'video' | 'calibration' | 'ground_truth': path} replacing the recording's files.
+    association : 'hungarian' or 'cjpdaf', replacing ``tracker.association``.
     """
     overrides = {f"recording.{key}": str(path) for key, path in (recording_paths or {}).items() if path is not None}
+    if association is not None:
+        overrides["tracker.association"] = association
     if detector is not None:
         overrides["detector.kind"] = detector
     if frames is not None:
@@ -69,7 +76,7 @@ def format_metrics(metrics: dict) -> str:
 
 
 def run_command(args: argparse.Namespace) -> int:
-    scenario = build_scenario(args.scenario, args.detector, args.frames, recording_paths(args))
+    scenario = build_scenario(args.scenario, args.detector, args.frames, recording_paths(args), args.association)
     episode = run_episode(scenario, args.policy, args.seed)
     metrics = episode_metrics(episode)
     print(
@@ -115,11 +122,15 @@ def experiment_command(args: argparse.Namespace) -> int:
     if args.name == "msg":
         return msg_experiment_command(args)
     if args.name == "pets":
-        scenario = build_scenario("pets", args.detector or "ideal", args.frames, recording_paths(args))
+        scenario = build_scenario(
+            "pets", args.detector or "ideal", args.frames, recording_paths(args), args.association
+        )
         cells = recording_cells(scenario, args.beta or [9.0, 1.0], args.strategies)
         title = f"PETS 2009 S2.L1 View_001, {scenario.detector.kind} detector, every 2nd frame"
     else:
-        scenario = build_scenario(args.scenario, args.detector or "realistic", args.frames, recording_paths(args))
+        scenario = build_scenario(
+            args.scenario, args.detector or "realistic", args.frames, recording_paths(args), args.association
+        )
         cells = synthetic_cells(scenario, args.sequences, args.strategies)
         title = (
             f"{args.scenario} scene, {scenario.detector.kind} detector, beta {scenario.control.beta:g}, "
@@ -143,6 +154,7 @@ def parser() -> argparse.ArgumentParser:
     run.add_argument("--detector", choices=("ideal", "realistic", "hog"), help="overrides the scenario's detector")
     run.add_argument("--seed", type=int, default=0)
     run.add_argument("--frames", type=_positive_int, help="overrides the scenario's number of frames")
+    _add_association_argument(run)
     run.add_argument("--out", type=Path, help="directory for metrics.json, tracks.csv, episode.png and episode.mp4")
     _add_recording_arguments(run)
     run.set_defaults(handler=run_command)
@@ -162,6 +174,7 @@ def parser() -> argparse.ArgumentParser:
     experiment.add_argument(
         "--beta", type=float, action="append", help="pets: a weight of the patrolling term (repeatable; default 9 and 1)"
     )
+    _add_association_argument(experiment)
     experiment.add_argument("--sequences", type=_positive_int, default=12)
     experiment.add_argument("--frames", type=_positive_int, help="overrides the scenario's number of frames")
     experiment.add_argument("--strategies", nargs="+", choices=STRATEGIES, default=list(STRATEGIES))
@@ -174,6 +187,12 @@ def parser() -> argparse.ArgumentParser:
     _add_recording_arguments(experiment)
     experiment.set_defaults(handler=experiment_command)
     return root
+
+
+def _add_association_argument(command: argparse.ArgumentParser) -> None:
+    command.add_argument(
+        "--association", choices=("hungarian", "cjpdaf"), help="overrides the scenario's tracker.association"
+    )
 
 
 def _add_recording_arguments(command: argparse.ArgumentParser) -> None:

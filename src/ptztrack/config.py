@@ -97,12 +97,32 @@ class Detector(_Strict):
 
 
 class Tracker(_Strict):
+    """The ground-plane EKF tracker and its data association.
+
+    association : 'hungarian' (one detection per track, assigned on the
+    Mahalanobis distance) or 'cjpdaf' (Fitzgerald's Cheap JPDAF, equation 6
+    of Lisanti et al.: every track is updated with all detections in its
+    gate, weighted by association probabilities; :mod:`ptztrack.track.jpdaf`).
+    clutter_density_per_px2 : the CJPDAF's constant C, which competes with
+    the detections' Gaussian likelihoods p (1/px^2): with one track and one
+    detection, beta = p / (p + C). It is the parametric PDA's
+    lambda (1 - P_D P_G) / P_D, lambda the density of false detections
+    per px^2, P_D the recall, P_G the gate probability. The default 0 is
+    that value for the simulated detectors, which report no false positives
+    (a positive C there only discounts true detections of uncertain tracks:
+    1e-6 costs `intg` and `smpl` 2 MOTA points on the synthetic realistic
+    table, 2e-5 costs 9); the PETS scenario with HOG sets it (see
+    ``PETS_HOG_TRACKER``). The Hungarian association ignores it.
+    """
+
     acceleration_sigma_m_s2: PositiveFloat = 1.5
     initial_speed_sigma_m_s: PositiveFloat = 0.9
     gate_probability: float = Field(0.99, gt=0, lt=1)
     max_missed_steps: int = Field(5, ge=0)
     max_position_sigma_m: PositiveFloat = 2.0
     confirmation_hits: int = Field(1, ge=1)
+    association: Literal["hungarian", "cjpdaf"] = "hungarian"
+    clutter_density_per_px2: NonNegativeFloat = 0.0
 
 
 class Control(_Strict):
@@ -216,7 +236,11 @@ PETS_HOG_RECALL = {"recall_kd": 0.0795, "recall_r0_px": 1.83}
 # second detection on, and dies at its first miss until then. The simulated
 # detectors report none, and there confirmation only loses tracks of people
 # seen rarely (synthetic realistic table, fix: 63.2 % -> 32.3 % MOTA).
-PETS_HOG_TRACKER = {"confirmation_hits": 2}
+# The CJPDAF's clutter density: HOG's boxes whose feet lie more than 5 px x
+# zoom from every annotated person's are 0.04 per view at zoom 1 and 0.2 at
+# zoom 2, at a recall of 0.69 and 0.91 (benchmarks/hog_clutter.py), which
+# makes lambda (1 - P_D P_G) / P_D 0.9e-6 and 1.2e-6 per px^2.
+PETS_HOG_TRACKER = {"confirmation_hits": 2, "clutter_density_per_px2": 1e-6}
 
 
 def pets_scenario(detector: str = "ideal", **overrides) -> Scenario:

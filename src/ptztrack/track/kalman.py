@@ -29,14 +29,19 @@ def innovation_covariance(P, C, V) -> np.ndarray:
     return C @ P @ np.swapaxes(C, -1, -2) + V
 
 
+def gain(P, C, V) -> np.ndarray:
+    """Kalman gain ``K = P C^T S^-1`` (n, 4, 2), solved without inverting ``S``."""
+    S = innovation_covariance(P, C, V)
+    return np.swapaxes(np.linalg.solve(S, C @ P), -1, -2)
+
+
 def update(x, P, innovation, C, V) -> tuple[np.ndarray, np.ndarray]:
     """EKF update with the innovation ``o - g(x-)`` (n, 2) and ``C = dg/dx`` at ``x-``.
 
     Uses the Joseph form of ``P+ = (I - K C) P-`` so that P stays symmetric
     positive definite when the gain is large (zoomed-in views).
     """
-    S = innovation_covariance(P, C, V)
-    K = np.swapaxes(np.linalg.solve(S, C @ P), -1, -2)
+    K = gain(P, C, V)
     x_plus = x + (K @ innovation[..., None])[..., 0]
     I_KC = np.eye(x.shape[-1]) - K @ C
     P_plus = I_KC @ P @ np.swapaxes(I_KC, -1, -2) + K @ V @ np.swapaxes(K, -1, -2)

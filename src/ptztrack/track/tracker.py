@@ -1,8 +1,10 @@
-"""Multi-person tracker: one EKF per person on the ground, Hungarian association in the image.
+"""Multi-person tracker: one EKF per person on the ground, association in the image.
 
 Observations are feet pixels taken at a known pose; the observation function
 is the ground-to-image homography of that pose, linearised at the predicted
-state (the paper's section 3.1).
+state (the paper's section 3.1). Detections are associated with tracks by
+the Hungarian assignment (default) or by the Cheap JPDAF of
+:mod:`ptztrack.track.jpdaf` (``Tracker.association``).
 """
 
 from dataclasses import dataclass, replace
@@ -20,7 +22,7 @@ from ptztrack.geometry.ptz import (
     image_to_ground,
     inside_image,
 )
-from ptztrack.track import kalman
+from ptztrack.track import jpdaf, kalman
 
 
 # Feet are found on a pixel grid: the tracker trusts them to half a pixel at
@@ -103,6 +105,22 @@ def predicted_feet_px(camera: PTZCamera, pose, mean) -> tuple[np.ndarray, np.nda
     return apply_homography(H, mean[:, :2]), in_front
 
 
+def gated_innovations(predicted_px, in_front, S, feet_px, gate_probability: float):
+    """Innovations of every track w.r.t. every detection, and the chi-square gate.
+
+    predicted_px : (n, 2) and in_front : (n,) from :func:`predicted_feet_px`;
+    S : (n, 2, 2) innovation covariances; feet_px : (K, 2) detections.
+    Returns the innovations (n, K, 2) ``feet - predicted``, their squared
+    Mahalanobis distances (n, K), and which pairs are allowed (n, K): those
+    within the chi-square quantile ``gate_probability`` (2 degrees of
+    freedom) of tracks in front of the camera.
+    """
+    residual = feet_px[None, :, :] - predicted_px[:, None, :]
+    distance2 = np.einsum("tdi,tij,tdj->td", residual, np.linalg.inv(S), residual)
+    allowed = in_front[:, None] & (distance2 <= chi2.ppf(gate_probability, df=2))
+    return residual, distance2, allowed
+
+
 def associate(predicted_px, in_front, S, feet_px, gate_probability: float) -> tuple[np.ndarray, np.ndarray]:
     """Hungarian assignment of detections to predicted tracks on the Mahalanobis distance.
 
@@ -114,11 +132,8 @@ def associate(predicted_px, in_front, S, feet_px, gate_probability: float) -> tu
     """
     if len(predicted_px) == 0 or len(feet_px) == 0:
         return np.zeros(0, dtype=int), np.zeros(0, dtype=int)
-    residual = feet_px[None, :, :] - predicted_px[:, None, :]
-    distance2 = np.einsum("tdi,tij,tdj->td", residual, np.linalg.inv(S), residual)
-    gate = chi2.ppf(gate_probability, df=2)
-    allowed = in_front[:, None] & (distance2 <= gate)
-    cost = np.where(allowed, distance2, gate * 1e3)
+    _, distance2, allowed = gated_innovations(predicted_px, in_front, S, feet_px, gate_probability)
+    cost = np.where(allowed, distance2, chi2.ppf(gate_probability, df=2) * 1e3)
     rows, cols = linear_sum_assignment(cost)
     keep = allowed[rows, cols]
     return rows[keep], cols[keep]
@@ -154,38 +169,56 @@ def start_tracks(feet_px, camera: PTZCamera, pose, V, config: Tracker, first_id:
 def update_tracks(tracks: Tracks, feet_px, camera: PTZCamera, pose, V, config: Tracker) -> Tracks:
     """Associate, update, start and delete: the tracker's step after prediction.
 
-    feet_px : (K, 2) detections taken at ``pose``. A step counts as missed
-    for a track only if the track was predicted inside the image: a PTZ
-    camera that looks elsewhere has not missed anybody. A track is deleted
-    after more than ``max_missed_steps`` missed steps, or when its position
-    standard deviation exceeds ``max_position_sigma_m`` (which is what ends
-    a track the camera no longer looks at). A track not yet confirmed (fewer
-    than ``confirmation_hits`` hits) is deleted at its first missed step:
-    a detector's false positive rarely repeats at the same ground point.
+    feet_px : (K, 2) detections taken at ``pose``. ``config.association``
+    chooses the association: 'hungarian' updates a track with at most one
+    detection, and a detection assigned to no track starts one; 'cjpdaf'
+    updates every track with all detections in its gate (see
+    :mod:`ptztrack.track.jpdaf`), a track counts as detected when they
+    explain it with probability above ``jpdaf.MIN_DETECTION_PROBABILITY`` (1/2),
+    and a detection in the gate of no surviving track starts one (a
+    detection shared by tracks is not a new person).
+
+    A step counts as missed for a track not detected only if the track was
+    predicted inside the image: a PTZ camera that looks elsewhere has not
+    missed anybody. A track is deleted after more than ``max_missed_steps``
+    missed steps, or when its position standard deviation exceeds
+    ``max_position_sigma_m`` (which is what ends a track the camera no
+    longer looks at). A track not yet confirmed (fewer than
+    ``confirmation_hits`` hits) is deleted at its first missed step: a
+    detector's false positive rarely repeats at the same ground point.
     """
     feet_px = np.asarray(feet_px, dtype=float).reshape(-1, 2)
     predicted_px, in_front = predicted_feet_px(camera, pose, tracks.mean)
     C = observation_matrix(camera, pose, tracks.mean)
     S = kalman.innovation_covariance(tracks.covariance, C, V)
-    track_index, detection_index = associate(predicted_px, in_front, S, feet_px, config.gate_probability)
-    mean, covariance = tracks.mean.copy(), tracks.covariance.copy()
-    mean[track_index], covariance[track_index] = kalman.update(
-        tracks.mean[track_index],
-        tracks.covariance[track_index],
-        feet_px[detection_index] - predicted_px[track_index],
-        C[track_index],
-        V,
-    )
+    if config.association == "cjpdaf":
+        innovation, distance2, gated = gated_innovations(predicted_px, in_front, S, feet_px, config.gate_probability)
+        mean, covariance, detected = jpdaf.cjpdaf_step(
+            tracks.mean, tracks.covariance, innovation, distance2, gated, S, C, V, config.clutter_density_per_px2
+        )
+        track_index = np.flatnonzero(detected)
+    else:
+        track_index, detection_index = associate(predicted_px, in_front, S, feet_px, config.gate_probability)
+        mean, covariance = tracks.mean.copy(), tracks.covariance.copy()
+        mean[track_index], covariance[track_index] = kalman.update(
+            tracks.mean[track_index],
+            tracks.covariance[track_index],
+            feet_px[detection_index] - predicted_px[track_index],
+            C[track_index],
+            V,
+        )
     missed = tracks.missed_steps + (in_front & inside_image(camera, predicted_px))
     missed[track_index] = 0
     hits = tracks.hits.copy()
     hits[track_index] += 1
     updated = replace(tracks, mean=mean, covariance=covariance, missed_steps=missed, hits=hits)
     allowed_missed_steps = np.where(hits >= config.confirmation_hits, config.max_missed_steps, 0)
-    survivors = updated.select(
-        (updated.missed_steps <= allowed_missed_steps) & (updated.position_sigma_m <= config.max_position_sigma_m)
-    )
-    unmatched = np.setdiff1d(np.arange(len(feet_px)), detection_index)
+    keep = (updated.missed_steps <= allowed_missed_steps) & (updated.position_sigma_m <= config.max_position_sigma_m)
+    survivors = updated.select(keep)
+    if config.association == "cjpdaf":
+        unmatched = np.flatnonzero(~gated[keep].any(axis=0))
+    else:
+        unmatched = np.setdiff1d(np.arange(len(feet_px)), detection_index)
     born = start_tracks(feet_px[unmatched], camera, pose, V, config, tracks.next_id)
     return Tracks(
         ids=np.concatenate([survivors.ids, born.ids]),

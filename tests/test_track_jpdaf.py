@@ -1,0 +1,298 @@
+import numpy as np
+import pydantic
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from scipy.stats import chi2, multivariate_normal
+
+from ptztrack.cli import build_scenario, main
+from ptztrack.config import ScenarioError, Tracker, scenario_from_dict
+from ptztrack.geometry.ptz import PTZCamera, apply_homography, ground_to_image, look_at
+from ptztrack.track import jpdaf, kalman
+from ptztrack.track.kalman import constant_velocity_model
+from ptztrack.track.tracker import (
+    gated_innovations,
+    no_tracks,
+    observation_matrix,
+    predict_tracks,
+    predicted_feet_px,
+    start_tracks,
+    update_tracks,
+)
+
+CAMERA = PTZCamera((7.5, -4.0, 7.0), 640, 480, 400.0)
+POSE = look_at(CAMERA, [7.5, 6.0], 1.0)
+V = 4.0 * np.eye(2)
+CJPDAF = Tracker(association="cjpdaf")
+GATE = chi2.ppf(CJPDAF.gate_probability, df=2)
+
+
+def feet_px(ground_xy, pose=POSE):
+    return apply_homography(ground_to_image(CAMERA, pose), np.asarray(ground_xy, dtype=float))
+
+
+def step_inputs(mean, covariance, feet):
+    """What update_tracks computes before associating: innovations, distances, gate, S and C."""
+    predicted_px, in_front = predicted_feet_px(CAMERA, POSE, mean)
+    C = observation_matrix(CAMERA, POSE, mean)
+    S = kalman.innovation_covariance(covariance, C, V)
+    innovation, distance2, allowed = gated_innovations(predicted_px, in_front, S, feet, CJPDAF.gate_probability)
+    return innovation, distance2, allowed, S, C
+
+
+def a_track(ground_xy=(7.0, 6.0), velocity=(0.8, -0.4)):
+    """One predicted track: started at ``ground_xy`` with ``velocity`` and predicted one step."""
+    F, U = constant_velocity_model(0.2, CJPDAF.acceleration_sigma_m_s2)
+    tracks = start_tracks(feet_px([ground_xy]), CAMERA, POSE, V, CJPDAF, first_id=0)
+    mean = tracks.mean.copy()
+    mean[:, 2:] = velocity
+    return kalman.predict(mean, tracks.covariance, F, U)
+
+
+def pixel_space_betas(predicted_px, feet, clutter, sigma_px=2.0):
+    """Betas of tracks predicted at ``predicted_px`` with isotropic innovation covariances."""
+    predicted_px = np.asarray(predicted_px, dtype=float)
+    S = np.broadcast_to(sigma_px**2 * np.eye(2), (len(predicted_px), 2, 2))
+    in_front = np.ones(len(predicted_px), dtype=bool)
+    _, distance2, allowed = gated_innovations(predicted_px, in_front, S, np.asarray(feet, float), 0.99)
+    p = jpdaf.likelihoods(distance2, S, allowed)
+    beta, beta_0 = jpdaf.association_probabilities(p, clutter)
+    return p, beta, beta_0
+
+
+def test_one_track_and_one_measurement_give_beta_p_over_p_plus_c():
+    mean, covariance = a_track()
+    feet = feet_px([[7.3, 6.1]])
+    innovation, distance2, allowed, S, _ = step_inputs(mean, covariance, feet)
+    assert allowed.all()
+    p = jpdaf.likelihoods(distance2, S, allowed)
+    predicted = predicted_feet_px(CAMERA, POSE, mean)[0][0]
+    assert p[0, 0] == pytest.approx(multivariate_normal(predicted, S[0]).pdf(feet[0]), rel=1e-12)
+    clutter = 0.3 * p[0, 0]
+    beta, beta_0 = jpdaf.association_probabilities(p, clutter)
+    assert beta[0, 0] == p[0, 0] / (p[0, 0] + clutter)
+    assert beta_0[0] == pytest.approx(clutter / (p[0, 0] + clutter), rel=1e-12)
+
+
+def test_as_c_goes_to_0_one_track_and_one_measurement_get_the_kalman_update():
+    mean, covariance = a_track()
+    feet = feet_px([[7.4, 5.8]])
+    innovation, distance2, allowed, S, C = step_inputs(mean, covariance, feet)
+    kalman_mean, kalman_covariance = kalman.update(mean, covariance, innovation[:, 0], C, V)
+    deviations = []
+    for clutter in (0.0, 1e-18, 1e-8, 1e-7, 1e-6):
+        new_mean, new_covariance, detected = jpdaf.cjpdaf_step(
+            mean, covariance, innovation, distance2, allowed, S, C, V, clutter
+        )
+        assert detected.all()
+        deviations.append(np.abs(new_covariance - kalman_covariance).max())
+        if clutter < 1e-15:
+            np.testing.assert_allclose(new_mean, kalman_mean, rtol=0, atol=1e-12)
+            np.testing.assert_allclose(new_covariance, kalman_covariance, rtol=0, atol=1e-12)
+    # Away from 0 the update leaves the Kalman one in proportion to C (beta_0 = C / (p + C)).
+    np.testing.assert_allclose(deviations[3] / deviations[2], 10.0, rtol=1e-3)
+    np.testing.assert_allclose(deviations[4] / deviations[2], 100.0, rtol=1e-2)
+
+
+def test_with_c_0_the_tracker_step_equals_the_hungarian_one_for_a_lone_person():
+    F, U = constant_velocity_model(0.2, CJPDAF.acceleration_sigma_m_s2)
+    hungarian = Tracker()
+    tracks = {"hungarian": None, "cjpdaf": None}
+    for name, config in (("hungarian", hungarian), ("cjpdaf", CJPDAF.model_copy(update={"clutter_density_per_px2": 0}))):
+        state = no_tracks()
+        for step in range(8):
+            state = update_tracks(predict_tracks(state, F, U), feet_px([[5.0 + 0.2 * step, 6.0]]), CAMERA, POSE, V, config)
+        tracks[name] = state
+    np.testing.assert_array_equal(tracks["cjpdaf"].ids, tracks["hungarian"].ids)
+    np.testing.assert_array_equal(tracks["cjpdaf"].hits, tracks["hungarian"].hits)
+    np.testing.assert_allclose(tracks["cjpdaf"].mean, tracks["hungarian"].mean, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(tracks["cjpdaf"].covariance, tracks["hungarian"].covariance, rtol=0, atol=1e-12)
+
+
+def test_two_tracks_equidistant_from_one_measurement_share_it_equally_and_each_gets_less_than_a_lone_track():
+    clutter = 1e-3
+    p, beta, beta_0 = pixel_space_betas([[100.0, 100.0], [110.0, 100.0]], [[105.0, 100.0]], clutter)
+    assert beta[0, 0] == beta[1, 0] > 0
+    _, lone_beta, _ = pixel_space_betas([[100.0, 100.0]], [[105.0, 100.0]], clutter)
+    assert beta[0, 0] < lone_beta[0, 0]
+    # Equation 6: S_k = p, S_i = 2p, so beta = p / (2p + C), against p / (p + C) alone.
+    assert beta[0, 0] == pytest.approx(p[0, 0] / (2 * p[0, 0] + clutter), rel=1e-12)
+    assert lone_beta[0, 0] == pytest.approx(p[0, 0] / (p[0, 0] + clutter), rel=1e-12)
+    np.testing.assert_allclose(beta_0, 1 - beta[:, 0])
+
+
+def test_a_measurement_where_two_gates_overlap_weighs_less_than_one_in_a_single_gate():
+    # Gates of radius 2 px x 3.03 around x = 100 and x = 112; both measurements are 6 px from track 0,
+    # the first also 6 px from track 1, the second 18 px from it.
+    p, beta, _ = pixel_space_betas([[100.0, 100.0], [112.0, 100.0]], [[106.0, 100.0], [94.0, 100.0]], 1e-4)
+    np.testing.assert_array_equal(p > 0, [[True, True], [True, False]])
+    assert p[0, 0] == p[0, 1]
+    assert beta[0, 0] < beta[0, 1]
+    q = p[0, 0]
+    assert beta[0, 0] == pytest.approx(q / (3 * q + 1e-4), rel=1e-12)
+    assert beta[0, 1] == pytest.approx(q / (2 * q + 1e-4), rel=1e-12)
+
+
+def test_no_measurement_in_the_gate_leaves_the_prediction_exactly():
+    mean, covariance = a_track()
+    innovation, distance2, allowed, S, C = step_inputs(mean, covariance, feet_px([[13.0, 11.0]]))
+    assert not allowed.any()
+    new_mean, new_covariance, detected = jpdaf.cjpdaf_step(
+        mean, covariance, innovation, distance2, allowed, S, C, V, 1e-5
+    )
+    np.testing.assert_array_equal(new_mean, mean)
+    np.testing.assert_array_equal(new_covariance, covariance)
+    assert not detected.any()
+
+
+def mixture_moments(mean, covariance, innovation, beta, beta_0, C):
+    """Mean and covariance of the mixture {prediction: beta_0, Kalman update with measurement i: beta_i}, by a loop."""
+    K = covariance @ C.T @ np.linalg.inv(C @ covariance @ C.T + V)
+    posterior = (np.eye(4) - K @ C) @ covariance
+    components = [(beta_0, mean, covariance)] + [(b, mean + K @ nu, posterior) for b, nu in zip(beta, innovation)]
+    total = sum(weight for weight, _, _ in components)
+    centre = sum(weight * m for weight, m, _ in components) / total
+    spread = sum(weight * (P + np.outer(m - centre, m - centre)) for weight, m, P in components) / total
+    return centre, spread
+
+
+unit = st.floats(-1.0, 1.0)
+
+
+@settings(max_examples=150, deadline=None)
+@given(
+    position=st.tuples(st.floats(4.0, 11.0), st.floats(3.0, 10.0)),
+    velocity=st.tuples(st.floats(-1.5, 1.5), st.floats(-1.5, 1.5)),
+    root=st.lists(st.floats(-0.4, 0.4), min_size=16, max_size=16),
+    offsets=st.tuples(unit, unit, unit, unit),
+    clutter_exponent=st.floats(-7.0, -3.0),
+)
+def test_the_pda_covariance_is_the_mixture_covariance_grows_with_a_second_measurement_and_stays_spd(
+    position, velocity, root, offsets, clutter_exponent
+):
+    L = np.array(root).reshape(4, 4)
+    covariance = (L @ L.T + 1e-3 * np.eye(4))[None]
+    mean = np.array([[*position, *velocity]])
+    predicted_px = predicted_feet_px(CAMERA, POSE, mean)[0]
+    C = observation_matrix(CAMERA, POSE, mean)
+    S = kalman.innovation_covariance(covariance, C, V)
+    # Two measurements inside the gate: Mahalanobis radius at most 2.9 (9.21 is the 99 % gate's square).
+    z = 2.9 * np.array(offsets).reshape(2, 2) / np.sqrt(2)
+    feet = predicted_px[0] + z @ np.linalg.cholesky(S[0]).T
+    innovation, distance2, allowed, _, _ = step_inputs(mean, covariance, feet)
+    assert allowed.all()
+
+    clutter = 10.0**clutter_exponent
+    beta, beta_0 = jpdaf.association_probabilities(jpdaf.likelihoods(distance2, S, allowed), clutter)
+    new_mean, two = jpdaf.pda_update(mean, covariance, innovation, beta, beta_0, C, V)
+    centre, spread = mixture_moments(mean[0], covariance[0], innovation[0], beta[0], beta_0[0], C[0])
+    scale = np.abs(covariance).max()
+    np.testing.assert_allclose(new_mean[0], centre, rtol=0, atol=1e-9)
+    np.testing.assert_allclose(two[0], spread, rtol=0, atol=1e-9 * scale)
+    np.testing.assert_array_equal(two, np.swapaxes(two, -1, -2))
+    assert np.linalg.eigvalsh(two[0])[0] > 0
+
+    # With C -> 0 the second measurement adds the spread beta_1 beta_2 K d d^T K^T, d = nu_1 - nu_2, to P.
+    beta, beta_0 = jpdaf.association_probabilities(jpdaf.likelihoods(distance2, S, allowed), 0.0)
+    _, two = jpdaf.pda_update(mean, covariance, innovation, beta, beta_0, C, V)
+    b1, b0 = jpdaf.association_probabilities(jpdaf.likelihoods(distance2[:, :1], S, allowed[:, :1]), 0.0)
+    _, one = jpdaf.pda_update(mean, covariance, innovation[:, :1], b1, b0, C, V)
+    K = kalman.gain(covariance, C, V)[0]
+    d = K @ (innovation[0, 0] - innovation[0, 1])
+    np.testing.assert_allclose(two[0] - one[0], beta[0, 0] * beta[0, 1] * np.outer(d, d), rtol=0, atol=1e-9 * scale)
+    assert np.linalg.eigvalsh(two[0] - one[0])[0] > -1e-9 * scale
+    assert np.trace(two[0]) >= np.trace(one[0])
+
+
+def test_a_lone_measurement_in_two_gates_keeps_only_the_likelier_track_alive_and_starts_none():
+    F, U = constant_velocity_model(0.2, CJPDAF.acceleration_sigma_m_s2)
+    config = CJPDAF.model_copy(update={"clutter_density_per_px2": 1e-6})
+    tracks = start_tracks(feet_px([[7.0, 6.0], [7.3, 6.0]]), CAMERA, POSE, V, config, first_id=0)
+    # One measurement near both tracks, nearer track 0; another far from both.
+    updated = update_tracks(predict_tracks(tracks, F, U), feet_px([[7.1, 6.0], [12.0, 9.0]]), CAMERA, POSE, V, config)
+    np.testing.assert_array_equal(updated.ids, [0, 1, 2])
+    np.testing.assert_array_equal(updated.missed_steps, [0, 1, 0])
+    np.testing.assert_array_equal(updated.hits, [2, 1, 1])
+    # Both tracks moved part of the way towards the shared measurement.
+    assert 7.0 < updated.mean[0, 0] < 7.1 < updated.mean[1, 0] < 7.3
+    np.testing.assert_allclose(updated.mean[2, :2], [12.0, 9.0], atol=1e-9)
+
+
+def test_two_people_each_detected_keep_both_tracks_alive_even_inside_each_others_gates():
+    F, U = constant_velocity_model(0.2, CJPDAF.acceleration_sigma_m_s2)
+    tracks = start_tracks(feet_px([[7.0, 6.0], [7.3, 6.0]]), CAMERA, POSE, V, CJPDAF, first_id=0)
+    updated = update_tracks(predict_tracks(tracks, F, U), feet_px([[7.0, 6.0], [7.3, 6.0]]), CAMERA, POSE, V, CJPDAF)
+    np.testing.assert_array_equal(updated.ids, [0, 1])
+    np.testing.assert_array_equal(updated.missed_steps, [0, 0])
+    np.testing.assert_array_equal(updated.hits, [2, 2])
+
+
+def test_a_measurement_only_in_the_gate_of_a_track_that_dies_starts_a_new_one():
+    F, U = constant_velocity_model(0.2, CJPDAF.acceleration_sigma_m_s2)
+    tracks = predict_tracks(start_tracks(feet_px([[7.5, 6.0]]), CAMERA, POSE, V, CJPDAF, first_id=0), F, U)
+    feet = feet_px([[7.7, 6.1]])
+    _, distance2, allowed, S, _ = step_inputs(tracks.mean, tracks.covariance, feet)
+    p = jpdaf.likelihoods(distance2, S, allowed)[0, 0]
+    assert p > 0
+    # C = 3p: beta = 1/4, so the unconfirmed track misses and dies, and the measurement is nobody's.
+    config = CJPDAF.model_copy(update={"confirmation_hits": 2, "clutter_density_per_px2": 3 * p})
+    updated = update_tracks(tracks, feet, CAMERA, POSE, V, config)
+    np.testing.assert_array_equal(updated.ids, [1])
+    np.testing.assert_allclose(updated.mean[0, :2], [7.7, 6.1], atol=1e-9)
+
+
+def test_missed_steps_count_only_in_view_and_a_track_dies_after_the_allowed_ones():
+    F, U = constant_velocity_model(0.2, CJPDAF.acceleration_sigma_m_s2)
+    config = CJPDAF.model_copy(update={"max_missed_steps": 2, "max_position_sigma_m": 100.0})
+    tracks = start_tracks(feet_px([[7.5, 6.0]]), CAMERA, POSE, V, config, first_id=0)
+    looking_away = np.array([60.0, 40.0, 4.0])
+    for _ in range(3):
+        tracks = update_tracks(predict_tracks(tracks, F, U), np.zeros((0, 2)), CAMERA, looking_away, V, config)
+    assert len(tracks) == 1 and tracks.missed_steps[0] == 0
+    lengths = []
+    for _ in range(3):
+        tracks = update_tracks(predict_tracks(tracks, F, U), feet_px([[2.0, 12.0]]), CAMERA, POSE, V, config)
+        lengths.append(sorted(tracks.ids.tolist()))
+    # The far detection starts a track of its own each step (it is gated by none), then keeps it alive.
+    assert lengths == [[0, 1], [0, 1], [1]]
+
+
+@pytest.mark.parametrize("association", ["cjpdaf", "hungarian"])
+def test_tracks_follow_two_crossing_walkers_and_keep_their_ids(association):
+    config = Tracker(association=association)
+    dt = 0.2
+    F, U = constant_velocity_model(dt, config.acceleration_sigma_m_s2)
+    # Both walkers reach (7.5, 6.5) at step 15, on paths crossing at right angles.
+    start = np.array([[4.5, 3.5], [10.5, 3.5]])
+    velocity = np.array([[1.0, 1.0], [-1.0, 1.0]])
+    tracks = no_tracks()
+    for step in range(31):
+        truth = start + velocity * step * dt
+        tracks = update_tracks(predict_tracks(tracks, F, U), feet_px(truth), CAMERA, POSE, V, config)
+        order = np.argsort(tracks.ids)
+        np.testing.assert_array_equal(tracks.ids[order], [0, 1])
+    np.testing.assert_allclose(tracks.mean[order, :2], truth, atol=0.02)
+    np.testing.assert_allclose(tracks.mean[order, 2:], velocity, atol=0.05)
+
+
+def test_an_unknown_association_is_refused_naming_the_field():
+    with pytest.raises(ScenarioError) as error:
+        scenario_from_dict({"tracker": {"association": "jpda"}})
+    assert "tracker.association: Input should be 'hungarian' or 'cjpdaf' (got 'jpda')" in str(error.value)
+    with pytest.raises(pydantic.ValidationError) as error:
+        Tracker(association="nearest")
+    assert error.value.errors()[0]["loc"] == ("association",)
+    with pytest.raises(ScenarioError, match="tracker.clutter_density_per_px2: Input should be greater than or equal"):
+        scenario_from_dict({"tracker": {"clutter_density_per_px2": -1e-6}})
+
+
+def test_the_default_is_hungarian_and_the_command_line_selects_the_cjpdaf(capsys):
+    assert Tracker().association == "hungarian"
+    hog = build_scenario("pets", "hog", association="cjpdaf").tracker
+    assert (hog.association, hog.confirmation_hits, hog.clutter_density_per_px2) == ("cjpdaf", 2, 1e-6)
+    assert build_scenario("synthetic", association="cjpdaf").tracker.association == "cjpdaf"
+    assert main(["run", "--scenario", "pets", "--policy", "fix", "--association", "cjpdaf", "--frames", "5"]) == 0
+    assert "MOTA" in capsys.readouterr().out
+    with pytest.raises(SystemExit) as error:
+        main(["run", "--association", "greedy"])
+    assert error.value.code == 2
