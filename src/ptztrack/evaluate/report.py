@@ -3,8 +3,6 @@
 import csv
 import io
 import json
-import os
-import tempfile
 from pathlib import Path
 
 import matplotlib
@@ -13,24 +11,11 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Rectangle
 
 from ptztrack.episode import Episode
+from ptztrack.files import write_atomically
 from ptztrack.evaluate.video import RenderView, write_episode_video
 from ptztrack.geometry.ptz import ground_footprint
 
 TRACK_COLUMNS = ("frame", "id", "x_m", "y_m", "vx_m_s", "vy_m_s", "var_x_m2", "cov_xy_m2", "var_y_m2")
-
-
-def write_atomically(path: Path, data: bytes) -> None:
-    """Write ``data`` to ``path`` through a temporary file and a rename, so that
-    a reader never sees a half-written file and an old file survives a failure."""
-    path = Path(path)
-    handle, temporary = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(handle, "wb") as file:
-            file.write(data)
-        os.replace(temporary, path)
-    except BaseException:
-        os.unlink(temporary)
-        raise
 
 
 def metrics_json(metrics: dict) -> bytes:
