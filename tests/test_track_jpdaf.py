@@ -7,7 +7,6 @@ from scipy.stats import chi2, multivariate_normal
 
 from ptztrack.cli import build_scenario, main
 from ptztrack.config import ScenarioError, Tracker, scenario_from_dict
-from ptztrack.geometry.ptz import PTZCamera, apply_homography, ground_to_image, look_at
 from ptztrack.track import jpdaf, kalman
 from ptztrack.track.kalman import constant_velocity_model
 from ptztrack.track.tracker import (
@@ -19,16 +18,10 @@ from ptztrack.track.tracker import (
     start_tracks,
     update_tracks,
 )
+from test_track_tracker import CAMERA, POSE, V, assert_tracks_follow_walkers, feet_px
 
-CAMERA = PTZCamera((7.5, -4.0, 7.0), 640, 480, 400.0)
-POSE = look_at(CAMERA, [7.5, 6.0], 1.0)
-V = 4.0 * np.eye(2)
 CJPDAF = Tracker(association="cjpdaf")
 GATE = chi2.ppf(CJPDAF.gate_probability, df=2)
-
-
-def feet_px(ground_xy, pose=POSE):
-    return apply_homography(ground_to_image(CAMERA, pose), np.asarray(ground_xy, dtype=float))
 
 
 def step_inputs(mean, covariance, feet):
@@ -259,20 +252,10 @@ def test_missed_steps_count_only_in_view_and_a_track_dies_after_the_allowed_ones
 
 @pytest.mark.parametrize("association", ["cjpdaf", "hungarian"])
 def test_tracks_follow_two_crossing_walkers_and_keep_their_ids(association):
-    config = Tracker(association=association)
-    dt = 0.2
-    F, U = constant_velocity_model(dt, config.acceleration_sigma_m_s2)
     # Both walkers reach (7.5, 6.5) at step 15, on paths crossing at right angles.
     start = np.array([[4.5, 3.5], [10.5, 3.5]])
     velocity = np.array([[1.0, 1.0], [-1.0, 1.0]])
-    tracks = no_tracks()
-    for step in range(31):
-        truth = start + velocity * step * dt
-        tracks = update_tracks(predict_tracks(tracks, F, U), feet_px(truth), CAMERA, POSE, V, config)
-        order = np.argsort(tracks.ids)
-        np.testing.assert_array_equal(tracks.ids[order], [0, 1])
-    np.testing.assert_allclose(tracks.mean[order, :2], truth, atol=0.02)
-    np.testing.assert_allclose(tracks.mean[order, 2:], velocity, atol=0.05)
+    assert_tracks_follow_walkers(start, velocity, 31, Tracker(association=association))
 
 
 def test_an_unknown_association_is_refused_naming_the_field():

@@ -39,19 +39,23 @@ def test_pixels_above_the_horizon_start_no_track():
     assert len(tracks) == 1
 
 
-def test_tracks_follow_walkers_and_keep_their_ids():
+def assert_tracks_follow_walkers(start, velocity, steps: int, config: Tracker) -> None:
+    """Walkers from ``start`` (2, 2) at ``velocity`` (2, 2) m/s, detected every step: the tracks keep ids 0
+    and 1 throughout and end on the walkers' positions and velocities."""
     dt = 0.2
-    F, U = constant_velocity_model(dt, CONFIG.acceleration_sigma_m_s2)
-    start = np.array([[4.0, 4.0], [11.0, 10.0]])
-    velocity = np.array([[1.0, 0.5], [-0.8, -0.6]])
+    F, U = constant_velocity_model(dt, config.acceleration_sigma_m_s2)
     tracks = no_tracks()
-    for step in range(30):
+    for step in range(steps):
         truth = start + velocity * step * dt
-        tracks = update_tracks(predict_tracks(tracks, F, U), feet_px(truth), CAMERA, POSE, V, CONFIG)
+        tracks = update_tracks(predict_tracks(tracks, F, U), feet_px(truth), CAMERA, POSE, V, config)
         order = np.argsort(tracks.ids)
         np.testing.assert_array_equal(tracks.ids[order], [0, 1])
     np.testing.assert_allclose(tracks.mean[order, :2], truth, atol=0.02)
     np.testing.assert_allclose(tracks.mean[order, 2:], velocity, atol=0.05)
+
+
+def test_tracks_follow_walkers_and_keep_their_ids():
+    assert_tracks_follow_walkers(np.array([[4.0, 4.0], [11.0, 10.0]]), np.array([[1.0, 0.5], [-0.8, -0.6]]), 30, CONFIG)
 
 
 def test_hungarian_assignment_ignores_detection_order_and_gates_outliers():
