@@ -4,11 +4,14 @@ import argparse
 import json
 import os
 import sys
+import tempfile
+from functools import partial
 from pathlib import Path
 
 import numpy as np
 
-from ptztrack.config import Scenario, ScenarioError, load_scenario, pets_scenario, scenario_from_dict
+from ptztrack.camera.pose_feedback import reference_index
+from ptztrack.config import PoseError, Scenario, ScenarioError, load_scenario, pets_scenario, scenario_from_dict
 from ptztrack.control.msg_scheduler import CHOOSERS
 from ptztrack.episode import POLICIES, episode_world, run_episode
 from ptztrack.evaluate.experiment import (
@@ -31,9 +34,17 @@ from ptztrack.evaluate.msg import (
     summarise_by_ambiguity,
     trails_figure,
 )
+from ptztrack.evaluate.registration import (
+    POSE_SOURCES,
+    closed_loop_cells,
+    registration_errors,
+    run_closed_loop_cell,
+    summarise_registration,
+)
 from ptztrack.evaluate.report import write_atomically, write_figure, write_outputs
 from ptztrack.evaluate.video import view_renderer
 from ptztrack.geometry.calibration import CalibrationError
+from ptztrack.geometry.registration import RegistrationIndexError
 from ptztrack.scene.pets import DatasetError
 from ptztrack.scene.roads import walk_roads
 
@@ -118,9 +129,62 @@ def msg_experiment_command(args: argparse.Namespace) -> int:
     return 0
 
 
+def registration_experiment_command(args: argparse.Namespace) -> int:
+    scenario = build_scenario(
+        "pets" if args.scenario == "synthetic" else args.scenario,
+        args.detector or "hog",
+        args.frames,
+        recording_paths(args),
+        args.association,
+    )
+    if scenario.recording is None or scenario.recording.video is None:
+        raise ScenarioError(f"{args.scenario}: the registration experiment needs a recording with a video")
+    with tempfile.TemporaryDirectory() as scratch:
+        index_path = args.index or Path(scratch) / "index.npz"
+        feedback = scenario.pose_feedback.model_copy(update={"index": str(index_path)})
+        scenario = scenario.model_copy(update={"pose_feedback": feedback})
+        built = not Path(index_path).exists()
+        print(f"{'building' if built else 'reading'} the reference index {index_path}", file=sys.stderr)
+        index = reference_index(scenario)
+        print(f"{len(index.poses)} reference views; registering {args.views} live views", file=sys.stderr)
+        views = registration_errors(scenario, index, args.views, args.seed, partial(print_progress, noun="views"))
+        summary = summarise_registration(views)
+        pose_error = PoseError(pan_tilt_sigma_deg=args.pose_noise_deg, zoom_sigma=args.zoom_noise)
+        cells = closed_loop_cells(scenario, pose_error, args.policy, args.pose_sources)
+        print(f"{len(cells)} closed-loop runs, {args.executor} executor", file=sys.stderr)
+        closed_loop = run_cells(cells, args.executor, args.workers, print_progress, run_closed_loop_cell)
+    size = scenario.pose_feedback.image_size_px
+    print(
+        f"Registration of {summary['views']} live views at random reachable poses, {size[0]} x {size[1]} px, "
+        f"against {len(index.poses)} reference views: {summary['registered']} registered"
+    )
+    print(f"  focal length error  median {summary['focal_err_median_pct']:.3f} %   p90 {summary['focal_err_p90_pct']:.3f} %")
+    print(f"  ground error        median {summary['ground_err_median_m']:.3f} m   p90 {summary['ground_err_p90_m']:.3f} m")
+    print(f"  time per view       median {summary['register_ms_median']:.0f} ms")
+    print(
+        f"\nClosed loop: {args.policy}, {scenario.detector.kind} detector, {scenario.tracker.association} association, "
+        f"camera off its commands by {args.pose_noise_deg:g} deg and {100 * args.zoom_noise:g} % zoom (1 sigma)"
+    )
+    width = max(len(name) for name in POSE_SOURCES)
+    print(f"  {'pose source':<{width + 2}} MOTA     MOTP [m]  pose known  tracker pose error (pan, tilt, zoom)")
+    for row in closed_loop:
+        print(
+            f"  {row['pose_source']:<{width + 2}} {row['mota']:6.1%}   {row['motp_m']:.3f}     {row['pose_known']:6.1%}"
+            f"      {row['tracker_pan_err_deg']:.3f} deg, {row['tracker_tilt_err_deg']:.3f} deg, "
+            f"{row['tracker_zoom_err_pct']:.2f} %"
+        )
+    if args.json is not None:
+        document = {**summary, "closed_loop": closed_loop, "views_detail": views}
+        write_atomically(args.json, (json.dumps(document, indent=2) + "\n").encode())
+        print(f"wrote {args.json}")
+    return 0
+
+
 def experiment_command(args: argparse.Namespace) -> int:
     if args.name == "msg":
         return msg_experiment_command(args)
+    if args.name == "registration":
+        return registration_experiment_command(args)
     if args.name == "pets":
         scenario = build_scenario(
             "pets", args.detector or "ideal", args.frames, recording_paths(args), args.association
@@ -162,8 +226,9 @@ def parser() -> argparse.ArgumentParser:
     experiment = commands.add_parser("experiment", help="run one of the paper's experiments and print its table")
     experiment.add_argument(
         "name",
-        choices=("synthetic", "pets", "msg"),
-        help="synthetic (the PTZ paper's Tables 1-2), pets (Tables 3-4) or msg (the face-capture paper's Figure 7)",
+        choices=("synthetic", "pets", "msg", "registration"),
+        help="synthetic (the PTZ paper's Tables 1-2), pets (Tables 3-4), msg (the face-capture paper's Figure 7) "
+        "or registration (the scale-invariant paper: registered PTZ views, and the closed loop on their poses)",
     )
     experiment.add_argument("--scenario", default="synthetic", help="'synthetic' (built in) or a scenario YAML file")
     experiment.add_argument(
@@ -184,6 +249,22 @@ def parser() -> argparse.ArgumentParser:
     experiment.add_argument("--runs", type=_positive_int, default=414, help="msg: simulations")
     experiment.add_argument("--plot", type=Path, help="msg: M against N_j/s per scheduler (PNG)")
     experiment.add_argument("--trails", type=Path, help="msg: one simulation's trails in (x, y, t) (PNG)")
+    registration = experiment.add_argument_group("registration")
+    registration.add_argument("--views", type=_positive_int, default=100, help="random live views to register")
+    registration.add_argument("--seed", type=int, default=0, help="draws the live views' poses and frames")
+    registration.add_argument(
+        "--index", type=Path, help="reference index file: read if it exists, else built and written (default: built)"
+    )
+    registration.add_argument("--policy", choices=POLICIES, default="smpl", help="closed-loop policy")
+    registration.add_argument(
+        "--pose-sources", nargs="+", choices=POSE_SOURCES, default=list(POSE_SOURCES), help="closed-loop pose sources"
+    )
+    registration.add_argument(
+        "--pose-noise-deg", type=_non_negative_float, default=2.0, help="closed loop: pan and tilt landing error, 1 sigma"
+    )
+    registration.add_argument(
+        "--zoom-noise", type=_non_negative_float, default=0.02, help="closed loop: relative zoom landing error, 1 sigma"
+    )
     _add_recording_arguments(experiment)
     experiment.set_defaults(handler=experiment_command)
     return root
@@ -203,6 +284,13 @@ def _add_recording_arguments(command: argparse.ArgumentParser) -> None:
     recording.add_argument("--gt", type=Path, help="MOTChallenge ground truth with world positions in metres")
 
 
+def _non_negative_float(text: str) -> float:
+    value = float(text)
+    if not value >= 0:
+        raise argparse.ArgumentTypeError(f"must be at least 0 (got {text})")
+    return value
+
+
 def _positive_int(text: str) -> int:
     value = int(text)
     if value < 1:
@@ -214,7 +302,7 @@ def main(argv: list[str] | None = None) -> int:
     args = parser().parse_args(argv)
     try:
         return args.handler(args)
-    except (ScenarioError, CalibrationError, DatasetError, RuntimeError) as error:
+    except (ScenarioError, CalibrationError, DatasetError, RegistrationIndexError, RuntimeError) as error:
         print(f"ptztrack: error: {error}", file=sys.stderr)
         return 2
     except BrokenPipeError:

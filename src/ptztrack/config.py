@@ -46,10 +46,50 @@ class People(_Strict):
         return self
 
 
+class PoseError(_Strict):
+    """How far a real PTZ camera lands from the pose it was sent to (backlash, zoom curves).
+
+    Each time the command changes, the camera lands at the commanded pan and tilt plus
+    ``pan_tilt_bias_deg`` plus independent Gaussian errors of ``pan_tilt_sigma_deg``, and at the
+    commanded zoom times ``zoom_bias`` times (1 + a Gaussian error of ``zoom_sigma``); it stays there
+    while the command does not change. The defaults are a perfect camera.
+    """
+
+    pan_tilt_sigma_deg: NonNegativeFloat = 0.0
+    pan_tilt_bias_deg: tuple[float, float] = (0.0, 0.0)
+    zoom_sigma: Annotated[float, Field(ge=0, lt=0.5)] = 0.0
+    zoom_bias: PositiveFloat = 1.0
+
+
 class Camera(_Strict):
     position_m: tuple[float, float, PositiveFloat] = (7.5, -4.0, 7.0)
     image_size_px: tuple[Annotated[int, Field(gt=0)], Annotated[int, Field(gt=0)]] = (640, 480)
     f_min_px: PositiveFloat = 400.0
+    pose_error: PoseError = PoseError()
+
+
+class PoseFeedback(_Strict):
+    """Which pose the tracker maps detections with (the scale-invariant tracking paper, section 3).
+
+    source : 'commanded' (what the camera was sent to), 'oracle' (where it really looks; for
+    experiments) or 'registered' (found from its image by SIFT registration against reference views,
+    :mod:`ptztrack.camera.pose_feedback`; needs a recording with a video). A view that cannot be
+    registered falls back to the commanded pose.
+    image_size_px : the resolution of the image registered (the detector may see a smaller one).
+    reference_zooms, reference_pan_steps, reference_tilt_steps : the reference views, a grid over the
+    action grid's pan and tilt range at each zoom; reference_pose_sigma_deg and
+    reference_zoom_spread : how roughly their poses are known before bundle adjustment.
+    index : a file caching the reference index: read when it exists, written when it does not.
+    """
+
+    source: Literal["commanded", "oracle", "registered"] = "commanded"
+    image_size_px: tuple[Annotated[int, Field(gt=0)], Annotated[int, Field(gt=0)]] = (640, 480)
+    reference_zooms: tuple[Annotated[float, Field(ge=1)], ...] = (1.0, 2.0, 3.2)
+    reference_pan_steps: int = Field(5, ge=1)
+    reference_tilt_steps: int = Field(3, ge=1)
+    reference_pose_sigma_deg: NonNegativeFloat = 0.5
+    reference_zoom_spread: Annotated[float, Field(ge=0, lt=0.5)] = 0.03
+    index: str | None = None
 
 
 class AxisRange(_Strict):
@@ -166,12 +206,16 @@ class Scenario(_Strict):
     detector: Detector = Detector()
     tracker: Tracker = Tracker()
     control: Control = Control()
+    pose_feedback: PoseFeedback = PoseFeedback()
     recording: Recording | None = None
 
     @model_validator(mode="after")
-    def _hog_needs_a_video(self):
-        if self.detector.kind == "hog" and (self.recording is None or self.recording.video is None):
+    def _images_need_a_video(self):
+        has_video = self.recording is not None and self.recording.video is not None
+        if self.detector.kind == "hog" and not has_video:
             raise ValueError("detector.kind 'hog' needs a recording with a video (recording.video)")
+        if self.pose_feedback.source == "registered" and not has_video:
+            raise ValueError("pose_feedback.source 'registered' needs a recording with a video (recording.video)")
         return self
 
     @property

@@ -2,8 +2,8 @@
 
 ``run_episode`` knows only the roles: a camera backend with ``observe``, the
 tracker's predict and update, and a policy with ``choose``. Random draws come
-from independent streams spawned from the seed: the scene, the policy, and
-one detector stream per frame. So different policies run with the same seed
+from independent streams spawned from the seed: the scene, the policy,
+one detector stream per frame, and the camera's landing errors. So different policies run with the same seed
 meet the same people and, frame by frame, the same detector luck (common
 random numbers), which makes their paired comparison far less noisy.
 """
@@ -15,6 +15,7 @@ import numpy as np
 from typing import Protocol
 
 from ptztrack.camera.actions import ActionGrid
+from ptztrack.camera.pose_feedback import PoseSource, commanded_pose, landed_pose, registered_pose_source, true_pose
 from ptztrack.camera.recorded import RecordedPTZ
 from ptztrack.camera.simulated import SimulatedPTZ
 from ptztrack.camera.virtual import virtual_ptz
@@ -49,6 +50,7 @@ class World:
     truth : the people, for the metrics.
     backend : gives the detections.
     area_bounds_m : [[x0, y0], [x1, y1]], where people can be.
+    pose_source : the pose the tracker maps detections with (:mod:`ptztrack.camera.pose_feedback`).
     """
 
     camera: PTZCamera
@@ -56,18 +58,23 @@ class World:
     truth: GroundTruth
     backend: CameraBackend
     area_bounds_m: np.ndarray
+    pose_source: PoseSource
+
+
+SIMPLE_POSE_SOURCES = {"commanded": commanded_pose, "oracle": true_pose}
 
 
 def build_world(scenario: Scenario, scene_rng: np.random.Generator) -> World:
     """The synthetic scene, or the recording of ``scenario.recording`` seen by a virtual PTZ camera."""
+    source = scenario.pose_feedback.source
     if scenario.recording is None:
         camera, grid = scenario.ptz_camera(), scenario.action_grid()
         truth = walk_people(scenario.people, scenario.area_m, scenario.frames, scenario.frame_rate_hz, scene_rng)
-        return World(camera, grid, truth, SimulatedPTZ(camera, truth, scenario.detector), scenario.area_bounds_m)
+        backend = SimulatedPTZ(camera, truth, scenario.detector)
+        return World(camera, grid, truth, backend, scenario.area_bounds_m, SIMPLE_POSE_SOURCES[source])
     recording = scenario.recording
-    virtual, whole_frame_pose = virtual_ptz(
-        load_calibration(recording.calibration, recording.view), recording.recorded_size_px, scenario.camera.image_size_px
-    )
+    calibration = load_calibration(recording.calibration, recording.view)
+    virtual, whole_frame_pose = virtual_ptz(calibration, recording.recorded_size_px, scenario.camera.image_size_px)
     offsets = scenario.action_grid()
     grid = ActionGrid(
         offsets.pan_deg + whole_frame_pose[0], offsets.tilt_deg + whole_frame_pose[1], offsets.zoom, offsets.max_steps
@@ -88,7 +95,11 @@ def build_world(scenario: Scenario, scene_rng: np.random.Generator) -> World:
         hog = HogPeopleDetector(detector.hog_upsample, detector.hog_hit_threshold, detector.hog_nms_iou)
         video = RecordedVideo(recording.video, recording.recorded_size_px)
     backend = RecordedPTZ(virtual, scene, detector, recording.occluded_above, video, hog)
-    return World(virtual.camera, grid, scene.truth, backend, area_bounds_m)
+    if source == "registered":
+        pose_source = registered_pose_source(scenario, scene.video_frame)
+    else:
+        pose_source = SIMPLE_POSE_SOURCES[source]
+    return World(virtual.camera, grid, scene.truth, backend, area_bounds_m, pose_source)
 
 
 @dataclass(frozen=True)
@@ -98,7 +109,10 @@ class Episode:
     truth : the people.
     camera : the PTZ camera that looked; area_bounds_m : [[x0, y0], [x1, y1]] where people can be.
     actions : (T,) flat action index taken at each step.
-    poses : (T, 3) those actions as (pan_deg, tilt_deg, zoom).
+    poses : (T, 3) the poses the camera took, as (pan_deg, tilt_deg, zoom): the actions' poses
+        unless ``camera.pose_error`` is set.
+    tracker_poses : (T, 3) the poses the tracker mapped detections with (``pose_feedback.source``).
+    pose_known : (T,) whether the pose source gave a pose; where not, the tracker used the commanded one.
     tracks : per step, the tracks reported after that step's update (the confirmed ones).
     detections : per step, what the detector reported.
     """
@@ -108,6 +122,8 @@ class Episode:
     area_bounds_m: np.ndarray
     actions: np.ndarray
     poses: np.ndarray
+    tracker_poses: np.ndarray
+    pose_known: np.ndarray
     tracks: list[Tracks]
     detections: list[Detections]
 
@@ -146,8 +162,8 @@ def make_policy(name: str, scenario: Scenario, world: World) -> Policy:
 
 
 def _episode_seeds(seed: int) -> list[np.random.SeedSequence]:
-    """The independent streams of an episode: scene, detector, policy."""
-    return np.random.SeedSequence(seed).spawn(3)
+    """The independent streams of an episode: scene, detector, policy, the camera's landing errors."""
+    return np.random.SeedSequence(seed).spawn(4)
 
 
 def episode_world(scenario: Scenario, seed: int) -> World:
@@ -159,34 +175,43 @@ def episode_world(scenario: Scenario, seed: int) -> World:
 def run_episode(scenario: Scenario, policy_name: str, seed: int) -> Episode:
     """Run one closed-loop episode of the scenario: at most ``scenario.frames`` steps."""
     world = episode_world(scenario, seed)
-    _, detector_seed, policy_seed = _episode_seeds(seed)
+    _, detector_seed, policy_seed, landing_seed = _episode_seeds(seed)
     steps = world.truth.positions_m.shape[0]
     policy = make_policy(policy_name, scenario, world)
     frame_seeds = detector_seed.spawn(steps)
     policy_rng = np.random.default_rng(policy_seed)
+    landing_rng = np.random.default_rng(landing_seed)
     F, U = constant_velocity_model(1.0 / scenario.frame_rate_hz, scenario.tracker.acceleration_sigma_m_s2)
     V = pixel_noise_covariance(scenario.detector)
 
     action = widest_view_action(world.camera, world.grid, world.area_bounds_m)
     tracks = no_tracks()
-    actions, track_history, detection_history = [], [], []
+    actions, poses, tracker_poses, pose_known, track_history, detection_history = [], [], [], [], [], []
     for step in range(steps):
         tracks = predict_tracks(tracks, F, U)
         context = DecisionContext(step, action, world.grid.reachable(action), tracks, policy_rng)
-        action = policy.choose(context)
-        pose = world.grid.poses[action]
+        previous_action, action = action, policy.choose(context)
+        commanded = world.grid.poses[action]
+        if step == 0 or action != previous_action:
+            pose = landed_pose(commanded, scenario.camera.pose_error, landing_rng)
         detections = world.backend.observe(step, pose, np.random.default_rng(frame_seeds[step]))
-        tracks = update_tracks(tracks, detections.feet_px, world.camera, pose, V, scenario.tracker)
+        believed = world.pose_source(step, commanded, pose)
+        tracker_pose = commanded if believed is None else believed
+        tracks = update_tracks(tracks, detections.feet_px, world.camera, tracker_pose, V, scenario.tracker)
         actions.append(action)
+        poses.append(pose)
+        tracker_poses.append(tracker_pose)
+        pose_known.append(believed is not None)
         track_history.append(tracks.confirmed(scenario.tracker))
         detection_history.append(detections)
-    actions = np.asarray(actions)
     return Episode(
         world.truth,
         world.camera,
         world.area_bounds_m,
-        actions,
-        world.grid.poses[actions],
+        np.asarray(actions),
+        np.asarray(poses),
+        np.asarray(tracker_poses),
+        np.asarray(pose_known),
         track_history,
         detection_history,
     )

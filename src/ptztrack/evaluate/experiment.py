@@ -174,9 +174,9 @@ def format_table(summary: Sequence[dict], title: str = "") -> str:
     return "\n".join(lines)
 
 
-def print_progress(done: int, total: int) -> None:
+def print_progress(done: int, total: int, noun: str = "episodes") -> None:
     """Progress on stderr: one line rewritten in a terminal, a line per tenth in a log."""
     if sys.stderr.isatty():
-        print(f"\r{done}/{total} episodes", end="\n" if done == total else "", file=sys.stderr, flush=True)
+        print(f"\r{done}/{total} {noun}", end="\n" if done == total else "", file=sys.stderr, flush=True)
     elif done == total or done % max(1, total // 10) == 0:
-        print(f"{done}/{total} episodes", file=sys.stderr, flush=True)
+        print(f"{done}/{total} {noun}", file=sys.stderr, flush=True)

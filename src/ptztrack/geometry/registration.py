@@ -31,19 +31,48 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import cv2
+import networkx as nx
 import numpy as np
 from scipy.optimize import least_squares
 from scipy.sparse import lil_matrix
 
 from ptztrack.files import write_atomically
-from ptztrack.geometry.ptz import PTZCamera, intrinsics, rotation_world_to_camera
+from ptztrack.geometry.ptz import PTZCamera, apply_homography, inside_image, intrinsics, rotation_world_to_camera
 
 RATIO_TEST = 0.75
 RANSAC_THRESHOLD_PX = 3.0
 MIN_INLIERS = 12
+# SIFT runs on the image halved: OpenCV's SIFT doubles its input first, so at full size a 640 x 480
+# view costs over 100 ms, and a PTZ view zoomed past the recording's resolution holds no detail at
+# the finest scales anyway. Keypoints are reported in full-size pixels.
+SIFT_IMAGE_SCALE = 0.5
+# A PTZ view zoomed in on the recording is an enlarged, blurred image: at SIFT's default contrast
+# threshold (0.04) a 3.4x view of PETS has 12 features, at 0.01 it has the 1000 asked for (the
+# strongest are kept, so a sharp view loses nothing).
+SIFT_CONTRAST_THRESHOLD = 0.01
+# Reference views whose predicted overlap (from their rough poses) is below this fraction of a view are
+# not matched: their matches could only be wrong, and matching every pair costs O(L^2).
+MIN_PAIR_OVERLAP = 0.2
+# A pair of reference views ties their poses together in bundle adjustment only with this many RANSAC
+# inliers: a dozen chance matches can agree on a homography, a few dozen cannot.
+MIN_PAIR_INLIERS = 30
+# Overlapping reference views share most features, so the ratio test must compare a live feature's two
+# nearest neighbours within one reference view: against all views at once, the second nearest is the
+# same scene point in another view, and the test rejects nearly everything (98 % of PETS matches).
+# One FLANN search for this many neighbours over all views gives every view's two nearest, or shows
+# that a view's second nearest lies beyond the last neighbour found.
+NEIGHBOURS = 8
+# The reference views with most ratio-tested matches whose RANSAC homographies are tried.
+CANDIDATE_VIEWS = 2
+# Leaves the FLANN search visits: 32 costs 60 % of 64 (the default) and finds the same views.
+FLANN_CHECKS = 32
 # Correspondences per pair of reference views that bundle adjustment uses (evenly spread over the
 # inliers): enough to pin three parameters per view many times over, few enough to stay fast.
 BUNDLE_POINTS_PER_PAIR = 40
+
+
+class RegistrationIndexError(ValueError):
+    """A reference index file that cannot be read; the message names the file."""
 
 
 @dataclass(frozen=True)
@@ -65,19 +94,27 @@ class ReferenceIndex:
     def __post_init__(self):
         # One k-d tree forest over every reference descriptor: a live view is matched against all
         # reference views at once, in tens of milliseconds rather than a brute-force second.
-        matcher = cv2.FlannBasedMatcher({"algorithm": 1, "trees": 4}, {"checks": 64})
+        matcher = cv2.FlannBasedMatcher({"algorithm": 1, "trees": 4}, {"checks": FLANN_CHECKS})
         matcher.add([self.descriptors])
         matcher.train()
         object.__setattr__(self, "matcher", matcher)
 
 
 def sift_features(image_bgr: np.ndarray, features: int = 1000) -> tuple[np.ndarray, np.ndarray]:
-    """Keypoint positions (K, 2) px and descriptors (K, 128) float32 of an image."""
+    """Keypoint positions (K, 2) px and descriptors (K, 128) float32 of an image.
+
+    Positions are in the camera model's pixel coordinates: pixel (row, col) has its centre at
+    (col + 0.5, row + 0.5).
+    """
     gray = cv2.cvtColor(image_bgr, cv2.COLOR_BGR2GRAY)
-    keypoints, descriptors = cv2.SIFT_create(nfeatures=features).detectAndCompute(gray, None)
+    halved = cv2.resize(gray, None, fx=SIFT_IMAGE_SCALE, fy=SIFT_IMAGE_SCALE, interpolation=cv2.INTER_AREA)
+    keypoints, descriptors = cv2.SIFT_create(nfeatures=features, contrastThreshold=SIFT_CONTRAST_THRESHOLD).detectAndCompute(
+        halved, None
+    )
     if descriptors is None:
         return np.zeros((0, 2)), np.zeros((0, 128), dtype=np.float32)
-    return np.array([k.pt for k in keypoints], dtype=float), descriptors
+    # OpenCV puts pixel centres at whole coordinates.
+    return (np.array([k.pt for k in keypoints], dtype=float) + 0.5) / SIFT_IMAGE_SCALE, descriptors
 
 
 def ratio_matches(query: np.ndarray, train: np.ndarray, ratio: float = RATIO_TEST) -> np.ndarray:
@@ -138,38 +175,78 @@ def bundle_adjust(camera: PTZCamera, initial_poses, matches: list[tuple[int, int
     return np.vstack([initial_poses[:1], result.x.reshape(-1, 3)])
 
 
-def pairwise_matches(keypoints: list, descriptors: list) -> list[tuple[int, int, np.ndarray, np.ndarray]]:
-    """RANSAC-inlier correspondences (at most ``BUNDLE_POINTS_PER_PAIR``) between every pair of views with
-    enough of them."""
+def overlapping_pairs(camera: PTZCamera, poses, min_overlap: float = MIN_PAIR_OVERLAP) -> list[tuple[int, int]]:
+    """Pairs (i, j), i < j, of views at ``poses`` (L, 3) that share at least ``min_overlap`` of one of them.
+
+    The overlap is the fraction of a 12 x 9 grid of one view's pixels that the rotation homography
+    carries, in front of the camera, into the other view; the larger of the two directions counts, so
+    a zoomed view inside a wide one overlaps it fully.
+    """
+    poses = np.asarray(poses, dtype=float)
+    u, v = np.meshgrid(
+        np.linspace(0, camera.image_width_px, 12), np.linspace(0, camera.image_height_px, 9)
+    )
+    grid = np.c_[u.ravel(), v.ravel(), np.ones(u.size)]
+    H = rotation_homography(camera, poses[:, None], poses[None, :])  # (L, L, 3, 3): view i -> view j
+    mapped = np.einsum("ijab,nb->ijna", H, grid)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        inside = (mapped[..., 2] > 0) & inside_image(camera, mapped[..., :2] / mapped[..., 2:])
+    overlap = inside.mean(axis=-1)
+    overlap = np.maximum(overlap, overlap.T)
+    return [(i, j) for i, j in zip(*np.nonzero(np.triu(overlap >= min_overlap, k=1)))]
+
+
+def pairwise_matches(keypoints: list, descriptors: list, pairs) -> list[tuple[int, int, np.ndarray, np.ndarray]]:
+    """RANSAC-inlier correspondences (at most ``BUNDLE_POINTS_PER_PAIR``, evenly spread) between the
+    views of each pair (i, j) that has at least ``MIN_PAIR_INLIERS`` of them."""
     found = []
-    for i in range(len(keypoints)):
-        for j in range(i + 1, len(keypoints)):
-            pairs = ratio_matches(descriptors[i], descriptors[j])
-            if len(pairs) < MIN_INLIERS:
-                continue
-            points_i, points_j = keypoints[i][pairs[:, 0]], keypoints[j][pairs[:, 1]]
-            _, inliers = cv2.findHomography(points_i, points_j, cv2.RANSAC, RANSAC_THRESHOLD_PX)
-            if inliers is not None and inliers.sum() >= MIN_INLIERS:
-                keep = np.flatnonzero(inliers.ravel())
-                keep = keep[np.linspace(0, len(keep) - 1, min(len(keep), BUNDLE_POINTS_PER_PAIR)).astype(int)]
-                found.append((i, j, points_i[keep], points_j[keep]))
+    for i, j in pairs:
+        matched = ratio_matches(descriptors[i], descriptors[j])
+        if len(matched) < MIN_PAIR_INLIERS:
+            continue
+        points_i, points_j = keypoints[i][matched[:, 0]], keypoints[j][matched[:, 1]]
+        _, inliers = cv2.findHomography(points_i, points_j, cv2.RANSAC, RANSAC_THRESHOLD_PX)
+        if inliers is not None and inliers.sum() >= MIN_PAIR_INLIERS:
+            keep = np.flatnonzero(inliers.ravel())
+            keep = keep[np.linspace(0, len(keep) - 1, min(len(keep), BUNDLE_POINTS_PER_PAIR)).astype(int)]
+            found.append((int(i), int(j), points_i[keep], points_j[keep]))
     return found
+
+
+def tied_to_first(view_count: int, matches) -> np.ndarray:
+    """(L,) bool: views joined to view 0 through matched pairs. Only these get their pose from bundle
+    adjustment; a view in no pair, or in a group of its own, would keep its rough pose."""
+    graph = nx.Graph()
+    graph.add_nodes_from(range(view_count))
+    graph.add_edges_from((i, j) for i, j, _, _ in matches)
+    tied = np.zeros(view_count, dtype=bool)
+    tied[list(nx.node_connected_component(graph, 0))] = True
+    return tied
 
 
 def build_index(camera: PTZCamera, images: list[np.ndarray], initial_poses, features: int = 1000) -> ReferenceIndex:
     """Reference views of the field of regard: SIFT, pairwise homographies, bundle adjustment.
 
     images : the views, taken at poses known roughly (``initial_poses`` (L, 3), the first exactly).
+    Views that no chain of well-matched pairs ties to the first are left out of the index (a view
+    mostly outside the scene, or of a featureless region, cannot be placed); the index keeps the
+    others in their order.
     """
+    initial_poses = np.asarray(initial_poses, dtype=float)
     extracted = [sift_features(image, features) for image in images]
-    keypoints = [k for k, _ in extracted]
-    descriptors = [d for _, d in extracted]
-    poses = bundle_adjust(camera, initial_poses, pairwise_matches(keypoints, descriptors))
+    matches = pairwise_matches(
+        [k for k, _ in extracted], [d for _, d in extracted], overlapping_pairs(camera, initial_poses)
+    )
+    tied = tied_to_first(len(images), matches)
+    renumbered = np.cumsum(tied) - 1
+    kept_matches = [(renumbered[i], renumbered[j], a, b) for i, j, a, b in matches if tied[i]]
+    poses = bundle_adjust(camera, initial_poses[tied], kept_matches)
+    kept = [extracted[view] for view in np.flatnonzero(tied)]
     return ReferenceIndex(
         poses=poses,
-        keypoints_px=np.concatenate(keypoints),
-        descriptors=np.concatenate(descriptors),
-        view=np.concatenate([np.full(len(k), index) for index, k in enumerate(keypoints)]),
+        keypoints_px=np.concatenate([k for k, _ in kept]),
+        descriptors=np.concatenate([d for _, d in kept]),
+        view=np.concatenate([np.full(len(k), view) for view, (k, _) in enumerate(kept)]),
         image_size_px=(camera.image_width_px, camera.image_height_px),
     )
 
@@ -190,7 +267,8 @@ def save_index(path: str | Path, index: ReferenceIndex) -> None:
 
 
 def load_index(path: str | Path) -> ReferenceIndex:
-    """Read an index written by :func:`save_index`; a missing or malformed file raises ValueError naming it."""
+    """Read an index written by :func:`save_index`; a missing or malformed file raises
+    :class:`RegistrationIndexError` naming it."""
     try:
         with np.load(path) as data:
             return ReferenceIndex(
@@ -201,9 +279,9 @@ def load_index(path: str | Path) -> ReferenceIndex:
                 image_size_px=tuple(int(x) for x in data["image_size_px"]),
             )
     except FileNotFoundError:
-        raise ValueError(f"{path}: no such registration index") from None
+        raise RegistrationIndexError(f"{path}: no such registration index") from None
     except (KeyError, ValueError, OSError) as error:
-        raise ValueError(f"{path}: not a registration index ({error})") from None
+        raise RegistrationIndexError(f"{path}: not a registration index ({error})") from None
 
 
 def focal_from_homography(H_reference_to_live: np.ndarray, reference_focal_px: float) -> float:
@@ -233,26 +311,52 @@ class Registration:
     inliers: int
 
 
+def within_view_ratio_matches(index: ReferenceIndex, descriptors: np.ndarray, ratio: float = RATIO_TEST) -> np.ndarray:
+    """(M, 2) index pairs (live feature, reference feature) that pass Lowe's ratio test within the
+    reference feature's view: its distance is below ``ratio`` times that of the next nearest feature of
+    the same view (or of the last of the ``NEIGHBOURS`` found, when none of them is of that view)."""
+    found = index.matcher.knnMatch(descriptors, k=NEIGHBOURS)
+    found = [row for row in found if len(row) == NEIGHBOURS]
+    if not found:
+        return np.zeros((0, 2), dtype=int)
+    query = np.array([row[0].queryIdx for row in found])
+    train = np.array([[m.trainIdx for m in row] for row in found])  # (Q, N), nearest first
+    distance = np.array([[m.distance for m in row] for row in found])
+    views = index.view[train]
+    same_view = views[:, :, None] == views[:, None, :]  # (Q, N, N)
+    earlier = np.tril(np.ones((NEIGHBOURS, NEIGHBOURS), dtype=bool), k=-1)
+    first_of_view = ~(same_view & earlier).any(axis=2)
+    later_same = same_view & earlier.T
+    next_distance = np.where(later_same, distance[:, None, :], np.inf).min(axis=2)
+    next_distance = np.minimum(next_distance, np.where(later_same.any(axis=2), np.inf, distance[:, -1:]))
+    passed = first_of_view & (distance < ratio * next_distance)
+    rows, columns = np.nonzero(passed)
+    return np.c_[query[rows], train[rows, columns]]
+
+
 def register(camera: PTZCamera, index: ReferenceIndex, image_bgr: np.ndarray, features: int = 1000) -> Registration | None:
-    """Register a live view against the index; None when no reference view shares enough features."""
+    """Register a live view against the index; None when no reference view shares enough features.
+
+    Of the reference views with most ratio-tested matches, the one whose RANSAC homography has most
+    inliers is the paper's I_m.
+    """
     keypoints, descriptors = sift_features(image_bgr, features)
     if len(descriptors) < MIN_INLIERS:
         return None
-    pairs = np.array(
-        [(m.queryIdx, m.trainIdx) for m, n in index.matcher.knnMatch(descriptors, k=2) if m.distance < RATIO_TEST * n.distance],
-        dtype=int,
-    ).reshape(-1, 2)
-    if len(pairs) < MIN_INLIERS:
-        return None
+    pairs = within_view_ratio_matches(index, descriptors)
     views = index.view[pairs[:, 1]]
-    best = int(np.bincount(views).argmax())
-    chosen = pairs[views == best]
-    if len(chosen) < MIN_INLIERS:
-        return None
-    H_live_to_reference, inliers = cv2.findHomography(
-        keypoints[chosen[:, 0]], index.keypoints_px[chosen[:, 1]], cv2.RANSAC, RANSAC_THRESHOLD_PX
-    )
-    if H_live_to_reference is None or inliers.sum() < MIN_INLIERS:
+    votes = np.bincount(views, minlength=len(index.poses))
+    best, best_inliers = -1, None
+    for view in np.argsort(-votes, kind="stable")[:CANDIDATE_VIEWS]:
+        if votes[view] < MIN_INLIERS:
+            break
+        chosen = pairs[views == view]
+        live_px, reference_px = keypoints[chosen[:, 0]], index.keypoints_px[chosen[:, 1]]
+        H, inliers = cv2.findHomography(live_px, reference_px, cv2.RANSAC, RANSAC_THRESHOLD_PX)
+        if H is not None and inliers.sum() >= MIN_INLIERS and (best < 0 or inliers.sum() > len(best_inliers[0])):
+            keep = inliers.ravel().astype(bool)
+            best, H_live_to_reference, best_inliers = int(view), H, (live_px[keep], reference_px[keep])
+    if best < 0:
         return None
     reference_pose = index.poses[best]
     K_reference = intrinsics(camera, reference_pose[2])
@@ -267,15 +371,14 @@ def register(camera: PTZCamera, index: ReferenceIndex, image_bgr: np.ndarray, fe
         rotation = -rotation
     R_live = rotation @ rotation_world_to_camera(reference_pose[0], reference_pose[1])
     pan_deg, tilt_deg = pose_from_rotation(R_live)
-    keep = inliers.ravel().astype(bool)
-    pose = refine_pose(
-        camera,
-        reference_pose,
-        index.keypoints_px[chosen[keep, 1]],
-        keypoints[chosen[keep, 0]],
-        np.array([pan_deg, tilt_deg, focal_px / camera.f_min_px]),
-    )
-    return Registration(pose, pose[2] * camera.f_min_px, best, int(keep.sum()))
+    live_px, reference_px = best_inliers
+    pose = refine_pose(camera, reference_pose, reference_px, live_px, np.array([pan_deg, tilt_deg, focal_px / camera.f_min_px]))
+    # The homography of a narrow view leaves its perspective part (and so eq. 2) poorly pinned; the
+    # three-parameter camera is not, but the inliers must then fit it, as they fit a true rotation.
+    fitted = np.linalg.norm(apply_homography(rotation_homography(camera, reference_pose, pose), reference_px) - live_px, axis=1)
+    if np.count_nonzero(fitted <= RANSAC_THRESHOLD_PX) < max(MIN_INLIERS, len(live_px) / 2):
+        return None
+    return Registration(pose, pose[2] * camera.f_min_px, best, int(np.count_nonzero(fitted <= RANSAC_THRESHOLD_PX)))
 
 
 def refine_pose(camera: PTZCamera, reference_pose, reference_px, live_px, initial_pose) -> np.ndarray:
