@@ -3,6 +3,8 @@ import pytest
 
 from ptztrack.camera.virtual import virtual_ptz
 from ptztrack.config import Tracker, pets_scenario
+from ptztrack.episode import run_episode
+from ptztrack.evaluate.metrics import episode_metrics
 from ptztrack.geometry.calibration import load_calibration
 from ptztrack.geometry.ptz import (
     PTZCamera,
@@ -84,7 +86,8 @@ def test_the_search_radius_is_three_sigma_of_the_innovation_clipped():
 def test_a_moved_person_is_found_at_the_new_feet():
     before_px, after_px = np.array([320.0, 300.0]), np.array([323.0, 298.0])
     background = noise_image(0)
-    templates = refresh_templates({}, [0], draw_person(background, before_px), CAMERA, POSE, [0], [before_px], HEIGHT_M, WIDTH_M)
+    image = draw_person(background, before_px)
+    templates = refresh_templates({}, [0], image, CAMERA, POSE, [0], [before_px], HEIGHT_M, WIDTH_M)
     later = draw_person(noise_image(1), after_px)
     found = template_measurements(later, CAMERA, POSE, tracks_at([before_px]), templates, V, HEIGHT_M, WIDTH_M)
     np.testing.assert_array_equal(found.track_ids, [0])
@@ -94,10 +97,11 @@ def test_a_moved_person_is_found_at_the_new_feet():
 
 def test_a_person_gone_gives_no_measurement_unless_any_similarity_will_do():
     feet_px = np.array([320.0, 300.0])
-    templates = refresh_templates({}, [0], draw_person(noise_image(0), feet_px), CAMERA, POSE, [0], [feet_px], HEIGHT_M, WIDTH_M)
-    empty = noise_image(1)
-    assert len(template_measurements(empty, CAMERA, POSE, tracks_at([feet_px]), templates, V, HEIGHT_M, WIDTH_M).feet_px) == 0
-    anything = template_measurements(empty, CAMERA, POSE, tracks_at([feet_px]), templates, V, HEIGHT_M, WIDTH_M, min_similarity=0.0)
+    image = draw_person(noise_image(0), feet_px)
+    templates = refresh_templates({}, [0], image, CAMERA, POSE, [0], [feet_px], HEIGHT_M, WIDTH_M)
+    empty, tracks = noise_image(1), tracks_at([feet_px])
+    assert len(template_measurements(empty, CAMERA, POSE, tracks, templates, V, HEIGHT_M, WIDTH_M).feet_px) == 0
+    anything = template_measurements(empty, CAMERA, POSE, tracks, templates, V, HEIGHT_M, WIDTH_M, min_similarity=0.0)
     assert len(anything.feet_px) == 1 and anything.similarity[0] < MIN_SIMILARITY
 
 
@@ -110,7 +114,7 @@ def test_a_track_not_predicted_in_the_image_gives_no_measurement(ground_m, pose)
     image = draw_person(noise_image(0), [320.0, 300.0])
     templates = refresh_templates({}, [0], image, CAMERA, POSE, [0], [[320.0, 300.0]], HEIGHT_M, WIDTH_M)
     tracks = tracks_at([[320.0, 300.0]])
-    tracks = Tracks(tracks.ids, np.array([[*ground_m, 0.0, 0.0]]), tracks.covariance, tracks.missed_steps, tracks.hits, 1)
+    tracks = Tracks(tracks.ids, np.array([[*ground_m, 0.0, 0.0]]), tracks.covariance, tracks.missed_steps, tracks.hits)
     found = template_measurements(image, CAMERA, pose, tracks, templates, V, HEIGHT_M, WIDTH_M, min_similarity=0.0)
     assert len(found.feet_px) == len(found.track_ids) == 0
 
@@ -148,7 +152,9 @@ def test_each_detected_or_new_track_is_paired_with_its_detection(association):
     detections_px = np.array([[560.0, 350.0], [202.0, 299.0]])  # somebody new, and track 3 moved
     updated = update_tracks(predicted, detections_px, CAMERA, POSE, V, config)
     assert set(updated.ids) == {3, 4, 5}
-    track_ids, paired_px = detection_of_each_track(predicted, updated, detections_px, CAMERA, POSE, V, config.gate_probability)
+    track_ids, paired_px = detection_of_each_track(
+        predicted, updated, detections_px, CAMERA, POSE, V, config.gate_probability
+    )
     np.testing.assert_array_equal(track_ids, [3, 5])
     np.testing.assert_allclose(paired_px, detections_px[::-1], atol=1e-6)
 
@@ -176,7 +182,8 @@ def pets_view():
     for frame in (0, 2):
         rows = np.flatnonzero(truth.frame == frame)
         views[frame] = virtual.render(video.frame(frame), pose)
-        people[frame] = (truth.person_id[rows], truth.ground_m[rows], virtual.recorded_to_virtual(truth.feet_px[rows], pose))
+        feet_px = virtual.recorded_to_virtual(truth.feet_px[rows], pose)
+        people[frame] = (truth.person_id[rows], truth.ground_m[rows], feet_px)
     return virtual.camera, pose, views, people
 
 
@@ -187,7 +194,7 @@ def test_pets_people_are_found_two_frames_later_near_their_annotated_feet(pets_v
     np.testing.assert_array_equal(later_ids, ids)
     count = len(ids)
     covariance = np.zeros((count, 4, 4))
-    covariance[:, :2, :2] = 0.3**2 * np.eye(2)  # metres: a 3-sigma radius of 18-24 px here
+    covariance[:, :2, :2] = 0.3**2 * np.eye(2)  # m^2: search radii of 16-20 px here
     tracks = Tracks(ids, np.c_[ground_m, np.zeros((count, 2))], covariance, np.zeros(count, int), np.ones(count, int))
     templates = refresh_templates({}, ids, views[0], camera, pose, ids, feet_px, HEIGHT_M, WIDTH_M)
     found = template_measurements(views[2], camera, pose, tracks, templates, V, HEIGHT_M, WIDTH_M)
@@ -196,3 +203,13 @@ def test_pets_people_are_found_two_frames_later_near_their_annotated_feet(pets_v
     assert np.max(np.linalg.norm(later_feet_px - feet_px, axis=1)) > 4.0
     assert np.all(np.linalg.norm(found.feet_px - later_feet_px, axis=1) < 2.0)
     assert np.all(found.similarity > 0.8)
+
+
+def test_between_detector_steps_the_closed_loop_measures_people_by_their_templates():
+    scenario = pets_scenario("ideal", frames=40, tracker={"measurement_source": "spatiogram", "detector_every_steps": 5})
+    episode = run_episode(scenario, "fix", 0)
+    between = [detections for step, detections in enumerate(episode.detections) if step % 5]
+    # The ideal detector names the person it saw; template matches know only their track.
+    assert all(np.all(detections.person_index == -1) for detections in between)
+    assert np.mean([len(detections.feet_px) for detections in between]) >= 2
+    assert episode_metrics(episode)["mota"] > 0.3

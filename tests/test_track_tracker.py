@@ -1,9 +1,18 @@
 import numpy as np
+import pytest
 
 from ptztrack.config import Tracker
 from ptztrack.geometry.ptz import PTZCamera, apply_homography, feet_jacobian, ground_to_image, look_at
+from ptztrack.track import kalman
 from ptztrack.track.kalman import constant_velocity_model
-from ptztrack.track.tracker import no_tracks, observation_matrix, predict_tracks, start_tracks, update_tracks
+from ptztrack.track.tracker import (
+    no_tracks,
+    observation_matrix,
+    predict_tracks,
+    start_tracks,
+    update_own_tracks,
+    update_tracks,
+)
 
 CAMERA = PTZCamera((7.5, -4.0, 7.0), 640, 480, 400.0)
 POSE = look_at(CAMERA, [7.5, 6.0], 1.0)
@@ -110,3 +119,28 @@ def test_with_confirmation_a_one_off_detection_is_never_reported_and_dies_at_its
     # Once confirmed, a track survives misses as before.
     tracks = update_tracks(predict_tracks(tracks, F, U), np.zeros((0, 2)), CAMERA, POSE, V, config)
     np.testing.assert_array_equal(tracks.confirmed(config).ids, [0])
+
+
+def test_a_track_measured_by_its_own_template_is_updated_without_becoming_more_or_less_alive():
+    tracks = start_tracks(feet_px(np.array([[7.0, 6.0], [9.0, 7.0]])), CAMERA, POSE, V, CONFIG, 0)
+    tracks = update_tracks(tracks, feet_px(np.array([[7.0, 6.0]])), CAMERA, POSE, V, CONFIG)  # track 1 missed
+    moved = feet_px(np.array([[9.1, 7.0]]))
+    updated = update_own_tracks(tracks, [1], moved, CAMERA, POSE, V, CONFIG)
+    np.testing.assert_array_equal(updated.ids, tracks.ids)
+    np.testing.assert_array_equal(updated.hits, tracks.hits)
+    np.testing.assert_array_equal(updated.missed_steps, tracks.missed_steps)
+    # Track 0 had no measurement; track 1 moved towards it, with the Kalman gain of its own covariance.
+    np.testing.assert_array_equal(updated.mean[0], tracks.mean[0])
+    C = observation_matrix(CAMERA, POSE, tracks.mean[1:])
+    expected, expected_covariance = kalman.update(
+        tracks.mean[1:], tracks.covariance[1:], moved - feet_px(tracks.mean[1:, :2]), C, V
+    )
+    np.testing.assert_allclose(updated.mean[1:], expected)
+    np.testing.assert_allclose(updated.covariance[1:], expected_covariance)
+    assert updated.mean[1, 0] > tracks.mean[1, 0]
+
+
+def test_a_measurement_of_a_dead_track_is_refused():
+    tracks = start_tracks(feet_px(np.array([[7.0, 6.0]])), CAMERA, POSE, V, CONFIG, 0)
+    with pytest.raises(ValueError, match=r"measurements of tracks \[5\], which are not alive"):
+        update_own_tracks(tracks, [5], feet_px(np.array([[7.0, 6.0]])), CAMERA, POSE, V, CONFIG)

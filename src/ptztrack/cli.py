@@ -158,8 +158,10 @@ def registration_experiment_command(args: argparse.Namespace) -> int:
         f"Registration of {summary['views']} live views at random reachable poses, {size[0]} x {size[1]} px, "
         f"against {len(index.poses)} reference views: {summary['registered']} registered"
     )
-    print(f"  focal length error  median {summary['focal_err_median_pct']:.3f} %   p90 {summary['focal_err_p90_pct']:.3f} %")
-    print(f"  ground error        median {summary['ground_err_median_m']:.3f} m   p90 {summary['ground_err_p90_m']:.3f} m")
+    for name, key, unit in (("focal length error", "focal_err", "pct"), ("ground error", "ground_err", "m")):
+        median, p90 = (_unless_failed(summary[f"{key}_{which}_{unit}"]) for which in ("median", "p90"))
+        symbol = "%" if unit == "pct" else unit
+        print(f"  {name:<19} median {median} {symbol}   p90 {p90} {symbol}")
     print(f"  time per view       median {summary['register_ms_median']:.0f} ms")
     print(
         f"\nClosed loop: {args.policy}, {scenario.detector.kind} detector, {scenario.tracker.association} association, "
@@ -178,6 +180,11 @@ def registration_experiment_command(args: argparse.Namespace) -> int:
         write_atomically(args.json, (json.dumps(document, indent=2) + "\n").encode())
         print(f"wrote {args.json}")
     return 0
+
+
+def _unless_failed(error: float | None) -> str:
+    """An error statistic, or what it means when it fell on views that were not registered."""
+    return "(unregistered views)" if error is None else f"{error:.3f}"
 
 
 def experiment_command(args: argparse.Namespace) -> int:

@@ -153,6 +153,11 @@ class Tracker(_Strict):
     1e-6 costs `intg` and `smpl` 2 MOTA points on the synthetic realistic
     table, 2e-5 costs 9); the PETS scenario with HOG sets it (see
     ``PETS_HOG_TRACKER``). The Hungarian association ignores it.
+    measurement_source : 'detector' (every step) or 'spatiogram' (the scale-invariant paper's
+    section 5: the detector runs every ``detector_every_steps`` steps, to start tracks and retake
+    each detected track's colour spatiogram; in between, each track is measured by searching for
+    its spatiogram around its prediction, at the scale the head/feet homology gives;
+    :mod:`ptztrack.track.templates`). Needs a recording with a video.
     """
 
     acceleration_sigma_m_s2: PositiveFloat = 1.5
@@ -163,6 +168,8 @@ class Tracker(_Strict):
     confirmation_hits: int = Field(1, ge=1)
     association: Literal["hungarian", "cjpdaf"] = "hungarian"
     clutter_density_per_px2: NonNegativeFloat = 0.0
+    measurement_source: Literal["detector", "spatiogram"] = "detector"
+    detector_every_steps: int = Field(5, ge=1)
 
 
 class Control(_Strict):
@@ -216,6 +223,8 @@ class Scenario(_Strict):
             raise ValueError("detector.kind 'hog' needs a recording with a video (recording.video)")
         if self.pose_feedback.source == "registered" and not has_video:
             raise ValueError("pose_feedback.source 'registered' needs a recording with a video (recording.video)")
+        if self.tracker.measurement_source == "spatiogram" and not has_video:
+            raise ValueError("tracker.measurement_source 'spatiogram' needs a recording with a video (recording.video)")
         return self
 
     @property

@@ -31,7 +31,22 @@ from ptztrack.detect.hog import HogPeopleDetector
 from ptztrack.scene.pets import RecordedVideo, load_mot_ground_truth, recorded_scene
 from ptztrack.scene.synthetic import GroundTruth, walk_people
 from ptztrack.track.kalman import constant_velocity_model
-from ptztrack.track.tracker import Tracks, no_tracks, pixel_noise_covariance, predict_tracks, update_tracks
+from ptztrack.track.templates import (
+    Templates,
+    detection_of_each_track,
+    refresh_templates,
+    template_box_px,
+    template_measurements,
+    template_noise_covariance,
+)
+from ptztrack.track.tracker import (
+    Tracks,
+    no_tracks,
+    pixel_noise_covariance,
+    predict_tracks,
+    update_own_tracks,
+    update_tracks,
+)
 
 POLICIES = ("fix", "patrol", "random", "intg", "smpl")
 
@@ -93,6 +108,7 @@ def build_world(scenario: Scenario, scene_rng: np.random.Generator) -> World:
     hog, video = None, None
     if detector.kind == "hog":
         hog = HogPeopleDetector(detector.hog_upsample, detector.hog_hit_threshold, detector.hog_nms_iou)
+    if detector.kind == "hog" or scenario.tracker.measurement_source == "spatiogram":
         video = RecordedVideo(recording.video, recording.recorded_size_px)
     backend = RecordedPTZ(virtual, scene, detector, recording.occluded_above, video, hog)
     if source == "registered":
@@ -172,6 +188,36 @@ def episode_world(scenario: Scenario, seed: int) -> World:
     return build_world(scenario, np.random.default_rng(scene_seed))
 
 
+def measure_and_update(
+    scenario: Scenario, world: World, step: int, tracks: Tracks, templates: Templates, pose, tracker_pose, rng
+) -> tuple[Tracks, Templates, Detections]:
+    """The tracker's update of a step, from the measurement source of ``scenario.tracker``.
+
+    tracks : predicted to the step; templates : each track's spatiogram (spatiogram source only);
+    pose : where the camera looks; tracker_pose : where the tracker believes it looks; rng : the
+    step's detector stream. Returns the updated tracks and templates, and the measurements.
+    """
+    config, camera = scenario.tracker, world.camera
+    V = pixel_noise_covariance(scenario.detector)
+    height_m, width_m = scenario.control.person_height_m, scenario.people.width_m
+    if config.measurement_source == "detector" or step % config.detector_every_steps == 0:
+        detections = world.backend.observe(step, pose, rng)
+        updated = update_tracks(tracks, detections.feet_px, camera, tracker_pose, V, config)
+        if config.measurement_source == "spatiogram":
+            ids, feet_px = detection_of_each_track(
+                tracks, updated, detections.feet_px, camera, tracker_pose, V, config.gate_probability
+            )
+            view = world.backend.view(step, pose)
+            templates = refresh_templates(templates, updated.ids, view, camera, tracker_pose, ids, feet_px, height_m, width_m)
+        return updated, templates, detections
+    found = template_measurements(world.backend.view(step, pose), camera, tracker_pose, tracks, templates, V, height_m, width_m)
+    noise = template_noise_covariance(camera, tracker_pose, found.feet_px, height_m, V)
+    updated = update_own_tracks(tracks, found.track_ids, found.feet_px, camera, tracker_pose, noise, config)
+    heights_px = template_box_px(camera, tracker_pose, found.feet_px, height_m, width_m)[:, 3]
+    detections = Detections(found.feet_px, heights_px, np.full(len(found.feet_px), -1))
+    return updated, templates, detections
+
+
 def run_episode(scenario: Scenario, policy_name: str, seed: int) -> Episode:
     """Run one closed-loop episode of the scenario: at most ``scenario.frames`` steps."""
     world = episode_world(scenario, seed)
@@ -182,10 +228,9 @@ def run_episode(scenario: Scenario, policy_name: str, seed: int) -> Episode:
     policy_rng = np.random.default_rng(policy_seed)
     landing_rng = np.random.default_rng(landing_seed)
     F, U = constant_velocity_model(1.0 / scenario.frame_rate_hz, scenario.tracker.acceleration_sigma_m_s2)
-    V = pixel_noise_covariance(scenario.detector)
 
     action = widest_view_action(world.camera, world.grid, world.area_bounds_m)
-    tracks = no_tracks()
+    tracks, templates = no_tracks(), {}
     actions, poses, tracker_poses, pose_known, track_history, detection_history = [], [], [], [], [], []
     for step in range(steps):
         tracks = predict_tracks(tracks, F, U)
@@ -194,10 +239,11 @@ def run_episode(scenario: Scenario, policy_name: str, seed: int) -> Episode:
         commanded = world.grid.poses[action]
         if step == 0 or action != previous_action:
             pose = landed_pose(commanded, scenario.camera.pose_error, landing_rng)
-        detections = world.backend.observe(step, pose, np.random.default_rng(frame_seeds[step]))
         believed = world.pose_source(step, commanded, pose)
         tracker_pose = commanded if believed is None else believed
-        tracks = update_tracks(tracks, detections.feet_px, world.camera, tracker_pose, V, scenario.tracker)
+        tracks, templates, detections = measure_and_update(
+            scenario, world, step, tracks, templates, pose, tracker_pose, np.random.default_rng(frame_seeds[step])
+        )
         actions.append(action)
         poses.append(pose)
         tracker_poses.append(tracker_pose)

@@ -43,10 +43,13 @@ class RecordedPTZ:
             return Detections(feet_px=feet_px, height_px=height_px, person_index=np.full(len(feet_px), -1))
         return self.observe_annotations(step, pose, rng)
 
+    def view(self, step: int, pose) -> np.ndarray:
+        """The virtual view (h, w, 3) uint8 BGR of ``step``'s recorded frame at ``pose``."""
+        return self.virtual.render(self.video.frame(int(self.scene.video_frame[step])), pose)
+
     def observe_hog_boxes(self, step: int, pose) -> np.ndarray:
         """HOG boxes (K, 4) (left, top, width, height) in the virtual view of ``step`` at ``pose``."""
-        view = self.virtual.render(self.video.frame(int(self.scene.video_frame[step])), pose)
-        return self.hog.detect(view)[0]
+        return self.hog.detect(self.view(step, pose))[0]
 
     def observe_annotations(self, step: int, pose, rng: np.random.Generator, pixel_noise: bool = True) -> Detections:
         """The ideal detector: annotated people fully in view and not occluded, feet with the detector's noise."""

@@ -45,7 +45,8 @@ def registration_errors(
     """Register ``views`` live views at random reachable poses of a recording scenario.
 
     One row per view: ``pose`` (pan_deg, tilt_deg, zoom), ``frame``, ``registered`` (bool),
-    ``focal_err_pct`` and ``ground_err_m`` (NaN when not registered), ``seconds`` (of registration).
+    ``focal_err_pct`` and ``ground_err_m`` (None when not registered, and the ground error also when
+    the view sees none of the walkable area), ``seconds`` (of registration).
     """
     recording = scenario.recording
     virtual, whole_frame_pose = registration_camera(scenario)
@@ -70,7 +71,7 @@ def registration_errors(
         start = time.perf_counter()
         result = register(camera, index, image)
         seconds = time.perf_counter() - start
-        focal_err_pct = ground_err_m = float("nan")
+        focal_err_pct = ground_err_m = None
         if result is not None:
             focal_err_pct = 100.0 * abs(result.focal_px / (pose[2] * camera.f_min_px) - 1.0)
             pixels = apply_homography(ground_to_image(camera, pose), ground_points_m)
@@ -94,18 +95,29 @@ def registration_errors(
 
 
 def summarise_registration(rows: Sequence[dict]) -> dict:
-    """Medians and 90th percentiles of the errors; a view that was not registered counts as an error
-    larger than any, so it raises the percentiles rather than vanishing from them."""
+    """Medians and 90th percentiles of the errors over the views.
+
+    A view that was not registered counts as an error larger than any, so it raises the percentiles
+    rather than vanishing from them; percentiles are order statistics (no interpolation with such
+    views), None when they fall on such a view. A registered view that sees none of the walkable area has no ground error and is left
+    out of the ground error's statistics only.
+    """
     registered = np.array([row["registered"] for row in rows])
-    focal = np.array([row["focal_err_pct"] if row["registered"] else np.inf for row in rows])
-    ground = np.array([row["ground_err_m"] if row["registered"] else np.inf for row in rows])
+    focal = np.array([row["focal_err_pct"] if row["registered"] else np.inf for row in rows], dtype=float)
+    ground = np.array([row["ground_err_m"] if row["registered"] else np.inf for row in rows], dtype=float)
+    ground = ground[~np.isnan(ground)]
+
+    def percentile(values, q):
+        value = float(np.percentile(values, q, method="inverted_cdf")) if len(values) else np.inf
+        return value if np.isfinite(value) else None
+
     return {
         "views": len(rows),
         "registered": int(registered.sum()),
-        "focal_err_median_pct": float(np.median(focal)),
-        "focal_err_p90_pct": float(np.percentile(focal, 90)),
-        "ground_err_median_m": float(np.nanmedian(ground)),
-        "ground_err_p90_m": float(np.nanpercentile(ground, 90)),
+        "focal_err_median_pct": percentile(focal, 50),
+        "focal_err_p90_pct": percentile(focal, 90),
+        "ground_err_median_m": percentile(ground, 50),
+        "ground_err_p90_m": percentile(ground, 90),
         "register_ms_median": float(1e3 * np.median([row["seconds"] for row in rows])),
     }
 

@@ -173,8 +173,9 @@ def recorded_scene(
 class RecordedVideo:
     """Frames of a video read forwards on demand, so that a long recording is never held in memory.
 
-    The closed loop asks for increasing frame indices; asking for an earlier
-    frame reopens the video.
+    The closed loop asks for increasing frame indices, the same one again
+    when a step looks at its frame twice (the last frame is kept); asking for
+    an earlier frame reopens the video.
     """
 
     def __init__(self, path: str | Path, expected_size_px=None):
@@ -187,9 +188,12 @@ class RecordedVideo:
     def _open(self) -> None:
         self._capture = cv2.VideoCapture(str(self.path))
         self._next = 0
+        self._last = None
 
     def frame(self, index: int) -> np.ndarray:
-        """Frame ``index`` (0-based) as (height, width, 3) uint8 BGR."""
+        """Frame ``index`` (0-based) as (height, width, 3) uint8 BGR (do not modify it: it is kept)."""
+        if index == self._next - 1:
+            return self._last
         if index < self._next:
             self._capture.release()
             self._open()
@@ -206,4 +210,5 @@ class RecordedVideo:
                 f"{self.path}: frames are {image.shape[1]}x{image.shape[0]} px, "
                 f"expected {self.expected_size_px[0]}x{self.expected_size_px[1]}"
             )
+        self._last = image
         return image

@@ -1,43 +1,47 @@
 """Spatiogram template matching as a measurement source (seed 002, section 5).
 
-Each track keeps a colour spatiogram of the person (:mod:`ptztrack.track.appearance`),
-taken from the box of a detection. At a step without detections, each track
-predicted in the image is searched for near its predicted feet, with boxes of
-the size a person must have there (from the head/feet homology of the pose),
-and a good enough match gives a feet pixel for that track: the paper's "scale
-invariant template matching inside [the] target search region".
+Each track keeps a colour spatiogram of its person (:mod:`ptztrack.track.appearance`),
+taken from the box of a detection. At a step, each track predicted in the
+image is searched for near its predicted feet, with boxes of the size a
+person must have there (from the head/feet homology of the pose), and a good
+enough match gives a feet pixel for that track: the paper's "scale invariant
+template matching inside [the] target search region".
 
-Thresholds, measured on PETS 2009 S2.L1 View_001 (frames 0-312, every 8th,
-templates at the annotated feet, boxes 1.75 m x 0.5 m from the homology;
-virtual 160 x 120 and 320 x 240 views at zoom 1-3; people 16-98 px tall):
+Thresholds, measured on PETS 2009 S2.L1 View_001 (every 8th frame of 0-312,
+templates at the annotated feet, boxes 1.75 m x 0.5 m from the homology,
+searched 2, 4 and 6 frames later; virtual 160 x 120 and 320 x 240 views at
+zoom 1-3, people 16-98 px tall):
 
 * The homology with 1.75 m gives the annotated box heights to a median
   ratio of 1.01 (10-90 %: 0.95-1.06).
-* Similarity of a template to its person 2 video frames later, at the best
-  box within half a body height of the annotated feet: 10th percentile 0.59
-  (160 x 120, zoom 1, people 16 px tall) and 0.75-0.85 in larger views. The
-  best box near empty ground scores 0.29-0.44 at the median and 0.49-0.58 at
-  the 90th percentile. ``MIN_SIMILARITY`` 0.6 keeps 89 % of the true matches
-  in the smallest view and 99-100 % in the others, and lets through 1-3 % of
-  searches over empty ground. Other people are not told apart by similarity
-  (34-80 % of searches centred on somebody else score 0.6 or more): keeping
-  the search inside the track's own uncertainty is what avoids them.
-* The found feet lie 3.5-6.5 % of the person's height from the annotated
-  ones at the median (1 px for 16 px people, 3.4 px for 98 px people), 7-13 %
-  at the 90th percentile: template measurements are noisier than the ideal
-  detector's 0.5 px.
-* Searches wider than needed rarely jump to another person: with radius a
-  quarter, a half, one and one and a half body heights around the true feet,
-  0, 1.9, 2.5 and 3.2 % of the matches land more than a quarter height away.
-* In closed-loop PETS runs (ideal detector, 'fix' and 'intg' policies), the
+* The best box within half a body height of the person 2 frames later
+  scores 0.59 at the 10th percentile in the smallest view (160 x 120, zoom
+  1, people 16 px tall) and 0.77-0.85 in the others; 6 frames later,
+  0.57-0.82. The best box near empty ground scores 0.29-0.44 at the median
+  and 0.49-0.58 at the 90th percentile. ``MIN_SIMILARITY`` 0.6 keeps 89 %
+  of the true matches in the smallest view and 99-100 % in the others, and
+  1-3 % of the searches over empty ground. Similarity does not tell people
+  apart (34-80 % of searches centred on somebody else reach 0.6): keeping
+  the search inside the track's own uncertainty does.
+* The found feet lie 3-6.5 % of the person's height from the annotated ones
+  at the median (1 px for 16 px people, 3.4 px for 98 px people) and
+  6.5-13.5 % at the 90th percentile: noisier than the ideal detector.
+* Boxes as wide as the annotated ones (0.36 of the height, 0.63 m) place the
+  feet a little better (90th percentile 11 % of the height in the smallest
+  view) but score empty ground higher (90th percentile 0.54-0.62), so
+  0.5 m separates the person from the background better.
+* Wider searches rarely jump to somebody else: with radii of a quarter, a
+  half, one and one and a half body heights around the true feet, 0, 1.9,
+  2.5 and 3.2 % of the matches land more than a quarter height away.
+* In closed-loop PETS runs (ideal detector, 'fix' and 'intg' policies) the
   3-sigma radius of the innovation covariance of tracks in view has median
-  3-9 px and 90th percentile 6-20 px; tracks re-found after the camera looked
-  away reach 100 px and more. ``MAX_RADIUS_PX`` 20 keeps the searches of
-  tracked people whole and bounds the cost (about 80 ms for a 100 px tall
-  person at 20 px radius), leaving lost tracks to the detector.
-  ``MIN_RADIUS_PX`` 3 is the 90th percentile of the localisation error of the
-  smallest people (2.2-2.9 px): an overconfident track still lets its
-  template settle where it fits.
+  3-9 px and 90th percentile 6-20 px; tracks found again after the camera
+  looked away reach 100 px and more. ``MAX_RADIUS_PX`` 20 keeps the searches
+  of tracked people whole and bounds the cost (about 80 ms for a 100 px tall
+  person), leaving lost tracks to the detector. ``MIN_RADIUS_PX`` 3 is the
+  90th percentile of the localisation error of the smallest people
+  (2.2-3.0 px): an overconfident track still lets its template settle where
+  it fits.
 """
 
 from typing import NamedTuple
@@ -52,6 +56,13 @@ from ptztrack.track.tracker import Tracks, associate, observation_matrix, predic
 MIN_SIMILARITY = 0.6
 MIN_RADIUS_PX = 3.0
 MAX_RADIUS_PX = 20.0
+# The noise the tracker assumes for template-found feet, 1 sigma per axis, as a fraction of the
+# person's height. One frame's error is 3-6.5 % of the height at the median (above), but the errors
+# of consecutive frames are not independent: a template that settles a little off its person stays
+# off. Trusting each match at 5 % made the PETS tracks (160 x 120 views, detector every 5th step)
+# so confident that the next detection fell outside their gates and started a second track: MOTA
+# fix -2 %, 'smpl' -76 %. At 10 % it was 31 % and 28 %, at 20 % 45 % and 50 %.
+NOISE_HEIGHT_FRACTION = 0.2
 SEARCH_SIGMAS = 3.0  # the search region is the 3-sigma extent of the innovation covariance
 
 Templates = dict[int, Spatiogram]
@@ -84,7 +95,9 @@ def template_box_px(camera: PTZCamera, pose, feet_px, person_height_m: float, pe
     return np.stack([feet_px[:, 0] - width_px / 2, head_px[:, 1], width_px, height_px], axis=-1)
 
 
-def detection_of_each_track(predicted: Tracks, updated: Tracks, feet_px, camera: PTZCamera, pose, V, gate_probability):
+def detection_of_each_track(
+    predicted: Tracks, updated: Tracks, feet_px, camera: PTZCamera, pose, V, gate_probability: float
+) -> tuple[np.ndarray, np.ndarray]:
     """Which detection each track was updated from or started at, after ``update_tracks``.
 
     predicted : the tracks given to :func:`~ptztrack.track.tracker.update_tracks`;
@@ -94,20 +107,19 @@ def detection_of_each_track(predicted: Tracks, updated: Tracks, feet_px, camera:
     born, and the feet (M, 2) px of their detections.
 
     A detected track (one whose hits grew) is paired with the detection the
-    Hungarian association gives it, which is the one that updated it under
-    the Hungarian association and the most likely one under the CJPDAF. A
-    new track's feet are its mean seen from ``pose``: the pixel of the
-    detection that started it.
+    Hungarian association gives it: the one that updated it under the
+    Hungarian association, the most likely one under the CJPDAF. A detection
+    the CJPDAF shares between tracks detects none of them, so it refreshes
+    no template. A new track's feet are its mean seen from ``pose``: the
+    pixel of the detection that started it.
     """
     feet_px = np.asarray(feet_px, dtype=float).reshape(-1, 2)
     predicted_px, in_front = predicted_feet_px(camera, pose, predicted.mean)
     S = kalman.innovation_covariance(predicted.covariance, observation_matrix(camera, pose, predicted.mean), V)
     track_index, detection_index = associate(predicted_px, in_front, S, feet_px, gate_probability)
     hits_after = dict(zip(updated.ids.tolist(), updated.hits.tolist()))
-    detected = np.array(
-        [hits_after.get(i, 0) > hits for i, hits in zip(predicted.ids[track_index], predicted.hits[track_index])],
-        dtype=bool,
-    )
+    hits_before = predicted.hits[track_index]
+    detected = np.array([hits_after.get(i, 0) > h for i, h in zip(predicted.ids[track_index], hits_before)], dtype=bool)
     born = updated.ids >= predicted.next_id
     born_px, _ = predicted_feet_px(camera, pose, updated.mean[born])
     ids = np.concatenate([predicted.ids[track_index][detected], updated.ids[born]])
@@ -145,7 +157,10 @@ def refresh_templates(
 
 
 def search_radius_px(S, min_radius_px: float = MIN_RADIUS_PX, max_radius_px: float = MAX_RADIUS_PX) -> np.ndarray:
-    """(n,) radii px of the circles around the 3-sigma ellipses of innovation covariances ``S`` (n, 2, 2) px^2, clipped."""
+    """Search radii (n,) px: the circles around the 3-sigma ellipses of innovation covariances ``S`` (n, 2, 2) px^2.
+
+    Clipped to ``[min_radius_px, max_radius_px]``.
+    """
     sigma_px = np.sqrt(np.linalg.eigvalsh(S)[:, -1])
     return np.clip(SEARCH_SIGMAS * sigma_px, min_radius_px, max_radius_px)
 
@@ -164,16 +179,17 @@ def template_measurements(
 ) -> TemplateMeasurements:
     """Feet of the tracked people found by their templates in ``image_bgr`` (h, w, 3) uint8 seen at ``pose``.
 
-    tracks : predicted to this step; V : (2, 2) px^2 the noise of the
-    measurements the innovation covariance ``S = C P C^T + V`` is formed with.
-    Each track with a template whose predicted feet lie in front of the
-    camera and in the image is searched for within :func:`search_radius_px`
-    of its predicted feet, with boxes of the person's size there
+    tracks : predicted to this step; V : (2, 2) px^2, the measurement noise
+    in the innovation covariance ``S = C P C^T + V`` that sets the search
+    radius (:func:`search_radius_px`). Each track with a template whose
+    predicted feet lie in front of the camera and in the image is searched
+    for around its predicted feet, with boxes of the person's size there
     (:func:`template_box_px`); the best match is a measurement when its
     similarity is at least ``min_similarity``.
 
-    Each measurement belongs to its track: a match that the tracker's
-    association leaves unassigned is that track's person, not a new one.
+    Each measurement belongs to its track and must not start a new one,
+    which ``update_tracks`` would do with a match its association leaves
+    unassigned.
     """
     predicted_px, in_front = predicted_feet_px(camera, pose, tracks.mean)
     S = kalman.innovation_covariance(tracks.covariance, observation_matrix(camera, pose, tracks.mean), V)
@@ -191,3 +207,10 @@ def template_measurements(
     return TemplateMeasurements(
         np.reshape(found_px, (-1, 2)), np.asarray(track_ids, dtype=int), np.asarray(scores, dtype=float)
     )
+
+
+def template_noise_covariance(camera: PTZCamera, pose, feet_px, person_height_m: float, V) -> np.ndarray:
+    """(K, 2, 2) px^2: the noise of template-found feet (K, 2) px, ``NOISE_HEIGHT_FRACTION`` of the
+    person's height there per axis, and never below the detector's ``V`` (2, 2)."""
+    height_px = template_box_px(camera, pose, feet_px, person_height_m, 1.0)[:, 3]
+    return np.maximum((NOISE_HEIGHT_FRACTION * height_px)[:, None, None] ** 2 * np.eye(2), V)

@@ -207,14 +207,7 @@ def update_tracks(tracks: Tracks, feet_px, camera: PTZCamera, pose, V, config: T
             C[track_index],
             V,
         )
-    missed = tracks.missed_steps + (in_front & inside_image(camera, predicted_px))
-    missed[track_index] = 0
-    hits = tracks.hits.copy()
-    hits[track_index] += 1
-    updated = replace(tracks, mean=mean, covariance=covariance, missed_steps=missed, hits=hits)
-    allowed_missed_steps = np.where(hits >= config.confirmation_hits, config.max_missed_steps, 0)
-    keep = (updated.missed_steps <= allowed_missed_steps) & (updated.position_sigma_m <= config.max_position_sigma_m)
-    survivors = updated.select(keep)
+    survivors, keep = _after_update(tracks, mean, covariance, track_index, predicted_px, in_front, camera, config)
     if config.association == "cjpdaf":
         unmatched = np.flatnonzero(~gated[keep].any(axis=0))
     else:
@@ -228,3 +221,41 @@ def update_tracks(tracks: Tracks, feet_px, camera: PTZCamera, pose, V, config: T
         hits=np.concatenate([survivors.hits, born.hits]),
         next_id=born.next_id,
     )
+
+
+def _after_update(tracks: Tracks, mean, covariance, track_index, predicted_px, in_front, camera: PTZCamera, config: Tracker):
+    """The updated tracks' misses, hits and deletions (see :func:`update_tracks`); returns the survivors
+    and which of the tracks survived (n,) bool."""
+    missed = tracks.missed_steps + (in_front & inside_image(camera, predicted_px))
+    missed[track_index] = 0
+    hits = tracks.hits.copy()
+    hits[track_index] += 1
+    updated = replace(tracks, mean=mean, covariance=covariance, missed_steps=missed, hits=hits)
+    allowed_missed_steps = np.where(hits >= config.confirmation_hits, config.max_missed_steps, 0)
+    keep = (updated.missed_steps <= allowed_missed_steps) & (updated.position_sigma_m <= config.max_position_sigma_m)
+    return updated.select(keep), keep
+
+
+def update_own_tracks(tracks: Tracks, track_ids, feet_px, camera: PTZCamera, pose, V, config: Tracker) -> Tracks:
+    """Update each track with its own measurement: no association, no new tracks, no missed steps.
+
+    track_ids : (K,) the track each measurement ``feet_px`` (K, 2) px belongs to (as template
+    matching finds them); V : (2, 2) or (K, 2, 2) px^2 their noise. Such measurements neither count
+    as hits nor clear missed steps: a template can settle on the background and keep matching it,
+    so only the detector confirms a track or keeps it alive. Tracks too uncertain are deleted as in
+    :func:`update_tracks`.
+    """
+    feet_px = np.asarray(feet_px, dtype=float).reshape(-1, 2)
+    index_of_id = {track_id: index for index, track_id in enumerate(tracks.ids.tolist())}
+    unknown = sorted(set(np.asarray(track_ids).tolist()) - set(index_of_id))
+    if unknown:
+        raise ValueError(f"measurements of tracks {unknown}, which are not alive")
+    track_index = np.array([index_of_id[track_id] for track_id in np.asarray(track_ids).tolist()], dtype=int)
+    predicted_px, _ = predicted_feet_px(camera, pose, tracks.mean)
+    C = observation_matrix(camera, pose, tracks.mean)
+    mean, covariance = tracks.mean.copy(), tracks.covariance.copy()
+    mean[track_index], covariance[track_index] = kalman.update(
+        tracks.mean[track_index], tracks.covariance[track_index], feet_px - predicted_px[track_index], C[track_index], V
+    )
+    updated = replace(tracks, mean=mean, covariance=covariance)
+    return updated.select(updated.position_sigma_m <= config.max_position_sigma_m)

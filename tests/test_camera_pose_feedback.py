@@ -1,0 +1,141 @@
+"""Where the camera looks: landing errors, the tracker's pose sources, and registration over PETS."""
+
+import numpy as np
+import pytest
+
+from ptztrack.camera import pose_feedback
+from ptztrack.config import PoseError, PoseFeedback, ScenarioError, pets_scenario, scenario_from_dict
+from ptztrack.episode import run_episode
+from ptztrack.evaluate.metrics import episode_metrics
+from ptztrack.evaluate.registration import registration_errors, summarise_registration
+from ptztrack.geometry.registration import register
+
+# Small enough to build in seconds, large enough to register most views (13 references at 480 x 360).
+SMALL_REGISTRATION = {"image_size_px": (480, 360), "reference_zooms": (1.0, 2.0), "reference_pan_steps": 3, "reference_tilt_steps": 2}
+
+
+def test_a_perfect_camera_lands_exactly_where_it_is_sent():
+    commanded = np.array([12.5, 20.0, 3.0])
+    landed = pose_feedback.landed_pose(commanded, PoseError(), np.random.default_rng(0))
+    np.testing.assert_array_equal(landed, commanded)
+
+
+def test_bias_and_noise_of_the_landing_pose_have_the_configured_size():
+    error = PoseError(pan_tilt_sigma_deg=2.0, pan_tilt_bias_deg=(1.0, -0.5), zoom_sigma=0.03, zoom_bias=1.1)
+    rng = np.random.default_rng(1)
+    commanded = np.array([10.0, 20.0, 2.0])
+    landed = np.array([pose_feedback.landed_pose(commanded, error, rng) for _ in range(20000)])
+    offset = landed - commanded
+    np.testing.assert_allclose(offset[:, :2].mean(axis=0), [1.0, -0.5], atol=0.05)
+    np.testing.assert_allclose(offset[:, :2].std(axis=0), [2.0, 2.0], rtol=0.03)
+    relative_zoom = landed[:, 2] / (commanded[2] * 1.1)
+    assert relative_zoom.mean() == pytest.approx(1.0, abs=1e-3)
+    assert relative_zoom.std() == pytest.approx(0.03, rel=0.03)
+
+
+def test_reference_poses_cover_the_grid_with_the_calibrated_view_first():
+    feedback = PoseFeedback(reference_zooms=(1.0, 2.0), reference_pan_steps=3, reference_tilt_steps=3)
+    poses = pose_feedback.reference_poses(np.array([50.0, 15.0, 1.0]), (-10.0, 10.0), (-5.0, 5.0), feedback)
+    np.testing.assert_array_equal(poses[0], [50.0, 15.0, 1.0])
+    # The grid's centre at zoom 1 is the calibrated view itself: listed once.
+    assert len(poses) == 2 * 3 * 3
+    assert len(np.unique(poses, axis=0)) == len(poses)
+    np.testing.assert_allclose([poses[:, 0].min(), poses[:, 0].max()], [40.0, 60.0])
+    np.testing.assert_allclose([poses[:, 1].min(), poses[:, 1].max()], [11.0, 19.0])
+    assert set(poses[:, 2]) == {1.0, 2.0}
+
+
+def test_a_registered_scenario_needs_a_video():
+    with pytest.raises(ScenarioError, match="pose_feedback.source 'registered' needs a recording with a video"):
+        scenario_from_dict({"pose_feedback": {"source": "registered"}})
+
+
+@pytest.fixture(scope="module")
+def small_registration(tmp_path_factory):
+    """The PETS scenario with a small reference index, cached in a file, and the index."""
+    path = tmp_path_factory.mktemp("index") / "index.npz"
+    scenario = pets_scenario("ideal", pose_feedback={**SMALL_REGISTRATION, "index": str(path)})
+    return scenario, pose_feedback.reference_index(scenario)
+
+
+def test_the_index_is_built_once_and_then_read_from_its_file(small_registration):
+    scenario, index = small_registration
+
+    def must_not_build():
+        raise AssertionError("the cached index should have been read")
+
+    again = pose_feedback.cached_reference_index(scenario.pose_feedback.index, must_not_build)
+    np.testing.assert_array_equal(again.poses, index.poses)
+    np.testing.assert_array_equal(again.descriptors, index.descriptors)
+
+
+def test_pets_views_register_to_a_fraction_of_a_percent_and_centimetres(small_registration):
+    scenario, index = small_registration
+    rows = registration_errors(scenario, index, views=8, seed=3)
+    summary = summarise_registration(rows)
+    assert summary["registered"] >= 6
+    assert summary["focal_err_median_pct"] < 0.5
+    assert summary["ground_err_median_m"] < 0.1
+
+
+def test_the_bundle_recovers_the_reference_poses_from_rough_ones(small_registration):
+    scenario, index = small_registration
+    virtual, whole_frame_pose = pose_feedback.registration_camera(scenario)
+    offsets = scenario.action_grid()
+    truth = pose_feedback.reference_poses(
+        whole_frame_pose,
+        (offsets.pan_deg.min(), offsets.pan_deg.max()),
+        (offsets.tilt_deg.min(), offsets.tilt_deg.max()),
+        scenario.pose_feedback,
+    )
+    # The rough poses were 0.5 deg and 3 % off; every view of this grid ties to the first.
+    assert len(index.poses) == len(truth)
+    np.testing.assert_allclose(index.poses[:, :2], truth[:, :2], atol=0.05)
+    np.testing.assert_allclose(index.poses[:, 2], truth[:, 2], rtol=0.005)
+
+
+def test_a_view_of_another_size_is_refused(small_registration):
+    scenario, index = small_registration
+    other = scenario.model_copy(
+        update={"pose_feedback": scenario.pose_feedback.model_copy(update={"image_size_px": (640, 480)})}
+    )
+    virtual, _ = pose_feedback.registration_camera(other)
+    with pytest.raises(ValueError, match="index is of 480x360 px views, but pose_feedback.image_size_px is 640x480"):
+        pose_feedback.RegisteredPose(virtual, index, None, np.zeros(1, dtype=int))
+
+
+def test_a_view_of_nothing_is_not_registered(small_registration):
+    scenario, index = small_registration
+    virtual, _ = pose_feedback.registration_camera(scenario)
+    assert register(virtual.camera, index, np.zeros((360, 480, 3), dtype=np.uint8)) is None
+
+
+def test_the_tracker_uses_the_commanded_the_true_or_the_registered_pose(small_registration):
+    scenario, _ = small_registration
+    scenario = scenario.model_copy(
+        update={
+            "frames": 12,
+            "camera": scenario.camera.model_copy(update={"pose_error": PoseError(pan_tilt_sigma_deg=2.0, zoom_sigma=0.02)}),
+        }
+    )
+    episodes = {}
+    for source in ("commanded", "oracle", "registered"):
+        feedback = scenario.pose_feedback.model_copy(update={"source": source})
+        episodes[source] = run_episode(scenario.model_copy(update={"pose_feedback": feedback}), "random", 0)
+    commanded, oracle, registered = episodes["commanded"], episodes["oracle"], episodes["registered"]
+    # The landing errors are their own random stream: the camera lands at the same poses whatever the tracker believes.
+    np.testing.assert_array_equal(commanded.actions, oracle.actions)
+    np.testing.assert_array_equal(commanded.poses, oracle.poses)
+    assert np.abs(commanded.poses[:, :2] - commanded.tracker_poses[:, :2]).max() > 1.0
+    np.testing.assert_array_equal(oracle.tracker_poses, oracle.poses)
+    known = registered.pose_known
+    assert known.mean() >= 0.75
+    np.testing.assert_allclose(registered.tracker_poses[known, :2], registered.poses[known, :2], atol=0.2)
+    assert episode_metrics(registered)["mota"] > episode_metrics(commanded)["mota"]
+
+
+def test_the_camera_stays_put_while_the_command_does_not_change():
+    scenario = scenario_from_dict({"frames": 15, "camera": {"pose_error": {"pan_tilt_sigma_deg": 1.0}}})
+    episode = run_episode(scenario, "fix", 0)
+    assert len(np.unique(episode.poses, axis=0)) == 1
+    assert np.abs(episode.poses - episode.tracker_poses).max() > 0
