@@ -108,3 +108,12 @@ def test_msg_experiment_prints_the_table_and_writes_rows_plot_and_trails(tmp_pat
     assert all({"scheduler", "nj_s", "m"} <= set(row) and 0 <= row["m"] <= 1 for row in rows)
     for name in ("figure7.png", "trails.png"):
         assert paths[name].read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_a_bad_registration_index_exits_2_naming_the_file(tmp_path, capsys):
+    bad = tmp_path / "index.npz"
+    bad.write_bytes(b"not an index")
+    assert main(["experiment", "registration", "--index", str(bad), "--views", "1"]) == 2
+    error = capsys.readouterr().err
+    assert f"{bad}: not a registration index" in error
+    assert "Traceback" not in error

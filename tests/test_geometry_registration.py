@@ -83,3 +83,41 @@ def test_an_index_survives_a_save_and_load(tmp_path):
     (tmp_path / "bad.npz").write_bytes(b"not an index")
     with pytest.raises(ValueError, match="not a registration index"):
         registration.load_index(tmp_path / "bad.npz")
+
+
+def test_the_ratio_test_compares_neighbours_within_one_reference_view():
+    rng = np.random.default_rng(0)
+    point, twin_a, twin_b = (rng.uniform(0, 100, 128) for _ in range(3))
+    descriptors = np.vstack(
+        [
+            point,  # 0, view 0: the live feature's scene point
+            point + 0.5,  # 1, view 1: the same point seen in an overlapping view
+            twin_a,  # 2, view 2: two features alike, which no ratio test can tell apart
+            twin_a + 0.5,  # 3, view 2
+            twin_b,  # 4, view 0
+            rng.uniform(0, 100, (6, 128)),  # 5-10: others, far from everything
+        ]
+    ).astype(np.float32)
+    view = np.array([0, 1, 2, 2, 0, 0, 1, 1, 2, 2, 0])
+    index = registration.ReferenceIndex(
+        np.zeros((3, 3)), np.zeros((len(view), 2)), descriptors, view, (640, 480)
+    )
+    # Each live feature lies as near to two reference features.
+    live = np.vstack([point + 0.25, twin_a + 0.25]).astype(np.float32)
+    pairs = {tuple(pair) for pair in registration.within_view_ratio_matches(index, live)}
+    # A ratio test over all views at once would reject the first live feature: its second nearest
+    # neighbour (1) is as near as its nearest (0).
+    assert pairs == {(0, 0), (0, 1)}
+
+
+def test_views_overlap_when_one_sees_much_of_the_other():
+    poses = np.array([[0.0, 20.0, 1.0], [10.0, 20.0, 1.0], [0.0, 20.0, 3.0], [130.0, 20.0, 1.0], [70.0, 20.0, 1.0]])
+    pairs = registration.overlapping_pairs(CAMERA, poses)
+    # A zoomed view inside a wide one overlaps it fully, though it covers a ninth of it; a view
+    # turned 130 degrees away overlaps nothing, and one 60 degrees away (of 65 seen) too little.
+    assert pairs == [(0, 1), (0, 2), (1, 2)]
+
+
+def test_only_views_tied_to_the_first_through_matched_pairs_are_kept():
+    matches = [(0, 1, None, None), (1, 3, None, None), (2, 4, None, None)]
+    np.testing.assert_array_equal(registration.tied_to_first(6, matches), [True, True, False, True, False, False])

@@ -57,15 +57,19 @@ def build_scenario(
     frames: int | None = None,
     recording_paths: dict | None = None,
     association: str | None = None,
+    measurement_source: str | None = None,
 ) -> Scenario:
     """The built-in synthetic or PETS scene or a YAML file, with command-line overrides applied.
 
     recording_paths : {'video' | 'calibration' | 'ground_truth': path} replacing the recording's files.
     association : 'hungarian' or 'cjpdaf', replacing ``tracker.association``.
+    measurement_source : 'detector' or 'spatiogram', replacing ``tracker.measurement_source``.
     """
     overrides = {f"recording.{key}": str(path) for key, path in (recording_paths or {}).items() if path is not None}
     if association is not None:
         overrides["tracker.association"] = association
+    if measurement_source is not None:
+        overrides["tracker.measurement_source"] = measurement_source
     if detector is not None:
         overrides["detector.kind"] = detector
     if frames is not None:
@@ -87,7 +91,9 @@ def format_metrics(metrics: dict) -> str:
 
 
 def run_command(args: argparse.Namespace) -> int:
-    scenario = build_scenario(args.scenario, args.detector, args.frames, recording_paths(args), args.association)
+    scenario = build_scenario(
+        args.scenario, args.detector, args.frames, recording_paths(args), args.association, args.measurement_source
+    )
     episode = run_episode(scenario, args.policy, args.seed)
     metrics = episode_metrics(episode)
     print(
@@ -136,6 +142,7 @@ def registration_experiment_command(args: argparse.Namespace) -> int:
         args.frames,
         recording_paths(args),
         args.association,
+        args.measurement_source,
     )
     if scenario.recording is None or scenario.recording.video is None:
         raise ScenarioError(f"{args.scenario}: the registration experiment needs a recording with a video")
@@ -194,13 +201,23 @@ def experiment_command(args: argparse.Namespace) -> int:
         return registration_experiment_command(args)
     if args.name == "pets":
         scenario = build_scenario(
-            "pets", args.detector or "ideal", args.frames, recording_paths(args), args.association
+            "pets",
+            args.detector or "ideal",
+            args.frames,
+            recording_paths(args),
+            args.association,
+            args.measurement_source,
         )
         cells = recording_cells(scenario, args.beta or [9.0, 1.0], args.strategies)
         title = f"PETS 2009 S2.L1 View_001, {scenario.detector.kind} detector, every 2nd frame"
     else:
         scenario = build_scenario(
-            args.scenario, args.detector or "realistic", args.frames, recording_paths(args), args.association
+            args.scenario,
+            args.detector or "realistic",
+            args.frames,
+            recording_paths(args),
+            args.association,
+            args.measurement_source,
         )
         cells = synthetic_cells(scenario, args.sequences, args.strategies)
         title = (
@@ -278,8 +295,14 @@ def parser() -> argparse.ArgumentParser:
 
 
 def _add_association_argument(command: argparse.ArgumentParser) -> None:
+    """The tracker's choices: association and measurement source."""
     command.add_argument(
         "--association", choices=("hungarian", "cjpdaf"), help="overrides the scenario's tracker.association"
+    )
+    command.add_argument(
+        "--measurement-source",
+        choices=("detector", "spatiogram"),
+        help="overrides the scenario's tracker.measurement_source (spatiogram: templates between detector steps)",
     )
 
 

@@ -208,9 +208,12 @@ def measure_and_update(
                 tracks, updated, detections.feet_px, camera, tracker_pose, V, config.gate_probability
             )
             view = world.backend.view(step, pose)
-            templates = refresh_templates(templates, updated.ids, view, camera, tracker_pose, ids, feet_px, height_m, width_m)
+            templates = refresh_templates(
+                templates, updated.ids, view, camera, tracker_pose, ids, feet_px, height_m, width_m
+            )
         return updated, templates, detections
-    found = template_measurements(world.backend.view(step, pose), camera, tracker_pose, tracks, templates, V, height_m, width_m)
+    view = world.backend.view(step, pose)
+    found = template_measurements(view, camera, tracker_pose, tracks, templates, V, height_m, width_m)
     noise = template_noise_covariance(camera, tracker_pose, found.feet_px, height_m, V)
     updated = update_own_tracks(tracks, found.track_ids, found.feet_px, camera, tracker_pose, noise, config)
     heights_px = template_box_px(camera, tracker_pose, found.feet_px, height_m, width_m)[:, 3]
