@@ -94,7 +94,8 @@ def run_command(args: argparse.Namespace) -> int:
     scenario = build_scenario(
         args.scenario, args.detector, args.frames, recording_paths(args), args.association, args.measurement_source
     )
-    episode = run_episode(scenario, args.policy, args.seed)
+    world = episode_world(scenario, args.seed)
+    episode = run_episode(scenario, args.policy, args.seed, world)
     metrics = episode_metrics(episode)
     print(
         f"scenario {args.scenario}, policy {args.policy}, detector {scenario.detector.kind}, "
@@ -103,8 +104,7 @@ def run_command(args: argparse.Namespace) -> int:
     print(format_metrics(metrics))
     if args.out is not None:
         title = f"{args.policy}, {scenario.detector.kind} detector, seed {args.seed}: MOTA {metrics['mota']:.1%}"
-        # The video draws the episode's world, rebuilt from the seed: the run's own is not kept.
-        write_outputs(args.out, episode, metrics, title, view_renderer(scenario, episode_world(scenario, args.seed)))
+        write_outputs(args.out, episode, metrics, title, view_renderer(scenario, world))
         names = ("metrics.json", "tracks.csv", "episode.png", "episode.mp4")
         print(f"wrote {', '.join(str(args.out / name) for name in names)}")
     return 0

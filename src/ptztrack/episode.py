@@ -221,9 +221,14 @@ def measure_and_update(
     return updated, templates, detections
 
 
-def run_episode(scenario: Scenario, policy_name: str, seed: int) -> Episode:
-    """Run one closed-loop episode of the scenario: at most ``scenario.frames`` steps."""
-    world = episode_world(scenario, seed)
+def run_episode(scenario: Scenario, policy_name: str, seed: int, world: World | None = None) -> Episode:
+    """Run one closed-loop episode of the scenario: at most ``scenario.frames`` steps.
+
+    world : ``episode_world(scenario, seed)``, when the caller has built it already (it is built
+    otherwise); a caller that also draws the episode's views needs it, and building it may mean
+    building a reference index.
+    """
+    world = world or episode_world(scenario, seed)
     _, detector_seed, policy_seed, landing_seed = _episode_seeds(seed)
     steps = world.truth.positions_m.shape[0]
     policy = make_policy(policy_name, scenario, world)

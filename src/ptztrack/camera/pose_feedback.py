@@ -124,12 +124,15 @@ def registration_camera(scenario: Scenario) -> tuple[VirtualPTZ, np.ndarray]:
     return virtual_ptz(calibration, recording.recorded_size_px, scenario.pose_feedback.image_size_px)
 
 
-def reference_index(scenario: Scenario) -> ReferenceIndex:
+def reference_index(scenario: Scenario, camera: tuple[VirtualPTZ, np.ndarray] | None = None) -> ReferenceIndex:
     """The reference index of a recording scenario: views over its action grid's pan and tilt range,
     rendered from the recording's frame ``REFERENCE_FRAME``. Read from ``pose_feedback.index`` when
-    that file exists; built otherwise (about a minute), and written there when a path is given."""
+    that file exists; built otherwise (about a minute), and written there when a path is given.
+
+    camera : ``registration_camera(scenario)``, when the caller has it already.
+    """
     recording, feedback = scenario.recording, scenario.pose_feedback
-    virtual, whole_frame_pose = registration_camera(scenario)
+    virtual, whole_frame_pose = camera or registration_camera(scenario)
     offsets = scenario.action_grid()
     poses = reference_poses(
         whole_frame_pose,
@@ -148,6 +151,6 @@ def reference_index(scenario: Scenario) -> ReferenceIndex:
 def registered_pose_source(scenario: Scenario, video_frame: np.ndarray) -> RegisteredPose:
     """The registered pose source of a recording scenario whose step ``t`` shows frame ``video_frame[t]``."""
     recording = scenario.recording
-    virtual, _ = registration_camera(scenario)
+    camera = registration_camera(scenario)
     video = RecordedVideo(recording.video, recording.recorded_size_px)
-    return RegisteredPose(virtual, reference_index(scenario), video, video_frame)
+    return RegisteredPose(camera[0], reference_index(scenario, camera), video, video_frame)

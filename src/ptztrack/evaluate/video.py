@@ -20,7 +20,7 @@ not in the pip wheels).
 import os
 import tempfile
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import cv2
@@ -146,13 +146,12 @@ def view_renderer(scenario: Scenario, world: World) -> RenderView:
     if scenario.recording is None:
         return lambda step, pose: model_view(world.camera, world.truth, step, pose)
     backend = world.backend
-    video = backend.video
-    if video is None and scenario.recording.video is not None:
-        video = RecordedVideo(scenario.recording.video, scenario.recording.recorded_size_px)
-    if video is None:
+    if backend.video is None and scenario.recording.video is not None:
+        backend = replace(backend, video=RecordedVideo(scenario.recording.video, scenario.recording.recorded_size_px))
+    if backend.video is None:
         blank = np.full((world.camera.image_height_px, world.camera.image_width_px, 3), MODEL_BACKGROUND_BGR, np.uint8)
         return lambda step, pose: blank
-    return lambda step, pose: backend.virtual.render(video.frame(int(backend.scene.video_frame[step])), pose)
+    return backend.view
 
 
 def write_episode_video(path: str | Path, episode: Episode, render_view: RenderView, label: str = "") -> None:
