@@ -13,7 +13,7 @@ from ptztrack.evaluate.msg import (
     run_msg_cell,
     summarise_by_ambiguity,
 )
-from ptztrack.scene.roads import RoadScene, walk_roads
+from ptztrack.scene.roads import walk_roads
 from ptztrack.track.tracklets import TrackletConfig, TrackletTracker
 
 SPACING_M = 10.0

@@ -6,7 +6,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from ptztrack.geometry import registration
-from ptztrack.geometry.ptz import PTZCamera, intrinsics, rotation_world_to_camera
+from ptztrack.geometry.ptz import PTZCamera, rotation_world_to_camera
 
 CAMERA = PTZCamera((0.0, 0.0, 8.0), 640, 480, 500.0)
 CENTRED = np.array([[1.0, 0.0, -320.0], [0.0, 1.0, -240.0], [0.0, 0.0, 1.0]])

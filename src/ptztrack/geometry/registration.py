@@ -3,9 +3,10 @@
 The scale-invariant tracking paper (its section 3): reference views I_l cover
 the field of regard; each is tied to a common reference plane by a
 bundle-adjusted homography H_l, and the reference plane to the ground by H_W.
-A live view I_t is matched (SIFT, ratio test) against all of them, the view
-I_m with most matches gives the RANSAC homography H_t, and the live view's
-image-to-ground map is the composition of equation 1. The reading chosen:
+A live view I_t is matched (SIFT, ratio test within each view) against all
+of them, the view I_m with most RANSAC inliers (of the two with most
+matches) gives the homography H_t, and the live view's image-to-ground map
+is the composition of equation 1. The reading chosen:
 
 * H_t maps live pixels to reference-view pixels, H_m reference pixels to the
   reference plane, H_W the reference plane to the ground, so
@@ -116,9 +117,8 @@ def sift_features(image_bgr: np.ndarray, features: int) -> tuple[np.ndarray, np.
     """
     gray = cv2.cvtColor(image_bgr, cv2.COLOR_BGR2GRAY)
     halved = cv2.resize(gray, None, fx=SIFT_IMAGE_SCALE, fy=SIFT_IMAGE_SCALE, interpolation=cv2.INTER_AREA)
-    keypoints, descriptors = cv2.SIFT_create(nfeatures=features, contrastThreshold=SIFT_CONTRAST_THRESHOLD).detectAndCompute(
-        halved, None
-    )
+    detector = cv2.SIFT_create(nfeatures=features, contrastThreshold=SIFT_CONTRAST_THRESHOLD)
+    keypoints, descriptors = detector.detectAndCompute(halved, None)
     if descriptors is None:
         return np.zeros((0, 2)), np.zeros((0, 128), dtype=np.float32)
     # OpenCV puts pixel centres at whole coordinates.
