@@ -14,7 +14,8 @@ import time
 import numpy as np
 
 from ptztrack.config import scenario_from_dict
-from ptztrack.episode import POLICIES, run_episode
+from ptztrack import registry
+from ptztrack.build.episode import run_episode
 from ptztrack.evaluate.metrics import episode_metrics
 
 COLUMNS = ("mota", "motp_m", "idf1", "height_px", "detections", "zoom")

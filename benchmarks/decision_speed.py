@@ -31,6 +31,7 @@ from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
 
+from ptztrack.build.world import action_grid
 from ptztrack.config import scenario_from_dict  # noqa: E402
 from ptztrack.episode import build_world, make_policy, run_episode  # noqa: E402
 from ptztrack.track.tracker import Tracks  # noqa: E402
@@ -85,7 +86,7 @@ def main() -> None:
     for size, overrides in SIZES.items():
         scenario = scenario_from_dict(overrides)
         track_count = scenario.people.count
-        actions = np.arange(scenario.action_grid().size)
+        actions = np.arange(action_grid(scenario).size)
         states = recorded_states(scenario, track_count)
         rng = np.random.default_rng(0)
         rates = {}

@@ -12,8 +12,9 @@ recall per height band, next to the paper's Caltech curve (Kd 0.0098, r0 21.29).
 import numpy as np
 
 from ptztrack.config import pets_scenario
-from ptztrack.episode import build_world
-from ptztrack.evaluate.recall import fit_recall, recall_curve, recorded_hog_trials
+from ptztrack.build.world import build_world
+from ptztrack.detect.recall_fit import fit_recall
+from ptztrack.detect.simulated import realistic_recall, recorded_hog_trials
 
 
 def main() -> None:
@@ -33,7 +34,7 @@ def main() -> None:
             middle = np.median(heights[band])
             print(
                 f"{low:>5}-{low * 1.4:<6.0f}{band.sum():>8}{detected[band].mean():>8.2f}"
-                f"{recall_curve(middle, kd, r0):>8.2f}{recall_curve(middle, 0.0098, 21.29):>8.2f}"
+                f"{realistic_recall(middle, kd, r0):>8.2f}{realistic_recall(middle, 0.0098, 21.29):>8.2f}"
             )
 
 

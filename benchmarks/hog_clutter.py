@@ -18,7 +18,7 @@ import numpy as np
 from scipy.spatial.distance import cdist
 
 from ptztrack.config import pets_scenario
-from ptztrack.episode import build_world
+from ptztrack.build.world import build_world
 
 
 def main() -> None:

@@ -8,7 +8,7 @@ gaps (X ambiguities), leaving and arriving, with faces captured now and then
 but no untangling (so the graph keeps every ambiguity, the worst case). At
 each size one decision scores every candidate (active, unlabelled, solo)
 vertex: with the auxiliary data (refresh from the parents, then read) and by
-traversal (:func:`ptztrack.control.msg_traversal.traversal_data`); the two
+traversal (``traversal_data`` of the tests' reference, ``tests/msg_traversal.py``); the two
 must agree, and the script stops if they do not. Prints, per size, the
 vertices, candidates, ms per decision each way and the ratio; ``--json``
 writes rows ``vertices``, ``aux_ms``, ``traversal_ms``.
@@ -16,12 +16,17 @@ writes rows ``vertices``, ``aux_ms``, ``traversal_ms``.
 
 import argparse
 import json
+import sys
 import time
+from pathlib import Path
 
 import numpy as np
 
-from ptztrack.control import msg
-from ptztrack.control.msg_traversal import traversal_data
+from ptztrack.track import msg
+
+# The traversal reference is test code, not part of the installed package.
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+from msg_traversal import traversal_data  # noqa: E402
 
 ACTIVE_TARGETS = 20
 

@@ -15,6 +15,7 @@ import time
 import cv2
 import numpy as np
 
+from ptztrack.build.world import action_grid
 from ptztrack.camera.pose_feedback import reference_index, registration_camera
 from ptztrack.config import pets_scenario
 from ptztrack.geometry.registration import LIVE_FEATURES, register, sift_features, within_view_ratio_matches
@@ -34,7 +35,7 @@ def main() -> None:
     index = reference_index(scenario)
     print(f"reference index: {len(index.poses)} views, {len(index.descriptors)} features, {time.perf_counter() - start:.1f} s")
     virtual, whole_frame_pose = registration_camera(scenario)
-    grid = scenario.action_grid()
+    grid = action_grid(scenario)
     rng = np.random.default_rng(0)
     video = RecordedVideo(scenario.recording.video, scenario.recording.recorded_size_px)
     frames = np.sort(rng.integers(50, 795, args.views))

@@ -49,9 +49,9 @@ import numpy as np  # noqa: E402
 
 from ptztrack.config import pets_scenario  # noqa: E402
 from ptztrack.control.baselines import widest_view_action  # noqa: E402
-from ptztrack.control.policy import DecisionContext  # noqa: E402
+from ptztrack.types import DecisionContext  # noqa: E402
 from ptztrack.detect.hog import feet_and_height_px  # noqa: E402
-from ptztrack.detect.simulated import Detections  # noqa: E402
+from ptztrack.types import Detections  # noqa: E402
 from ptztrack.episode import build_world, make_policy  # noqa: E402
 from ptztrack.track.kalman import constant_velocity_model  # noqa: E402
 from ptztrack.track.tracker import no_tracks, pixel_noise_covariance, predict_tracks, update_tracks  # noqa: E402

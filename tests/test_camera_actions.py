@@ -7,10 +7,11 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from ptztrack.build.world import action_grid
 from ptztrack.camera.actions import ActionGrid
 from ptztrack.config import Scenario
 
-GRID = Scenario().action_grid()
+GRID = action_grid(Scenario())
 PROPERTY = settings(deadline=None, max_examples=100)
 
 

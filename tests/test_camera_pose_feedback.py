@@ -3,11 +3,14 @@
 import numpy as np
 import pytest
 
+from ptztrack.build.episode import run_episode
+from ptztrack.build.experiments import registration_views
+from ptztrack.build.registration import reference_index, registration_camera
+from ptztrack.build.world import action_grid, landing_error
 from ptztrack.camera import pose_feedback
-from ptztrack.config import PoseError, PoseFeedback, ScenarioError, pets_scenario, scenario_from_dict
-from ptztrack.episode import run_episode
+from ptztrack.config import PoseError, ScenarioError, pets_scenario, scenario_from_dict
 from ptztrack.evaluate.metrics import episode_metrics
-from ptztrack.evaluate.registration import registration_errors, summarise_registration
+from ptztrack.evaluate.registration import summarise_registration
 from ptztrack.geometry.registration import register
 
 # Small enough to build in seconds, large enough to register most views (13 references at 480 x 360).
@@ -16,12 +19,12 @@ SMALL_REGISTRATION = {"image_size_px": (480, 360), "reference_zooms": (1.0, 2.0)
 
 def test_a_perfect_camera_lands_exactly_where_it_is_sent():
     commanded = np.array([12.5, 20.0, 3.0])
-    landed = pose_feedback.landed_pose(commanded, PoseError(), np.random.default_rng(0))
+    landed = pose_feedback.landed_pose(commanded, landing_error(scenario_from_dict({})), np.random.default_rng(0))
     np.testing.assert_array_equal(landed, commanded)
 
 
 def test_bias_and_noise_of_the_landing_pose_have_the_configured_size():
-    error = PoseError(pan_tilt_sigma_deg=2.0, pan_tilt_bias_deg=(1.0, -0.5), zoom_sigma=0.03, zoom_bias=1.1)
+    error = pose_feedback.LandingError(pan_tilt_sigma_deg=2.0, pan_tilt_bias_deg=(1.0, -0.5), zoom_sigma=0.03, zoom_bias=1.1)
     rng = np.random.default_rng(1)
     commanded = np.array([10.0, 20.0, 2.0])
     landed = np.array([pose_feedback.landed_pose(commanded, error, rng) for _ in range(20000)])
@@ -34,8 +37,7 @@ def test_bias_and_noise_of_the_landing_pose_have_the_configured_size():
 
 
 def test_reference_poses_cover_the_grid_with_the_calibrated_view_first():
-    feedback = PoseFeedback(reference_zooms=(1.0, 2.0), reference_pan_steps=3, reference_tilt_steps=3)
-    poses = pose_feedback.reference_poses(np.array([50.0, 15.0, 1.0]), (-10.0, 10.0), (-5.0, 5.0), feedback)
+    poses = pose_feedback.reference_poses(np.array([50.0, 15.0, 1.0]), (-10.0, 10.0), (-5.0, 5.0), 3, 3, (1.0, 2.0))
     np.testing.assert_array_equal(poses[0], [50.0, 15.0, 1.0])
     # The grid's centre at zoom 1 is the calibrated view itself: listed once.
     assert len(poses) == 2 * 3 * 3
@@ -55,7 +57,7 @@ def small_registration(tmp_path_factory):
     """The PETS scenario with a small reference index, cached in a file, and the index."""
     path = tmp_path_factory.mktemp("index") / "index.npz"
     scenario = pets_scenario("ideal", pose_feedback={**SMALL_REGISTRATION, "index": str(path)})
-    return scenario, pose_feedback.reference_index(scenario)
+    return scenario, reference_index(scenario)
 
 
 def test_the_index_is_built_once_and_then_read_from_its_file(small_registration):
@@ -71,7 +73,7 @@ def test_the_index_is_built_once_and_then_read_from_its_file(small_registration)
 
 def test_pets_views_register_to_a_fraction_of_a_percent_and_centimetres(small_registration):
     scenario, index = small_registration
-    rows = registration_errors(scenario, index, views=8, seed=3)
+    rows = registration_views(scenario, index, views=8, seed=3)
     summary = summarise_registration(rows)
     assert summary["registered"] >= 6
     assert summary["focal_err_median_pct"] < 0.5
@@ -80,13 +82,15 @@ def test_pets_views_register_to_a_fraction_of_a_percent_and_centimetres(small_re
 
 def test_the_bundle_recovers_the_reference_poses_from_rough_ones(small_registration):
     scenario, index = small_registration
-    virtual, whole_frame_pose = pose_feedback.registration_camera(scenario)
-    offsets = scenario.action_grid()
+    virtual, whole_frame_pose = registration_camera(scenario)
+    offsets = action_grid(scenario)
     truth = pose_feedback.reference_poses(
         whole_frame_pose,
         (offsets.pan_deg.min(), offsets.pan_deg.max()),
         (offsets.tilt_deg.min(), offsets.tilt_deg.max()),
-        scenario.pose_feedback,
+        scenario.pose_feedback.reference_pan_steps,
+        scenario.pose_feedback.reference_tilt_steps,
+        scenario.pose_feedback.reference_zooms,
     )
     # The rough poses were 0.5 deg and 3 % off; every view of this grid ties to the first.
     assert len(index.poses) == len(truth)
@@ -99,14 +103,14 @@ def test_a_view_of_another_size_is_refused(small_registration):
     other = scenario.model_copy(
         update={"pose_feedback": scenario.pose_feedback.model_copy(update={"image_size_px": (640, 480)})}
     )
-    virtual, _ = pose_feedback.registration_camera(other)
+    virtual, _ = registration_camera(other)
     with pytest.raises(ValueError, match="index is of 480x360 px views, but pose_feedback.image_size_px is 640x480"):
         pose_feedback.RegisteredPose(virtual, index, None, np.zeros(1, dtype=int))
 
 
 def test_a_view_of_nothing_is_not_registered(small_registration):
     scenario, index = small_registration
-    virtual, _ = pose_feedback.registration_camera(scenario)
+    virtual, _ = registration_camera(scenario)
     assert register(virtual.camera, index, np.zeros((360, 480, 3), dtype=np.uint8)) is None
 
 

@@ -4,7 +4,8 @@ from pathlib import Path
 import numpy as np
 
 from ptztrack.config import load_scenario, pets_scenario
-from ptztrack.episode import build_world, run_episode
+from ptztrack.build.episode import run_episode
+from ptztrack.build.world import build_world
 from ptztrack.evaluate.metrics import episode_metrics
 from ptztrack.geometry.ptz import apply_homography, ground_to_image
 
@@ -43,14 +44,14 @@ def test_the_ideal_detector_reports_annotated_feet_where_the_virtual_camera_sees
     world = build_world(excerpt_scenario(tmp_path), np.random.default_rng(0))
     wide = int(np.argmin(np.abs(world.grid.axis_indices - [3, 2, 0]).sum(axis=1)))
     pose = world.grid.poses[wide]
-    found = world.backend.observe(0, pose, np.random.default_rng(0))
+    found = world.detector.detect(world.backend, 0, pose, np.random.default_rng(0))
     present = np.flatnonzero(~np.isnan(world.truth.positions_m[0, :, 0]))
     assert len(found) >= 0.7 * len(present)
     expected = apply_homography(ground_to_image(world.camera, pose), world.truth.positions_m[0, found.person_index])
     # the annotations sit about 2 px from the calibrated feet in the 768 px frame: 0.5 px at 160 px
     assert np.median(np.linalg.norm(found.feet_px - expected, axis=1)) < 1.0
     narrow = np.flatnonzero(world.grid.axis_indices[:, 2] == 3)
-    views = [world.backend.observe(0, world.grid.poses[a], np.random.default_rng(0)) for a in narrow]
+    views = [world.detector.detect(world.backend, 0, world.grid.poses[a], np.random.default_rng(0)) for a in narrow]
     zoomed = max(views, key=len)
     assert 0 < len(zoomed) < len(found)
     assert np.mean(zoomed.height_px) > 2.5 * np.mean(found.height_px)

@@ -1,12 +1,13 @@
 import numpy as np
 
+from ptztrack.build.world import action_grid, ptz_camera
 from ptztrack.config import Scenario
 from ptztrack.control.baselines import area_coverage, area_samples_m, patrol_route, widest_view_action
-from ptztrack.episode import run_episode
+from ptztrack.build.episode import run_episode
 from ptztrack.geometry.ptz import person_in_view, project_people
 
 SCENARIO = Scenario()
-CAMERA, GRID = SCENARIO.ptz_camera(), SCENARIO.action_grid()
+CAMERA, GRID = ptz_camera(SCENARIO), action_grid(SCENARIO)
 
 
 def test_fix_looks_at_the_area_at_the_widest_zoom():

@@ -4,7 +4,10 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.stats import multivariate_normal
 
-from ptztrack.config import Control, Detector, Scenario, scenario_from_dict
+from ptztrack.build.episode import make_policy
+from ptztrack.build.factories import recall_model
+from ptztrack.build.world import action_grid, build_world, ptz_camera
+from ptztrack.config import Control, Scenario, scenario_from_dict
 from ptztrack.control.gaussian_rectangle import bivariate_normal_cdf, gaussian_rectangle_probability
 from ptztrack.control.information_gain import (
     action_geometry,
@@ -12,9 +15,7 @@ from ptztrack.control.information_gain import (
     detection_weight_sampled,
     information_if_detected_nats,
 )
-from ptztrack.control.policy import DecisionContext
-from ptztrack.detect.simulated import occluded_fraction, occlusion_in_centred_views, recall
-from ptztrack.episode import build_world, make_policy
+from ptztrack.geometry.occlusion import occluded_fraction, occlusion_in_centred_views
 from ptztrack.geometry.ptz import (
     apply_homography,
     feet_jacobian,
@@ -25,14 +26,19 @@ from ptztrack.geometry.ptz import (
     project_people,
 )
 from ptztrack.track import kalman
-from ptztrack.track.tracker import Tracks, no_tracks
+from ptztrack.types import DecisionContext, Tracks
 
 SCENARIO = Scenario()
 
 
+def detector_model(kind="realistic"):
+    """The recall model the policies plan with for the scenario's detector of ``kind``."""
+    return recall_model(scenario_from_dict({"detector": {"kind": kind}}))
+
+
 def policy_for(name, scenario):
     return make_policy(name, scenario, build_world(scenario, np.random.default_rng(0)))
-CAMERA, GRID = SCENARIO.ptz_camera(), SCENARIO.action_grid()
+CAMERA, GRID = ptz_camera(SCENARIO), action_grid(SCENARIO)
 V = 4.0 * np.eye(2)
 HEIGHT_M = 1.75
 
@@ -85,13 +91,13 @@ def alpha_monte_carlo(pose, mean_m, cov_m2, detector, rng, samples=400_000):
         & (head_v >= 0)
         & (head_v <= CAMERA.image_height_px)
     )
-    return np.mean(inside * recall(draws[:, 1] - head_v, detector))
+    return np.mean(inside * detector(draws[:, 1] - head_v))
 
 
 @pytest.mark.parametrize("kind", ["ideal", "realistic"])
 def test_closed_form_alpha_agrees_with_monte_carlo_of_equation_8(kind):
     rng = np.random.default_rng(7)
-    detector = Detector(kind=kind)
+    detector = detector_model(kind)
     checked = 0
     for _ in range(30):
         mean_m = rng.uniform(0, 15, size=2)
@@ -108,7 +114,7 @@ def test_closed_form_alpha_agrees_with_monte_carlo_of_equation_8(kind):
 
 
 def test_alpha_is_the_recall_well_inside_a_wide_view_and_zero_far_outside():
-    detector = Detector()
+    detector = detector_model()
     mean_m = np.array([[7.5, 4.0]])
     cov_m2 = np.eye(2)[None] * 0.01**2
     inside = look_at(CAMERA, mean_m[0], 1.0)
@@ -116,7 +122,7 @@ def test_alpha_is_the_recall_well_inside_a_wide_view_and_zero_far_outside():
     geometry = action_geometry(CAMERA, np.stack([inside, away]), HEIGHT_M)
     alpha = detection_weight_integral(CAMERA, geometry, detector, mean_m, cov_m2, V)
     height_px = project_people(CAMERA, inside, mean_m, HEIGHT_M, 0.5).height_px[0]
-    assert alpha[0, 0] == pytest.approx(recall(height_px, detector), abs=0.01)
+    assert alpha[0, 0] == pytest.approx(detector(height_px), abs=0.01)
     assert alpha[1, 0] < 1e-6
 
 
@@ -179,7 +185,7 @@ def test_smpl_does_not_count_on_a_person_hidden_behind_another_but_intg_does():
     cov_m2 = np.eye(2)[None].repeat(2, 0) * 0.02**2
     pose = look_at(CAMERA, behind, 2.0)
     geometry = action_geometry(CAMERA, pose[None], HEIGHT_M)
-    detector = Detector(kind="ideal")
+    detector = detector_model("ideal")
     intg = detection_weight_integral(CAMERA, geometry, detector, mean_m, cov_m2, V)[0]
     smpl = detection_weight_sampled(
         CAMERA, geometry, detector, mean_m, cov_m2, HEIGHT_M, 0.5, pose, np.random.default_rng(0), 100
@@ -236,7 +242,7 @@ def test_patrolling_term_grows_while_unobserved_and_clears_where_the_camera_look
 
 
 def test_without_tracks_the_patrolling_term_moves_the_camera_and_without_it_the_camera_stays():
-    empty = no_tracks()
+    empty = Tracks.empty()
     start = int(GRID.index(3, 4, 1))
     context = DecisionContext(0, start, GRID.reachable(start), empty, np.random.default_rng(0))
     assert policy_for("intg", scenario_from_dict({"control": {"beta": 0.0}})).choose(context) == start

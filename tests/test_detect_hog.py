@@ -24,7 +24,7 @@ def test_hog_finds_the_people_of_a_zoomed_virtual_view_at_their_annotated_feet()
     pose = whole_frame * [1, 1, 2]
     frame = 10
     view = virtual.render(read_video(EXCERPT / "View_001.avi")[frame], pose)
-    boxes, scores = HogPeopleDetector().detect(view)
+    boxes, scores = HogPeopleDetector().boxes(view)
     assert len(boxes) >= 1 and np.all(scores > 0)
     truth = load_mot_ground_truth(EXCERPT / "gt_mot15.txt")
     annotated = apply_homography(ground_to_image(virtual.camera, pose), truth.ground_m[truth.frame == frame])
@@ -34,7 +34,7 @@ def test_hog_finds_the_people_of_a_zoomed_virtual_view_at_their_annotated_feet()
 
 
 def test_hog_finds_nobody_in_an_empty_image():
-    boxes, scores = HogPeopleDetector().detect(np.full((120, 160, 3), 128, np.uint8))
+    boxes, scores = HogPeopleDetector().boxes(np.full((120, 160, 3), 128, np.uint8))
     assert boxes.shape == (0, 4) and scores.shape == (0,)
 
 

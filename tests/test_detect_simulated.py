@@ -5,19 +5,19 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from ptztrack.config import Detector, Scenario
-from ptztrack.detect.simulated import (
-    detect,
-    detection_probability,
-    occluded_fraction,
-    occlusion_in_centred_views,
-    recall,
-)
-from ptztrack.geometry.ptz import apply_homography, image_to_ground, inside_image, look_at, project_people
+from ptztrack.build.factories import recall_model
+from ptztrack.build.world import ptz_camera
+from ptztrack.config import Scenario
+from ptztrack.detect.simulated import RecallDetector, RecallModel, detection_probability
+from ptztrack.geometry.occlusion import occluded_fraction, occlusion_in_centred_views
+from ptztrack.geometry.ptz import apply_homography, image_to_ground, inside_image, look_at, person_in_view, project_people
+from ptztrack.types import PeopleInView
 
-CAMERA = Scenario().ptz_camera()
-REALISTIC = Detector()
-IDEAL = Detector(kind="ideal")
+CAMERA = ptz_camera(Scenario())
+SIZE = (CAMERA.image_width_px, CAMERA.image_height_px)
+# The scenario's default detectors: the paper's realistic curve, and the ideal one.
+REALISTIC = RecallDetector(recall_model(Scenario()), 2.0, 0.0, SIZE)
+IDEAL = RecallDetector(recall_model(Scenario(detector={"kind": "ideal"})), 2.0, 0.0, SIZE)
 PROPERTY = settings(deadline=None, max_examples=100)
 
 
@@ -167,36 +167,35 @@ def test_occluded_fraction_batched_matches_raster(frames):
 
 
 def test_realistic_recall():
-    assert REALISTIC.kind == "realistic"
-    assert REALISTIC.recall_r0_px == 21.29 and REALISTIC.recall_kd == 0.0098
-    below = recall(np.array([0.0, 5.0, 21.0, 21.2899]), REALISTIC)
+    assert REALISTIC.recall.r0_px == 21.29 and REALISTIC.recall.kd_per_px == 0.0098
+    below = REALISTIC.recall(np.array([0.0, 5.0, 21.0, 21.2899]))
     np.testing.assert_array_equal(below, 0.0)
-    assert recall(21.29, REALISTIC) == 0.0
-    value = recall(100.0, REALISTIC)
+    assert REALISTIC.recall(21.29) == 0.0
+    value = REALISTIC.recall(100.0)
     np.testing.assert_allclose(value, 1 - np.exp(-0.0098 * (100 - 21.29)), rtol=1e-14)
     np.testing.assert_allclose(value, 0.5376, atol=5e-5)
     heights = np.array([30.0, 50.0, 200.0, 480.0])
-    np.testing.assert_allclose(recall(heights, REALISTIC), 1 - np.exp(-0.0098 * (heights - 21.29)), rtol=1e-14)
-    np.testing.assert_allclose(recall(1e5, REALISTIC), 1.0, rtol=1e-12)
+    np.testing.assert_allclose(REALISTIC.recall(heights), 1 - np.exp(-0.0098 * (heights - 21.29)), rtol=1e-14)
+    np.testing.assert_allclose(REALISTIC.recall(1e5), 1.0, rtol=1e-12)
 
 
 def test_recall_is_monotone_and_keeps_shape():
     heights = np.linspace(0, 1000, 5001)
-    values = recall(heights, REALISTIC)
+    values = REALISTIC.recall(heights)
     assert values.shape == heights.shape
     assert np.all(np.diff(values) >= 0)
     assert np.all(np.diff(values[heights > 21.29]) > 0)
     assert np.all((values >= 0) & (values < 1))
-    grid = recall(heights[:5000].reshape(50, 100), REALISTIC)
+    grid = REALISTIC.recall(heights[:5000].reshape(50, 100))
     np.testing.assert_array_equal(grid, values[:5000].reshape(50, 100))
-    other = Detector(recall_kd=0.05, recall_r0_px=10.0)
-    np.testing.assert_allclose(recall(30.0, other), 1 - np.exp(-0.05 * 20.0), rtol=1e-14)
-    assert recall(9.99, other) == 0.0
+    other = RecallDetector(RecallModel(0.05, 10.0), 2.0, 0.0, SIZE)
+    np.testing.assert_allclose(other.recall(30.0), 1 - np.exp(-0.05 * 20.0), rtol=1e-14)
+    assert other.recall(9.99) == 0.0
 
 
 def test_ideal_recall_is_one():
     heights = np.array([[0.0, 1.0, 21.0], [100.0, 1e4, 3.5]])
-    np.testing.assert_array_equal(recall(heights, IDEAL), np.ones((2, 3)))
+    np.testing.assert_array_equal(IDEAL.recall(heights), np.ones((2, 3)))
 
 
 # ---------------------------------------------------------------------------
@@ -219,6 +218,30 @@ def hidden_of(people, present):
     return occluded_fraction(people.box_px, people.range_m, present & people.in_front)
 
 
+def in_view(people, present):
+    """What a simulated camera knows of projected people, seen in the view they were projected in."""
+    index = np.broadcast_to(np.arange(people.feet_px.shape[-2]), people.height_px.shape)
+    visible = present & person_in_view(CAMERA, people)
+    return PeopleInView(index, people.feet_px, people.height_px, visible, hidden_of(people, present))
+
+
+class FixedView:
+    """A camera backend that always shows the same people."""
+
+    def __init__(self, people):
+        self.shown = people
+
+    def image(self, step, pose):
+        return None
+
+    def people(self, step, pose):
+        return self.shown
+
+
+def detect(people, present, detector, rng):
+    return detector.detect(FixedView(in_view(people, present)), 0, POSE, rng)
+
+
 def box_area(box):
     return (box[2] - box[0]) * (box[3] - box[1])
 
@@ -233,12 +256,12 @@ def test_unoccluded_person_in_middle_has_recall_probability():
     people = project_people(CAMERA, POSE, np.array([[7.5, 8.0], [12.0, 8.0]]), 1.75, 0.5)
     np.testing.assert_allclose(people.feet_px[0], [320.0, 240.0], atol=1e-9)
     assert 80 < people.height_px[0] < 110
-    p = detection_probability(CAMERA, people, hidden_of(people, np.ones(2, dtype=bool)), np.ones(2, dtype=bool), REALISTIC)
-    np.testing.assert_allclose(p, recall(people.height_px, REALISTIC), rtol=1e-14)
+    p = detection_probability(in_view(people, np.ones(2, dtype=bool)), REALISTIC.recall)
+    np.testing.assert_allclose(p, REALISTIC.recall(people.height_px), rtol=1e-14)
     assert 0.4 < p[0] < 0.6
-    np.testing.assert_array_equal(detection_probability(CAMERA, people, hidden_of(people, np.ones(2, dtype=bool)), np.ones(2, dtype=bool), IDEAL), [1.0, 1.0])
+    np.testing.assert_array_equal(detection_probability(in_view(people, np.ones(2, dtype=bool)), IDEAL.recall), [1.0, 1.0])
     # a person who is not present is never detected and does not count
-    np.testing.assert_array_equal(detection_probability(CAMERA, people, hidden_of(people, np.array([False, True])), np.array([False, True]), IDEAL), [0.0, 1.0])
+    np.testing.assert_array_equal(detection_probability(in_view(people, np.array([False, True])), IDEAL.recall), [0.0, 1.0])
 
 
 def test_person_behind_another_is_reduced_by_visible_fraction():
@@ -254,10 +277,10 @@ def test_person_behind_another_is_reduced_by_visible_fraction():
     hidden = occluded_fraction(box, people.range_m, ALL)
     np.testing.assert_allclose(hidden[:3], [0.0, c1, 1.0], rtol=1e-12, atol=1e-12)
 
-    r = recall(people.height_px, REALISTIC)
-    p = detection_probability(CAMERA, people, hidden_of(people, ALL), ALL, REALISTIC)
+    r = REALISTIC.recall(people.height_px)
+    p = detection_probability(in_view(people, ALL), REALISTIC.recall)
     np.testing.assert_allclose(p, [r[0], r[1] * (1 - c1), 0.0, r[3]], rtol=1e-12, atol=1e-12)
-    p_ideal = detection_probability(CAMERA, people, hidden_of(people, ALL), ALL, IDEAL)
+    p_ideal = detection_probability(in_view(people, ALL), IDEAL.recall)
     np.testing.assert_allclose(p_ideal, [1.0, 1 - c1, 0.0, 1.0], rtol=1e-12, atol=1e-12)
 
     # without the front person, the child is fully visible and now it alone hides part of person 1
@@ -265,11 +288,11 @@ def test_person_behind_another_is_reduced_by_visible_fraction():
     c1_child = intersection_area(box[1], box[2]) / box_area(box[1])
     assert 0 < c1_child < c1
     present = np.array([False, True, True, True])
-    p_alone = detection_probability(CAMERA, people, hidden_of(people, present), present, REALISTIC)
+    p_alone = detection_probability(in_view(people, present), REALISTIC.recall)
     np.testing.assert_allclose(p_alone, [0.0, r[1] * (1 - c1_child), r[2], r[3]], rtol=1e-12)
     # and without both, person 1 is fully visible
     present = np.array([False, True, False, True])
-    p_free = detection_probability(CAMERA, people, hidden_of(people, present), present, REALISTIC)
+    p_free = detection_probability(in_view(people, present), REALISTIC.recall)
     np.testing.assert_allclose(p_free, [0.0, r[1], 0.0, r[3]], rtol=1e-12)
 
 
@@ -279,20 +302,20 @@ def test_person_outside_image_or_cut_off_is_never_detected():
     zoom2 = project_people(CAMERA, POSE, xy, 1.75, 0.5)
     zoom3 = project_people(CAMERA, POSE * [1, 1, 1.5], xy, 1.75, 0.5)
     assert inside_image(CAMERA, zoom2.feet_px).all() and not inside_image(CAMERA, zoom3.feet_px).any()
-    assert detection_probability(CAMERA, zoom2, hidden_of(zoom2, np.ones(1, bool)), np.ones(1, bool), IDEAL)[0] == 1.0
-    assert detection_probability(CAMERA, zoom3, hidden_of(zoom3, np.ones(1, bool)), np.ones(1, bool), IDEAL)[0] == 0.0
+    assert detection_probability(in_view(zoom2, np.ones(1, bool)), IDEAL.recall)[0] == 1.0
+    assert detection_probability(in_view(zoom3, np.ones(1, bool)), IDEAL.recall)[0] == 0.0
 
     to_ground = image_to_ground(CAMERA, POSE)
     # feet 10 px below the top border: the head is above the image
     top = apply_homography(to_ground, np.array([[320.0, 10.0]]))
     cut = project_people(CAMERA, POSE, top, 1.75, 0.5)
     assert inside_image(CAMERA, cut.feet_px).all() and cut.head_px[0, 1] < 0
-    assert detection_probability(CAMERA, cut, hidden_of(cut, np.ones(1, bool)), np.ones(1, bool), IDEAL)[0] == 0.0
+    assert detection_probability(in_view(cut, np.ones(1, bool)), IDEAL.recall)[0] == 0.0
     # feet just below the bottom border: head inside, feet outside
     bottom = apply_homography(to_ground, np.array([[320.0, 485.0]]))
     low = project_people(CAMERA, POSE, bottom, 1.75, 0.5)
     assert inside_image(CAMERA, low.head_px).all() and not inside_image(CAMERA, low.feet_px).any()
-    assert detection_probability(CAMERA, low, hidden_of(low, np.ones(1, bool)), np.ones(1, bool), IDEAL)[0] == 0.0
+    assert detection_probability(in_view(low, np.ones(1, bool)), IDEAL.recall)[0] == 0.0
 
 
 def test_person_behind_the_camera_is_never_detected():
@@ -301,7 +324,7 @@ def test_person_behind_the_camera_is_never_detected():
     behind = project_people(CAMERA, pose, np.array([[7.5, -104.0]]), 1.75, 0.5)
     assert behind.depth_m[0] < 0
     assert inside_image(CAMERA, behind.feet_px).all() and inside_image(CAMERA, behind.head_px).all()
-    assert detection_probability(CAMERA, behind, hidden_of(behind, np.ones(1, bool)), np.ones(1, bool), IDEAL)[0] == 0.0
+    assert detection_probability(in_view(behind, np.ones(1, bool)), IDEAL.recall)[0] == 0.0
 
 
 def test_detection_probability_batched_over_poses():
@@ -310,11 +333,11 @@ def test_detection_probability_batched_over_poses():
     heights = np.array([1.75, 1.75, 0.8, 1.75])
     present = np.array([True, True, True, False])
     batch = project_people(CAMERA, poses, np.broadcast_to(xy, (3, 4, 2)), heights, 0.5)
-    p = detection_probability(CAMERA, batch, hidden_of(batch, np.broadcast_to(present, (3, 4))), np.broadcast_to(present, (3, 4)), REALISTIC)
+    p = detection_probability(in_view(batch, np.broadcast_to(present, (3, 4))), REALISTIC.recall)
     assert p.shape == (3, 4)
     for k, pose in enumerate(poses):
         single = project_people(CAMERA, pose, xy, heights, 0.5)
-        np.testing.assert_allclose(p[k], detection_probability(CAMERA, single, hidden_of(single, present), present, REALISTIC), rtol=1e-12)
+        np.testing.assert_allclose(p[k], detection_probability(in_view(single, present), REALISTIC.recall), rtol=1e-12)
 
 
 # ---------------------------------------------------------------------------
@@ -336,13 +359,13 @@ def many_draws():
     people = project_people(CAMERA, POSE, xy, 1.75, 0.5)
     present = np.ones(ROW, dtype=bool)
     rng = np.random.default_rng(20240611)
-    frames = [detect(CAMERA, people, hidden_of(people, present), present, REALISTIC, rng) for _ in range(FRAMES)]
+    frames = [detect(people, present, REALISTIC, rng) for _ in range(FRAMES)]
     return people, present, frames
 
 
 def test_empirical_detection_rate_matches_probability(many_draws):
     people, present, frames = many_draws
-    p = detection_probability(CAMERA, people, hidden_of(people, present), present, REALISTIC)
+    p = detection_probability(in_view(people, present), REALISTIC.recall)
     np.testing.assert_allclose(p, p[0], rtol=1e-12)
     assert 0.4 < p[0] < 0.6
     np.testing.assert_array_equal(occluded_fraction(people.box_px, people.depth_m, present), 0.0)
@@ -373,9 +396,9 @@ def test_pixel_noise_matches_detector(many_draws):
 
 def test_noise_free_detector_reports_exact_feet():
     people = scene()
-    detector = Detector(kind="ideal", pixel_noise_px=0.0)
+    detector = RecallDetector(IDEAL.recall, 0.0, 0.0, SIZE)
     everyone = np.ones(4, dtype=bool)
-    found = detect(CAMERA, people, hidden_of(people, everyone), everyone, detector, np.random.default_rng(3))
+    found = detect(people, everyone, detector, np.random.default_rng(3))
     # ideal detector: everyone except the fully hidden child (2); person 1 with probability 1 - c
     assert 0 in found.person_index and 3 in found.person_index and 2 not in found.person_index
     np.testing.assert_array_equal(found.feet_px, people.feet_px[found.person_index])
@@ -384,11 +407,11 @@ def test_noise_free_detector_reports_exact_feet():
 
 def test_false_positives():
     rate = 1.5
-    detector = Detector(false_positives_per_frame=rate)
+    detector = RecallDetector(REALISTIC.recall, 2.0, rate, SIZE)
     people = scene()
     absent = np.zeros(4, dtype=bool)
     rng = np.random.default_rng(99)
-    frames = [detect(CAMERA, people, hidden_of(people, absent), absent, detector, rng) for _ in range(4000)]
+    frames = [detect(people, absent, detector, rng) for _ in range(4000)]
     counts = np.array([len(f) for f in frames])
     standard_error = np.sqrt(rate / len(counts))
     assert abs(counts.mean() - rate) < 4 * standard_error
@@ -404,8 +427,8 @@ def test_false_positives():
 
     # with a true person present, false positives come after the hits
     present = np.array([True, False, False, True])
-    ideal = Detector(kind="ideal", false_positives_per_frame=rate)
-    mixed = [detect(CAMERA, people, hidden_of(people, present), present, ideal, rng) for _ in range(50)]
+    ideal = RecallDetector(IDEAL.recall, 2.0, rate, SIZE)
+    mixed = [detect(people, present, ideal, rng) for _ in range(50)]
     for frame in mixed:
         true = frame.person_index >= 0
         assert np.all(true[: true.sum()]) and not np.any(true[true.sum():])
@@ -415,10 +438,10 @@ def test_false_positives():
 
 def test_same_seed_gives_identical_detections():
     people = scene()
-    detector = Detector(false_positives_per_frame=2.0)
+    detector = RecallDetector(REALISTIC.recall, 2.0, 2.0, SIZE)
     present = np.ones(4, dtype=bool)
-    first = [detect(CAMERA, people, hidden_of(people, present), present, detector, np.random.default_rng(7)) for _ in range(3)]
-    again = detect(CAMERA, people, hidden_of(people, present), present, detector, np.random.default_rng(7))
+    first = [detect(people, present, detector, np.random.default_rng(7)) for _ in range(3)]
+    again = detect(people, present, detector, np.random.default_rng(7))
     for frame in first:
         np.testing.assert_array_equal(frame.feet_px, again.feet_px)
         np.testing.assert_array_equal(frame.height_px, again.height_px)
@@ -426,7 +449,7 @@ def test_same_seed_gives_identical_detections():
     # a stream of draws is reproducible too, and different seeds differ
     def stream(seed):
         rng = np.random.default_rng(seed)
-        return np.concatenate([detect(CAMERA, people, hidden_of(people, present), present, detector, rng).feet_px.ravel() for _ in range(20)])
+        return np.concatenate([detect(people, present, detector, rng).feet_px.ravel() for _ in range(20)])
 
     np.testing.assert_array_equal(stream(11), stream(11))
     assert not np.array_equal(stream(11), stream(12))

@@ -6,7 +6,9 @@ import pytest
 
 from ptztrack.cli import main
 from ptztrack.config import scenario_from_dict
-from ptztrack.evaluate.experiment import STRATEGIES, format_table, run_cells, summarise, synthetic_cells
+from ptztrack.build.experiments import STRATEGIES, run_cell, synthetic_cells
+from ptztrack.evaluate.executors import run_cells
+from ptztrack.evaluate.tables import format_table, summarise
 
 SMALL = scenario_from_dict({"frames": 8})
 
@@ -14,8 +16,8 @@ SMALL = scenario_from_dict({"frames": 8})
 def test_serial_and_local_process_executors_give_identical_rows():
     cells = synthetic_cells(SMALL, sequences=2)
     progress = []
-    local = run_cells(cells, "local", workers=2, progress=lambda done, total: progress.append((done, total)))
-    assert local == run_cells(cells, "serial")
+    local = run_cells(cells, run_cell, "local", workers=2, progress=lambda done, total: progress.append((done, total)))
+    assert local == run_cells(cells, run_cell, "serial")
     assert [row["strategy"] for row in local] == [cell.strategy for cell in cells]
     assert progress[-1] == (len(cells), len(cells)) and len(progress) == len(cells)
 
@@ -25,7 +27,7 @@ def test_ray_executor_gives_the_same_rows():
     # Not imported here: the executor must import Ray itself, after setting
     # the environment that keeps a local cluster on the loopback interface.
     cells = synthetic_cells(SMALL, sequences=2, strategies=("rnd", "smpl"))
-    assert run_cells(cells, "ray") == run_cells(cells, "serial")
+    assert run_cells(cells, run_cell, "ray") == run_cells(cells, run_cell, "serial")
 
 
 def test_summary_is_the_mean_over_sequences_in_the_papers_layout():
@@ -58,7 +60,7 @@ def test_unknown_strategies_and_executors_are_refused():
     with pytest.raises(ValueError, match="unknown strategies"):
         synthetic_cells(SMALL, 1, ("fix", "greedy"))
     with pytest.raises(ValueError, match="unknown executor"):
-        run_cells(synthetic_cells(SMALL, 1, ("fix",)), "cluster")
+        run_cells(synthetic_cells(SMALL, 1, ("fix",)), run_cell, "cluster")
 
 
 def test_experiment_command_prints_the_table_and_writes_one_row_per_strategy(tmp_path, capsys):
@@ -75,7 +77,7 @@ def test_experiment_command_prints_the_table_and_writes_one_row_per_strategy(tmp
 
 def table(detector):
     scenario = scenario_from_dict({"detector": {"kind": detector}})
-    return {row["label"]: row for row in summarise(run_cells(synthetic_cells(scenario, 12), "local"))}
+    return {row["label"]: row for row in summarise(run_cells(synthetic_cells(scenario, 12), run_cell, "local"))}
 
 
 def test_the_papers_synthetic_tables_qualitatively():

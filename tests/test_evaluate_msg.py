@@ -1,10 +1,12 @@
 """The face-capture experiment: the tracker layer's graph, the score M, and the paper's qualitative results."""
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
-from ptztrack.control import msg
-from ptztrack.evaluate.experiment import run_cells
+from ptztrack.track import msg
+from ptztrack.evaluate.executors import run_cells
 from ptztrack.evaluate.msg import (
     EXPERIMENT_SCENE,
     labelled_fraction,
@@ -14,7 +16,7 @@ from ptztrack.evaluate.msg import (
     summarise_by_ambiguity,
 )
 from ptztrack.scene.roads import walk_roads
-from ptztrack.track.tracklets import TrackletConfig, TrackletTracker
+from ptztrack.scene.road_tracklets import TrackletOracle, TrackletOracleConfig
 
 SPACING_M = 10.0
 
@@ -28,8 +30,8 @@ def straight_walks(starts_m, headings, steps: int, speed_m_s: float = 1.0, rate_
 
 
 def tracker_for(positions_m, group_id, heading, zoom_steps=5):
-    return TrackletTracker(
-        positions_m, group_id, heading, 40.0, 5.0, 1.0, SPACING_M, TrackletConfig(zoom_steps=zoom_steps)
+    return TrackletOracle(
+        positions_m, group_id, heading, 40.0, 5.0, 1.0, SPACING_M, TrackletOracleConfig(zoom_steps=zoom_steps)
     )
 
 
@@ -91,7 +93,7 @@ def test_m_counts_labelled_length_per_target_with_labelling_chains():
 
 
 def test_a_run_is_reproducible_and_every_scheduler_captures_faces():
-    scene = walk_roads(EXPERIMENT_SCENE.model_copy(update={"people": 12, "join_probability": 0.7}), np.random.default_rng(3))
+    scene = walk_roads(replace(EXPERIMENT_SCENE, people=12, join_probability=0.7), np.random.default_rng(3))
     for scheduler in ("msg", "msg-no-untangling", "naive"):
         first, second = run_msg(scene, scheduler), run_msg(scene, scheduler)
         assert first.m == second.m and first.captures == second.captures
@@ -101,7 +103,7 @@ def test_a_run_is_reproducible_and_every_scheduler_captures_faces():
 
 
 def test_the_paper_scheduler_labels_more_than_the_naive_one_and_untangling_helps():
-    rows = [row for rows in run_cells(msg_cells(16), "serial", run=run_msg_cell) for row in rows]
+    rows = [row for rows in run_cells(msg_cells(16), run_msg_cell, "serial") for row in rows]
     mean_m = {
         scheduler: np.mean([row["m"] for row in rows if row["scheduler"] == scheduler])
         for scheduler in ("msg", "msg-no-untangling", "naive")
@@ -114,4 +116,4 @@ def test_the_paper_scheduler_labels_more_than_the_naive_one_and_untangling_helps
 
 def test_local_processes_and_serial_give_the_same_rows():
     cells = msg_cells(4)
-    assert run_cells(cells, "local", workers=2, run=run_msg_cell) == run_cells(cells, "serial", run=run_msg_cell)
+    assert run_cells(cells, run_msg_cell, "local", workers=2) == run_cells(cells, run_msg_cell, "serial")

@@ -6,7 +6,8 @@ import pytest
 
 from ptztrack.cli import main
 from ptztrack.config import scenario_from_dict
-from ptztrack.episode import episode_world, run_episode
+from ptztrack.build.episode import episode_world, run_episode
+from ptztrack.evaluate.report import RUN_FILES
 from ptztrack.evaluate.video import (
     FRAME_SIZE_PX,
     PANEL_SIZE_PX,
@@ -36,17 +37,18 @@ def read_video(path):
 
 def test_run_out_writes_an_mp4_with_one_frame_per_step(tmp_path, capsys):
     assert main(["run", "--policy", "fix", "--detector", "ideal", "--frames", "10", "--out", str(tmp_path)]) == 0
-    assert str(tmp_path / "episode.mp4") in capsys.readouterr().out
+    printed = capsys.readouterr().out
+    assert "episode.mp4" in printed and str(tmp_path) in printed
     frames, frame_rate_hz = read_video(tmp_path / "episode.mp4")
     assert frames.shape == (10, FRAME_SIZE_PX[1], FRAME_SIZE_PX[0], 3)
     assert frame_rate_hz == pytest.approx(5.0)
-    assert sorted(os.listdir(tmp_path)) == ["episode.mp4", "episode.png", "metrics.json", "tracks.csv"]
+    assert sorted(os.listdir(tmp_path)) == sorted(RUN_FILES)
 
 
 def test_the_video_holds_the_drawn_frames_and_the_same_seed_gives_the_same_bytes(tmp_path):
     scenario = scenario_from_dict({"frames": 6, "detector": {"kind": "ideal"}})
     episode = run_episode(scenario, "random", 3)
-    render_view = view_renderer(scenario, episode_world(scenario, 3))
+    render_view = view_renderer(episode_world(scenario, 3))
     drawn = np.stack(list(episode_frames(episode, render_view, "random")))
     for name in ("a.mp4", "b.mp4"):
         write_episode_video(tmp_path / name, episode, render_view, "random")
@@ -59,7 +61,7 @@ def test_the_video_holds_the_drawn_frames_and_the_same_seed_gives_the_same_bytes
 def test_the_synthetic_view_shows_the_people_the_detector_saw():
     scenario = scenario_from_dict({"frames": 1, "detector": {"kind": "ideal", "pixel_noise_px": 0.0}})
     episode = run_episode(scenario, "fix", 0)
-    view = view_renderer(scenario, episode_world(scenario, 0))(0, episode.poses[0])
+    view = view_renderer(episode_world(scenario, 0))(0, episode.poses[0])
     assert view.shape == (480, 640, 3)
     background = view[0, 0]
     feet_px = np.floor(episode.detections[0].feet_px).astype(int)
@@ -73,7 +75,7 @@ def test_a_pets_excerpt_video_shows_the_recording_through_the_virtual_camera(tmp
     scenario = excerpt_scenario(tmp_path, **{"recording.video": str(EXCERPT / "View_001.avi")})
     episode = run_episode(scenario, "fix", 0)
     world = episode_world(scenario, 0)
-    write_episode_video(tmp_path / "episode.mp4", episode, view_renderer(scenario, world), "fix")
+    write_episode_video(tmp_path / "episode.mp4", episode, view_renderer(world), "fix")
     frames, frame_rate_hz = read_video(tmp_path / "episode.mp4")
     assert frames.shape == (15, FRAME_SIZE_PX[1], FRAME_SIZE_PX[0], 3)
     assert frame_rate_hz == pytest.approx(5.0)

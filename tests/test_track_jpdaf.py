@@ -1,26 +1,35 @@
+from dataclasses import replace
+
 import numpy as np
-import pydantic
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.stats import chi2, multivariate_normal
 
 from ptztrack.cli import build_scenario, main
-from ptztrack.config import ScenarioError, Tracker, scenario_from_dict
+from ptztrack.config import ScenarioError, scenario_from_dict
 from ptztrack.track import jpdaf, kalman
+from ptztrack.types import Tracks
 from ptztrack.track.kalman import constant_velocity_model
 from ptztrack.track.tracker import (
     gated_innovations,
-    no_tracks,
     observation_matrix,
     predict_tracks,
     predicted_feet_px,
     start_tracks,
     update_tracks,
 )
-from test_track_tracker import CAMERA, POSE, V, assert_tracks_follow_walkers, feet_px
+from test_track_tracker import (
+    ACCELERATION_SIGMA_M_S2,
+    CAMERA,
+    POSE,
+    V,
+    assert_tracks_follow_walkers,
+    feet_px,
+    parameters,
+)
 
-CJPDAF = Tracker(association="cjpdaf")
+CJPDAF = parameters(association="cjpdaf")
 GATE = chi2.ppf(CJPDAF.gate_probability, df=2)
 
 
@@ -35,8 +44,8 @@ def step_inputs(mean, covariance, feet):
 
 def a_track(ground_xy=(7.0, 6.0), velocity=(0.8, -0.4)):
     """One predicted track: started at ``ground_xy`` with ``velocity`` and predicted one step."""
-    F, U = constant_velocity_model(0.2, CJPDAF.acceleration_sigma_m_s2)
-    tracks = start_tracks(feet_px([ground_xy]), CAMERA, POSE, V, CJPDAF, first_id=0)
+    F, U = constant_velocity_model(0.2, ACCELERATION_SIGMA_M_S2)
+    tracks = start_tracks(feet_px([ground_xy]), CAMERA, POSE, V, CJPDAF.initial_speed_sigma_m_s, first_id=0)
     mean = tracks.mean.copy()
     mean[:, 2:] = velocity
     return kalman.predict(mean, tracks.covariance, F, U)
@@ -88,13 +97,13 @@ def test_as_c_goes_to_0_one_track_and_one_measurement_get_the_kalman_update():
 
 
 def test_with_c_0_the_tracker_step_equals_the_hungarian_one_for_a_lone_person():
-    F, U = constant_velocity_model(0.2, CJPDAF.acceleration_sigma_m_s2)
-    hungarian = Tracker()
+    F, U = constant_velocity_model(0.2, ACCELERATION_SIGMA_M_S2)
+    hungarian = parameters()
     tracks = {"hungarian": None, "cjpdaf": None}
-    for name, config in (("hungarian", hungarian), ("cjpdaf", CJPDAF.model_copy(update={"clutter_density_per_px2": 0}))):
-        state = no_tracks()
+    for name, config in (("hungarian", hungarian), ("cjpdaf", replace(CJPDAF, clutter_density_per_px2=0))):
+        state = Tracks.empty()
         for step in range(8):
-            state = update_tracks(predict_tracks(state, F, U), feet_px([[5.0 + 0.2 * step, 6.0]]), CAMERA, POSE, V, config)
+            state = update_tracks(predict_tracks(state, F, U), feet_px([[5.0 + 0.2 * step, 6.0]]), CAMERA, POSE, V, config).tracks
         tracks[name] = state
     np.testing.assert_array_equal(tracks["cjpdaf"].ids, tracks["hungarian"].ids)
     np.testing.assert_array_equal(tracks["cjpdaf"].hits, tracks["hungarian"].hits)
@@ -198,11 +207,11 @@ def test_the_pda_covariance_is_the_mixture_covariance_grows_with_a_second_measur
 
 
 def test_a_lone_measurement_in_two_gates_keeps_only_the_likelier_track_alive_and_starts_none():
-    F, U = constant_velocity_model(0.2, CJPDAF.acceleration_sigma_m_s2)
-    config = CJPDAF.model_copy(update={"clutter_density_per_px2": 1e-6})
-    tracks = start_tracks(feet_px([[7.0, 6.0], [7.3, 6.0]]), CAMERA, POSE, V, config, first_id=0)
+    F, U = constant_velocity_model(0.2, ACCELERATION_SIGMA_M_S2)
+    config = replace(CJPDAF, clutter_density_per_px2=1e-6)
+    tracks = start_tracks(feet_px([[7.0, 6.0], [7.3, 6.0]]), CAMERA, POSE, V, config.initial_speed_sigma_m_s, first_id=0)
     # One measurement near both tracks, nearer track 0; another far from both.
-    updated = update_tracks(predict_tracks(tracks, F, U), feet_px([[7.1, 6.0], [12.0, 9.0]]), CAMERA, POSE, V, config)
+    updated = update_tracks(predict_tracks(tracks, F, U), feet_px([[7.1, 6.0], [12.0, 9.0]]), CAMERA, POSE, V, config).tracks
     np.testing.assert_array_equal(updated.ids, [0, 1, 2])
     np.testing.assert_array_equal(updated.missed_steps, [0, 1, 0])
     np.testing.assert_array_equal(updated.hits, [2, 1, 1])
@@ -212,39 +221,39 @@ def test_a_lone_measurement_in_two_gates_keeps_only_the_likelier_track_alive_and
 
 
 def test_two_people_each_detected_keep_both_tracks_alive_even_inside_each_others_gates():
-    F, U = constant_velocity_model(0.2, CJPDAF.acceleration_sigma_m_s2)
-    tracks = start_tracks(feet_px([[7.0, 6.0], [7.3, 6.0]]), CAMERA, POSE, V, CJPDAF, first_id=0)
-    updated = update_tracks(predict_tracks(tracks, F, U), feet_px([[7.0, 6.0], [7.3, 6.0]]), CAMERA, POSE, V, CJPDAF)
+    F, U = constant_velocity_model(0.2, ACCELERATION_SIGMA_M_S2)
+    tracks = start_tracks(feet_px([[7.0, 6.0], [7.3, 6.0]]), CAMERA, POSE, V, CJPDAF.initial_speed_sigma_m_s, first_id=0)
+    updated = update_tracks(predict_tracks(tracks, F, U), feet_px([[7.0, 6.0], [7.3, 6.0]]), CAMERA, POSE, V, CJPDAF).tracks
     np.testing.assert_array_equal(updated.ids, [0, 1])
     np.testing.assert_array_equal(updated.missed_steps, [0, 0])
     np.testing.assert_array_equal(updated.hits, [2, 2])
 
 
 def test_a_measurement_only_in_the_gate_of_a_track_that_dies_starts_a_new_one():
-    F, U = constant_velocity_model(0.2, CJPDAF.acceleration_sigma_m_s2)
-    tracks = predict_tracks(start_tracks(feet_px([[7.5, 6.0]]), CAMERA, POSE, V, CJPDAF, first_id=0), F, U)
+    F, U = constant_velocity_model(0.2, ACCELERATION_SIGMA_M_S2)
+    tracks = predict_tracks(start_tracks(feet_px([[7.5, 6.0]]), CAMERA, POSE, V, CJPDAF.initial_speed_sigma_m_s, first_id=0), F, U)
     feet = feet_px([[7.7, 6.1]])
     _, distance2, allowed, S, _ = step_inputs(tracks.mean, tracks.covariance, feet)
     p = jpdaf.likelihoods(distance2, S, allowed)[0, 0]
     assert p > 0
     # C = 3p: beta = 1/4, so the unconfirmed track misses and dies, and the measurement is nobody's.
-    config = CJPDAF.model_copy(update={"confirmation_hits": 2, "clutter_density_per_px2": 3 * p})
-    updated = update_tracks(tracks, feet, CAMERA, POSE, V, config)
+    config = replace(CJPDAF, confirmation_hits=2, clutter_density_per_px2=3 * p)
+    updated = update_tracks(tracks, feet, CAMERA, POSE, V, config).tracks
     np.testing.assert_array_equal(updated.ids, [1])
     np.testing.assert_allclose(updated.mean[0, :2], [7.7, 6.1], atol=1e-9)
 
 
 def test_missed_steps_count_only_in_view_and_a_track_dies_after_the_allowed_ones():
-    F, U = constant_velocity_model(0.2, CJPDAF.acceleration_sigma_m_s2)
-    config = CJPDAF.model_copy(update={"max_missed_steps": 2, "max_position_sigma_m": 100.0})
-    tracks = start_tracks(feet_px([[7.5, 6.0]]), CAMERA, POSE, V, config, first_id=0)
+    F, U = constant_velocity_model(0.2, ACCELERATION_SIGMA_M_S2)
+    config = replace(CJPDAF, max_missed_steps=2, max_position_sigma_m=100.0)
+    tracks = start_tracks(feet_px([[7.5, 6.0]]), CAMERA, POSE, V, config.initial_speed_sigma_m_s, first_id=0)
     looking_away = np.array([60.0, 40.0, 4.0])
     for _ in range(3):
-        tracks = update_tracks(predict_tracks(tracks, F, U), np.zeros((0, 2)), CAMERA, looking_away, V, config)
+        tracks = update_tracks(predict_tracks(tracks, F, U), np.zeros((0, 2)), CAMERA, looking_away, V, config).tracks
     assert len(tracks) == 1 and tracks.missed_steps[0] == 0
     lengths = []
     for _ in range(3):
-        tracks = update_tracks(predict_tracks(tracks, F, U), feet_px([[2.0, 12.0]]), CAMERA, POSE, V, config)
+        tracks = update_tracks(predict_tracks(tracks, F, U), feet_px([[2.0, 12.0]]), CAMERA, POSE, V, config).tracks
         lengths.append(sorted(tracks.ids.tolist()))
     # The far detection starts a track of its own each step (it is gated by none), then keeps it alive.
     assert lengths == [[0, 1], [0, 1], [1]]
@@ -255,22 +264,19 @@ def test_tracks_follow_two_crossing_walkers_and_keep_their_ids(association):
     # Both walkers reach (7.5, 6.5) at step 15, on paths crossing at right angles.
     start = np.array([[4.5, 3.5], [10.5, 3.5]])
     velocity = np.array([[1.0, 1.0], [-1.0, 1.0]])
-    assert_tracks_follow_walkers(start, velocity, 31, Tracker(association=association))
+    assert_tracks_follow_walkers(start, velocity, 31, parameters(association=association))
 
 
 def test_an_unknown_association_is_refused_naming_the_field():
     with pytest.raises(ScenarioError) as error:
         scenario_from_dict({"tracker": {"association": "jpda"}})
     assert "tracker.association: Input should be 'hungarian' or 'cjpdaf' (got 'jpda')" in str(error.value)
-    with pytest.raises(pydantic.ValidationError) as error:
-        Tracker(association="nearest")
-    assert error.value.errors()[0]["loc"] == ("association",)
     with pytest.raises(ScenarioError, match="tracker.clutter_density_per_px2: Input should be greater than or equal"):
         scenario_from_dict({"tracker": {"clutter_density_per_px2": -1e-6}})
 
 
 def test_the_default_is_hungarian_and_the_command_line_selects_the_cjpdaf(capsys):
-    assert Tracker().association == "hungarian"
+    assert parameters().association == "hungarian"
     hog = build_scenario("pets", "hog", association="cjpdaf").tracker
     assert (hog.association, hog.confirmation_hits, hog.clutter_density_per_px2) == ("cjpdaf", 2, 1e-6)
     assert build_scenario("synthetic", association="cjpdaf").tracker.association == "cjpdaf"

@@ -2,8 +2,8 @@ import numpy as np
 import pytest
 
 from ptztrack.camera.virtual import virtual_ptz
-from ptztrack.config import Tracker, pets_scenario
-from ptztrack.episode import run_episode
+from ptztrack.build.episode import run_episode
+from ptztrack.config import pets_scenario
 from ptztrack.evaluate.metrics import episode_metrics
 from ptztrack.geometry.calibration import load_calibration
 from ptztrack.geometry.ptz import (
@@ -18,15 +18,16 @@ from ptztrack.geometry.ptz import (
 from ptztrack.scene.pets import RecordedVideo, load_mot_ground_truth
 from ptztrack.track.appearance import pixel_span, similarity, spatiogram
 from ptztrack.track.kalman import constant_velocity_model
-from ptztrack.track.tracker import Tracks, predict_tracks, start_tracks, update_tracks
 from ptztrack.track.templates import (
     MIN_SIMILARITY,
-    detection_of_each_track,
     refresh_templates,
     search_radius_px,
     template_box_px,
     template_measurements,
 )
+from ptztrack.track.tracker import predict_tracks, start_tracks, update_tracks
+from ptztrack.types import Tracks
+from test_track_tracker import ACCELERATION_SIGMA_M_S2, parameters
 
 CAMERA = PTZCamera((7.5, -4.0, 7.0), 640, 480, 400.0)
 POSE = look_at(CAMERA, [7.5, 6.0], 1.0)
@@ -145,30 +146,25 @@ def test_refreshing_retakes_the_given_tracks_keeps_the_other_live_ones_and_drops
 
 @pytest.mark.parametrize("association", ["hungarian", "cjpdaf"])
 def test_each_detected_or_new_track_is_paired_with_its_detection(association):
-    config = Tracker(association=association)
+    config = parameters(association=association)
     feet_px = np.array([[200.0, 300.0], [420.0, 300.0]])
-    F, U = constant_velocity_model(0.2, config.acceleration_sigma_m_s2)
-    predicted = predict_tracks(start_tracks(feet_px, CAMERA, POSE, V, config, first_id=3), F, U)
+    F, U = constant_velocity_model(0.2, ACCELERATION_SIGMA_M_S2)
+    predicted = predict_tracks(start_tracks(feet_px, CAMERA, POSE, V, config.initial_speed_sigma_m_s, 3), F, U)
     detections_px = np.array([[560.0, 350.0], [202.0, 299.0]])  # somebody new, and track 3 moved
-    updated = update_tracks(predicted, detections_px, CAMERA, POSE, V, config)
-    assert set(updated.ids) == {3, 4, 5}
-    track_ids, paired_px = detection_of_each_track(
-        predicted, updated, detections_px, CAMERA, POSE, V, config.gate_probability
-    )
-    np.testing.assert_array_equal(track_ids, [3, 5])
-    np.testing.assert_allclose(paired_px, detections_px[::-1], atol=1e-6)
+    update = update_tracks(predicted, detections_px, CAMERA, POSE, V, config)
+    assert set(update.tracks.ids) == {3, 4, 5}
+    np.testing.assert_array_equal(update.track_ids, [3, 5])
+    np.testing.assert_array_equal(update.measurement_index, [1, 0])
 
 
 @pytest.mark.parametrize("association, paired", [("hungarian", 1), ("cjpdaf", 0)])
 def test_a_detection_the_cjpdaf_shares_between_tracks_is_paired_with_none(association, paired):
-    config = Tracker(association=association)
-    F, U = constant_velocity_model(0.2, config.acceleration_sigma_m_s2)
+    config = parameters(association=association)
+    F, U = constant_velocity_model(0.2, ACCELERATION_SIGMA_M_S2)
     feet_px = np.array([[298.0, 300.0], [302.0, 302.0], [302.0, 298.0]])
-    predicted = predict_tracks(start_tracks(feet_px, CAMERA, POSE, V, config, first_id=0), F, U)
-    detections_px = np.array([[301.0, 300.0]])
-    updated = update_tracks(predicted, detections_px, CAMERA, POSE, V, config)
-    track_ids, _ = detection_of_each_track(predicted, updated, detections_px, CAMERA, POSE, V, config.gate_probability)
-    assert len(track_ids) == paired
+    predicted = predict_tracks(start_tracks(feet_px, CAMERA, POSE, V, config.initial_speed_sigma_m_s, 0), F, U)
+    update = update_tracks(predicted, np.array([[301.0, 300.0]]), CAMERA, POSE, V, config)
+    assert len(update.track_ids) == len(update.measurement_index) == paired
 
 
 @pytest.fixture(scope="module")

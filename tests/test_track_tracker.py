@@ -1,12 +1,14 @@
 import numpy as np
 import pytest
 
-from ptztrack.config import Tracker
+from ptztrack.build.factories import tracker_parameters
+from ptztrack.config import Tracker, scenario_from_dict
+from ptztrack.types import Tracks
 from ptztrack.geometry.ptz import PTZCamera, apply_homography, feet_jacobian, ground_to_image, look_at
 from ptztrack.track import kalman
 from ptztrack.track.kalman import constant_velocity_model
 from ptztrack.track.tracker import (
-    no_tracks,
+    TrackerParameters,
     observation_matrix,
     predict_tracks,
     start_tracks,
@@ -17,7 +19,15 @@ from ptztrack.track.tracker import (
 CAMERA = PTZCamera((7.5, -4.0, 7.0), 640, 480, 400.0)
 POSE = look_at(CAMERA, [7.5, 6.0], 1.0)
 V = 4.0 * np.eye(2)
-CONFIG = Tracker()
+ACCELERATION_SIGMA_M_S2 = Tracker().acceleration_sigma_m_s2
+
+
+def parameters(**fields) -> TrackerParameters:
+    """The tracker's parameters of a scenario with these ``tracker`` fields."""
+    return tracker_parameters(scenario_from_dict({"tracker": fields}))
+
+
+CONFIG = parameters()
 
 
 def feet_px(ground_xy, pose=POSE):
@@ -33,7 +43,7 @@ def test_observation_matrix_is_the_feet_jacobian_with_zero_velocity_columns():
 
 def test_a_new_track_starts_at_the_ground_point_with_the_pixel_noise_carried_to_the_ground():
     ground = np.array([[5.0, 6.0], [10.0, 9.0]])
-    tracks = start_tracks(feet_px(ground), CAMERA, POSE, V, CONFIG, first_id=7)
+    tracks = start_tracks(feet_px(ground), CAMERA, POSE, V, CONFIG.initial_speed_sigma_m_s, first_id=7)
     np.testing.assert_allclose(tracks.mean[:, :2], ground, atol=1e-9)
     np.testing.assert_array_equal(tracks.ids, [7, 8])
     assert tracks.next_id == 9
@@ -44,19 +54,19 @@ def test_a_new_track_starts_at_the_ground_point_with_the_pixel_noise_carried_to_
 
 def test_pixels_above_the_horizon_start_no_track():
     pose = np.array([0.0, 5.0, 1.0])
-    tracks = start_tracks(np.array([[320.0, 10.0], [320.0, 400.0]]), CAMERA, pose, V, CONFIG, first_id=0)
+    tracks = start_tracks(np.array([[320.0, 10.0], [320.0, 400.0]]), CAMERA, pose, V, CONFIG.initial_speed_sigma_m_s, first_id=0)
     assert len(tracks) == 1
 
 
-def assert_tracks_follow_walkers(start, velocity, steps: int, config: Tracker) -> None:
+def assert_tracks_follow_walkers(start, velocity, steps: int, config: TrackerParameters) -> None:
     """Walkers from ``start`` (2, 2) at ``velocity`` (2, 2) m/s, detected every step: the tracks keep ids 0
     and 1 throughout and end on the walkers' positions and velocities."""
     dt = 0.2
-    F, U = constant_velocity_model(dt, config.acceleration_sigma_m_s2)
-    tracks = no_tracks()
+    F, U = constant_velocity_model(dt, ACCELERATION_SIGMA_M_S2)
+    tracks = Tracks.empty()
     for step in range(steps):
         truth = start + velocity * step * dt
-        tracks = update_tracks(predict_tracks(tracks, F, U), feet_px(truth), CAMERA, POSE, V, config)
+        tracks = update_tracks(predict_tracks(tracks, F, U), feet_px(truth), CAMERA, POSE, V, config).tracks
         order = np.argsort(tracks.ids)
         np.testing.assert_array_equal(tracks.ids[order], [0, 1])
     np.testing.assert_allclose(tracks.mean[order, :2], truth, atol=0.02)
@@ -68,38 +78,38 @@ def test_tracks_follow_walkers_and_keep_their_ids():
 
 
 def test_hungarian_assignment_ignores_detection_order_and_gates_outliers():
-    F, U = constant_velocity_model(0.2, CONFIG.acceleration_sigma_m_s2)
-    tracks = start_tracks(feet_px([[5.0, 5.0], [9.0, 7.0]]), CAMERA, POSE, V, CONFIG, first_id=0)
+    F, U = constant_velocity_model(0.2, ACCELERATION_SIGMA_M_S2)
+    tracks = start_tracks(feet_px([[5.0, 5.0], [9.0, 7.0]]), CAMERA, POSE, V, CONFIG.initial_speed_sigma_m_s, first_id=0)
     detections = feet_px([[9.0, 7.0], [14.0, 1.0], [5.0, 5.0]])
-    updated = update_tracks(predict_tracks(tracks, F, U), detections, CAMERA, POSE, V, CONFIG)
+    updated = update_tracks(predict_tracks(tracks, F, U), detections, CAMERA, POSE, V, CONFIG).tracks
     np.testing.assert_array_equal(updated.ids, [0, 1, 2])
     np.testing.assert_allclose(updated.mean[:, :2], [[5.0, 5.0], [9.0, 7.0], [14.0, 1.0]], atol=1e-6)
     np.testing.assert_array_equal(updated.missed_steps, 0)
 
 
 def test_a_track_in_view_is_deleted_after_the_allowed_missed_steps_but_not_one_out_of_view():
-    F, U = constant_velocity_model(0.2, CONFIG.acceleration_sigma_m_s2)
-    config = Tracker(max_missed_steps=2, max_position_sigma_m=100.0)
-    tracks = start_tracks(feet_px([[7.5, 6.0]]), CAMERA, POSE, V, config, first_id=0)
+    F, U = constant_velocity_model(0.2, ACCELERATION_SIGMA_M_S2)
+    config = parameters(max_missed_steps=2, max_position_sigma_m=100.0)
+    tracks = start_tracks(feet_px([[7.5, 6.0]]), CAMERA, POSE, V, config.initial_speed_sigma_m_s, first_id=0)
     looking_away = np.array([60.0, 40.0, 4.0])
     for _ in range(5):
-        tracks = update_tracks(predict_tracks(tracks, F, U), np.zeros((0, 2)), CAMERA, looking_away, V, config)
+        tracks = update_tracks(predict_tracks(tracks, F, U), np.zeros((0, 2)), CAMERA, looking_away, V, config).tracks
     assert len(tracks) == 1 and tracks.missed_steps[0] == 0
     lengths = []
     for _ in range(3):
-        tracks = update_tracks(predict_tracks(tracks, F, U), np.zeros((0, 2)), CAMERA, POSE, V, config)
+        tracks = update_tracks(predict_tracks(tracks, F, U), np.zeros((0, 2)), CAMERA, POSE, V, config).tracks
         lengths.append(len(tracks))
     assert lengths == [1, 1, 0]
 
 
 def test_a_track_is_deleted_when_its_uncertainty_grows_too_large():
-    F, U = constant_velocity_model(0.2, CONFIG.acceleration_sigma_m_s2)
-    config = Tracker(max_position_sigma_m=1.0, max_missed_steps=1000)
-    tracks = start_tracks(feet_px([[7.5, 6.0]]), CAMERA, POSE, V, config, first_id=0)
+    F, U = constant_velocity_model(0.2, ACCELERATION_SIGMA_M_S2)
+    config = parameters(max_position_sigma_m=1.0, max_missed_steps=1000)
+    tracks = start_tracks(feet_px([[7.5, 6.0]]), CAMERA, POSE, V, config.initial_speed_sigma_m_s, first_id=0)
     looking_away = np.array([60.0, 40.0, 4.0])
     alive = 0
     while len(tracks):
-        tracks = update_tracks(predict_tracks(tracks, F, U), np.zeros((0, 2)), CAMERA, looking_away, V, config)
+        tracks = update_tracks(predict_tracks(tracks, F, U), np.zeros((0, 2)), CAMERA, looking_away, V, config).tracks
         alive += 1
         assert alive < 100
     # position sd 0.9 m/s * t (initial velocity spread) passes 1 m between 1.0 s and 1.2 s
@@ -107,25 +117,25 @@ def test_a_track_is_deleted_when_its_uncertainty_grows_too_large():
 
 
 def test_with_confirmation_a_one_off_detection_is_never_reported_and_dies_at_its_first_miss():
-    F, U = constant_velocity_model(0.2, CONFIG.acceleration_sigma_m_s2)
-    config = Tracker(confirmation_hits=2)
+    F, U = constant_velocity_model(0.2, ACCELERATION_SIGMA_M_S2)
+    config = parameters(confirmation_hits=2)
     person, false_positive = [7.5, 6.0], [10.0, 9.0]
-    tracks = update_tracks(no_tracks(), feet_px([person, false_positive]), CAMERA, POSE, V, config)
-    assert len(tracks) == 2 and len(tracks.confirmed(config)) == 0
-    tracks = update_tracks(predict_tracks(tracks, F, U), feet_px([person]), CAMERA, POSE, V, config)
+    tracks = update_tracks(Tracks.empty(), feet_px([person, false_positive]), CAMERA, POSE, V, config).tracks
+    assert len(tracks) == 2 and len(tracks.confirmed(config.confirmation_hits)) == 0
+    tracks = update_tracks(predict_tracks(tracks, F, U), feet_px([person]), CAMERA, POSE, V, config).tracks
     np.testing.assert_array_equal(tracks.ids, [0])
     np.testing.assert_array_equal(tracks.hits, [2])
-    np.testing.assert_array_equal(tracks.confirmed(config).ids, [0])
+    np.testing.assert_array_equal(tracks.confirmed(config.confirmation_hits).ids, [0])
     # Once confirmed, a track survives misses as before.
-    tracks = update_tracks(predict_tracks(tracks, F, U), np.zeros((0, 2)), CAMERA, POSE, V, config)
-    np.testing.assert_array_equal(tracks.confirmed(config).ids, [0])
+    tracks = update_tracks(predict_tracks(tracks, F, U), np.zeros((0, 2)), CAMERA, POSE, V, config).tracks
+    np.testing.assert_array_equal(tracks.confirmed(config.confirmation_hits).ids, [0])
 
 
 def test_a_track_measured_by_its_own_template_is_updated_without_becoming_more_or_less_alive():
-    tracks = start_tracks(feet_px(np.array([[7.0, 6.0], [9.0, 7.0]])), CAMERA, POSE, V, CONFIG, 0)
-    tracks = update_tracks(tracks, feet_px(np.array([[7.0, 6.0]])), CAMERA, POSE, V, CONFIG)  # track 1 missed
+    tracks = start_tracks(feet_px(np.array([[7.0, 6.0], [9.0, 7.0]])), CAMERA, POSE, V, CONFIG.initial_speed_sigma_m_s, 0)
+    tracks = update_tracks(tracks, feet_px(np.array([[7.0, 6.0]])), CAMERA, POSE, V, CONFIG).tracks  # track 1 missed
     moved = feet_px(np.array([[9.1, 7.0]]))
-    updated = update_own_tracks(tracks, [1], moved, CAMERA, POSE, V, CONFIG)
+    updated = update_own_tracks(tracks, [1], moved, CAMERA, POSE, V, CONFIG.max_position_sigma_m)
     np.testing.assert_array_equal(updated.ids, tracks.ids)
     np.testing.assert_array_equal(updated.hits, tracks.hits)
     np.testing.assert_array_equal(updated.missed_steps, tracks.missed_steps)
@@ -141,6 +151,6 @@ def test_a_track_measured_by_its_own_template_is_updated_without_becoming_more_o
 
 
 def test_a_measurement_of_a_dead_track_is_refused():
-    tracks = start_tracks(feet_px(np.array([[7.0, 6.0]])), CAMERA, POSE, V, CONFIG, 0)
+    tracks = start_tracks(feet_px(np.array([[7.0, 6.0]])), CAMERA, POSE, V, CONFIG.initial_speed_sigma_m_s, 0)
     with pytest.raises(ValueError, match=r"measurements of tracks \[5\], which are not alive"):
-        update_own_tracks(tracks, [5], feet_px(np.array([[7.0, 6.0]])), CAMERA, POSE, V, CONFIG)
+        update_own_tracks(tracks, [5], feet_px(np.array([[7.0, 6.0]])), CAMERA, POSE, V, CONFIG.max_position_sigma_m)

@@ -10,20 +10,22 @@ from pathlib import Path
 
 import numpy as np
 
-from ptztrack.camera.pose_feedback import reference_index
-from ptztrack.config import PoseError, Scenario, ScenarioError, load_scenario, pets_scenario, scenario_from_dict
-from ptztrack.control.msg_scheduler import CHOOSERS
-from ptztrack.episode import POLICIES, episode_world, run_episode
-from ptztrack.evaluate.experiment import (
-    EXECUTORS,
+from ptztrack import registry
+from ptztrack.build.episode import episode_world, run_episode
+from ptztrack.build.experiments import (
+    POSE_SOURCES,
     STRATEGIES,
-    format_table,
-    print_progress,
+    closed_loop_cells,
     recording_cells,
-    run_cells,
-    summarise,
+    registration_views,
+    run_cell,
+    run_closed_loop_cell,
     synthetic_cells,
 )
+from ptztrack.build.registration import reference_index
+from ptztrack.config import PoseError, Scenario, ScenarioError, load_scenario, pets_scenario, scenario_from_dict
+from ptztrack.control.msg_scheduler import CHOOSERS
+from ptztrack.evaluate.executors import EXECUTORS, print_progress, run_cells
 from ptztrack.evaluate.metrics import DISPLAY, episode_metrics
 from ptztrack.evaluate.msg import (
     ambiguity_figure,
@@ -34,14 +36,9 @@ from ptztrack.evaluate.msg import (
     summarise_by_ambiguity,
     trails_figure,
 )
-from ptztrack.evaluate.registration import (
-    POSE_SOURCES,
-    closed_loop_cells,
-    registration_errors,
-    run_closed_loop_cell,
-    summarise_registration,
-)
-from ptztrack.evaluate.report import write_atomically, write_figure, write_outputs
+from ptztrack.evaluate.registration import summarise_registration
+from ptztrack.evaluate.report import RUN_FILES, write_atomically, write_figure, write_outputs
+from ptztrack.evaluate.tables import format_table, summarise
 from ptztrack.evaluate.video import view_renderer
 from ptztrack.geometry.calibration import CalibrationError
 from ptztrack.geometry.registration import RegistrationIndexError
@@ -104,16 +101,15 @@ def run_command(args: argparse.Namespace) -> int:
     print(format_metrics(metrics))
     if args.out is not None:
         title = f"{args.policy}, {scenario.detector.kind} detector, seed {args.seed}: MOTA {metrics['mota']:.1%}"
-        write_outputs(args.out, episode, metrics, title, view_renderer(scenario, world))
-        names = ("metrics.json", "tracks.csv", "episode.png", "episode.mp4")
-        print(f"wrote {', '.join(str(args.out / name) for name in names)}")
+        write_outputs(args.out, episode, metrics, title, view_renderer(world))
+        print(f"wrote {', '.join(RUN_FILES)} into {args.out}")
     return 0
 
 
 def msg_experiment_command(args: argparse.Namespace) -> int:
     cells = msg_cells(args.runs)
     print(f"{len(cells)} simulations x {len(CHOOSERS)} schedulers, {args.executor} executor", file=sys.stderr)
-    rows = [row for rows in run_cells(cells, args.executor, args.workers, print_progress, run_msg_cell) for row in rows]
+    rows = [row for rows in run_cells(cells, run_msg_cell, args.executor, args.workers, print_progress) for row in rows]
     print("Face capture on the MSG: M by N_j/s bin, mean +- standard deviation (runs)")
     print(format_ambiguity_table(summarise_by_ambiguity(rows)))
     written = []
@@ -137,8 +133,8 @@ def msg_experiment_command(args: argparse.Namespace) -> int:
 
 def registration_experiment_command(args: argparse.Namespace) -> int:
     scenario = build_scenario(
-        "pets" if args.scenario == "synthetic" else args.scenario,
-        args.detector or "hog",
+        args.scenario,
+        args.detector,
         args.frames,
         recording_paths(args),
         args.association,
@@ -154,12 +150,12 @@ def registration_experiment_command(args: argparse.Namespace) -> int:
         print(f"{'building' if built else 'reading'} the reference index {index_path}", file=sys.stderr)
         index = reference_index(scenario)
         print(f"{len(index.poses)} reference views; registering {args.views} live views", file=sys.stderr)
-        views = registration_errors(scenario, index, args.views, args.seed, partial(print_progress, noun="views"))
+        views = registration_views(scenario, index, args.views, args.seed, partial(print_progress, noun="views"))
         summary = summarise_registration(views)
         pose_error = PoseError(pan_tilt_sigma_deg=args.pose_noise_deg, zoom_sigma=args.zoom_noise)
         cells = closed_loop_cells(scenario, pose_error, args.policy, args.pose_sources)
         print(f"{len(cells)} closed-loop runs, {args.executor} executor", file=sys.stderr)
-        closed_loop = run_cells(cells, args.executor, args.workers, print_progress, run_closed_loop_cell)
+        closed_loop = run_cells(cells, run_closed_loop_cell, args.executor, args.workers, print_progress)
     size = scenario.pose_feedback.image_size_px
     print(
         f"Registration of {summary['views']} live views at random reachable poses, {size[0]} x {size[1]} px, "
@@ -194,38 +190,30 @@ def _unless_failed(error: float | None) -> str:
     return "(unregistered views)" if error is None else f"{error:.3f}"
 
 
-def experiment_command(args: argparse.Namespace) -> int:
-    if args.name == "msg":
-        return msg_experiment_command(args)
-    if args.name == "registration":
-        return registration_experiment_command(args)
-    if args.name == "pets":
-        scenario = build_scenario(
-            "pets",
-            args.detector or "ideal",
-            args.frames,
-            recording_paths(args),
-            args.association,
-            args.measurement_source,
-        )
-        cells = recording_cells(scenario, args.beta or [9.0, 1.0], args.strategies)
-        title = f"PETS 2009 S2.L1 View_001, {scenario.detector.kind} detector, every 2nd frame"
-    else:
-        scenario = build_scenario(
-            args.scenario,
-            args.detector or "realistic",
-            args.frames,
-            recording_paths(args),
-            args.association,
-            args.measurement_source,
-        )
-        cells = synthetic_cells(scenario, args.sequences, args.strategies)
-        title = (
-            f"{args.scenario} scene, {scenario.detector.kind} detector, beta {scenario.control.beta:g}, "
-            f"{args.sequences} sequences of {scenario.frames} frames (means over sequences)"
-        )
+def synthetic_experiment_command(args: argparse.Namespace) -> int:
+    scenario = build_scenario(
+        args.scenario, args.detector, args.frames, association=args.association, measurement_source=None
+    )
+    cells = synthetic_cells(scenario, args.sequences, args.strategies)
+    title = (
+        f"{args.scenario} scene, {scenario.detector.kind} detector, beta {scenario.control.beta:g}, "
+        f"{args.sequences} sequences of {scenario.frames} frames (means over sequences)"
+    )
+    return _run_table(args, cells, title)
+
+
+def pets_experiment_command(args: argparse.Namespace) -> int:
+    scenario = build_scenario(
+        "pets", args.detector, args.frames, recording_paths(args), args.association, args.measurement_source
+    )
+    cells = recording_cells(scenario, args.beta or [9.0, 1.0], args.strategies)
+    title = f"PETS 2009 S2.L1 View_001, {scenario.detector.kind} detector, every 2nd frame"
+    return _run_table(args, cells, title)
+
+
+def _run_table(args: argparse.Namespace, cells: list, title: str) -> int:
     print(f"{len(cells)} episodes, {args.executor} executor", file=sys.stderr)
-    summary = summarise(run_cells(cells, args.executor, args.workers, print_progress))
+    summary = summarise(run_cells(cells, run_cell, args.executor, args.workers, print_progress))
     print(format_table(summary, title))
     if args.json is not None:
         write_atomically(args.json, (json.dumps(summary, indent=2) + "\n").encode())
@@ -233,53 +221,69 @@ def experiment_command(args: argparse.Namespace) -> int:
     return 0
 
 
+class OneLineParser(argparse.ArgumentParser):
+    """Command-line mistakes end in one line on stderr and exit status 2, like every other bad input."""
+
+    def error(self, message: str):
+        self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+
 def parser() -> argparse.ArgumentParser:
-    root = argparse.ArgumentParser(prog="ptztrack", description="Multi-person tracking with a PTZ camera.")
+    root = OneLineParser(prog="ptztrack", description="Multi-person tracking with a PTZ camera.")
     commands = root.add_subparsers(dest="command", required=True)
+    policies, detectors = registry.names("policies"), registry.names("detectors")
     run = commands.add_parser("run", help="run one closed-loop episode and print its metrics")
     run.add_argument("--scenario", default="synthetic", help="'synthetic' or 'pets' (built in), or a scenario YAML file")
-    run.add_argument("--policy", choices=POLICIES, default="smpl")
-    run.add_argument("--detector", choices=("ideal", "realistic", "hog"), help="overrides the scenario's detector")
-    run.add_argument("--seed", type=int, default=0)
+    run.add_argument("--policy", choices=policies, default="smpl")
+    run.add_argument("--detector", choices=detectors, help="overrides the scenario's detector")
+    run.add_argument("--seed", type=_non_negative_int, default=0)
     run.add_argument("--frames", type=_positive_int, help="overrides the scenario's number of frames")
-    _add_association_argument(run)
-    run.add_argument("--out", type=Path, help="directory for metrics.json, tracks.csv, episode.png and episode.mp4")
+    _add_tracker_arguments(run)
+    run.add_argument("--out", type=Path, help=f"directory for {', '.join(RUN_FILES)}")
     _add_recording_arguments(run)
     run.set_defaults(handler=run_command)
 
-    experiment = commands.add_parser("experiment", help="run one of the paper's experiments and print its table")
-    experiment.add_argument(
-        "name",
-        choices=("synthetic", "pets", "msg", "registration"),
-        help="synthetic (the PTZ paper's Tables 1-2), pets (Tables 3-4), msg (the face-capture paper's Figure 7) "
-        "or registration (the scale-invariant paper: registered PTZ views, and the closed loop on their poses)",
+    experiment = commands.add_parser("experiment", help="run one of the papers' experiments and print its table")
+    experiments = experiment.add_subparsers(dest="name", required=True, metavar="{synthetic,pets,msg,registration}")
+
+    synthetic = experiments.add_parser("synthetic", help="the PTZ paper's Tables 1-2 on the synthetic scene")
+    synthetic.add_argument("--scenario", default="synthetic", help="'synthetic' (built in) or a scenario YAML file")
+    synthetic.add_argument("--detector", choices=detectors, default="realistic")
+    synthetic.add_argument("--sequences", type=_positive_int, default=12)
+    synthetic.add_argument("--frames", type=_positive_int, help="overrides the scenario's number of frames")
+    synthetic.add_argument("--strategies", nargs="+", choices=_strategies(policies), default=list(STRATEGIES))
+    _add_association_argument(synthetic)
+    _add_executor_arguments(synthetic, "one row per strategy")
+    synthetic.set_defaults(handler=synthetic_experiment_command)
+
+    pets = experiments.add_parser("pets", help="the PTZ paper's Tables 3-4 on PETS 2009 S2.L1")
+    pets.add_argument("--detector", default="ideal", help="ideal (the annotations) or hog")
+    pets.add_argument("--beta", type=_non_negative_float, action="append", help="a weight of the patrolling term (repeatable; default 9 and 1)")
+    pets.add_argument("--strategies", nargs="+", choices=_strategies(policies), default=list(STRATEGIES))
+    pets.add_argument("--frames", type=_positive_int, help="overrides the scenario's number of steps")
+    _add_tracker_arguments(pets)
+    _add_executor_arguments(pets, "one row per strategy and beta")
+    _add_recording_arguments(pets)
+    pets.set_defaults(handler=pets_experiment_command)
+
+    msg = experiments.add_parser("msg", help="the face-capture paper's Figure 7")
+    msg.add_argument("--runs", type=_positive_int, default=414, help="simulations")
+    msg.add_argument("--plot", type=Path, help="M against N_j/s per scheduler (PNG)")
+    msg.add_argument("--trails", type=Path, help="one simulation's trails in (x, y, t) (PNG)")
+    _add_executor_arguments(msg, "one row per run and scheduler")
+    msg.set_defaults(handler=msg_experiment_command)
+
+    registration = experiments.add_parser(
+        "registration", help="the scale-invariant paper: registered PTZ views, and the closed loop on their poses"
     )
-    experiment.add_argument("--scenario", default="synthetic", help="'synthetic' (built in) or a scenario YAML file")
-    experiment.add_argument(
-        "--detector",
-        choices=("ideal", "realistic", "hog"),
-        help="synthetic: ideal or realistic (default); pets: ideal (default) or hog",
-    )
-    experiment.add_argument(
-        "--beta", type=float, action="append", help="pets: a weight of the patrolling term (repeatable; default 9 and 1)"
-    )
-    _add_association_argument(experiment)
-    experiment.add_argument("--sequences", type=_positive_int, default=12)
-    experiment.add_argument("--frames", type=_positive_int, help="overrides the scenario's number of frames")
-    experiment.add_argument("--strategies", nargs="+", choices=STRATEGIES, default=list(STRATEGIES))
-    experiment.add_argument("--executor", choices=EXECUTORS, default="local")
-    experiment.add_argument("--workers", type=_positive_int, help="processes of the local executor (default: all cores)")
-    experiment.add_argument("--json", type=Path, help="write one row per strategy (msg: per run and scheduler) here")
-    experiment.add_argument("--runs", type=_positive_int, default=414, help="msg: simulations")
-    experiment.add_argument("--plot", type=Path, help="msg: M against N_j/s per scheduler (PNG)")
-    experiment.add_argument("--trails", type=Path, help="msg: one simulation's trails in (x, y, t) (PNG)")
-    registration = experiment.add_argument_group("registration")
+    registration.add_argument("--scenario", default="pets", help="'pets' (built in) or a recording scenario YAML file")
     registration.add_argument("--views", type=_positive_int, default=100, help="random live views to register")
-    registration.add_argument("--seed", type=int, default=0, help="draws the live views' poses and frames")
+    registration.add_argument("--seed", type=_non_negative_int, default=0, help="draws the live views' poses and frames")
     registration.add_argument(
         "--index", type=Path, help="reference index file: read if it exists, else built and written (default: built)"
     )
-    registration.add_argument("--policy", choices=POLICIES, default="smpl", help="closed-loop policy")
+    registration.add_argument("--detector", choices=detectors, default="hog", help="closed-loop detector")
+    registration.add_argument("--policy", choices=policies, default="smpl", help="closed-loop policy")
     registration.add_argument(
         "--pose-sources", nargs="+", choices=POSE_SOURCES, default=list(POSE_SOURCES), help="closed-loop pose sources"
     )
@@ -289,20 +293,37 @@ def parser() -> argparse.ArgumentParser:
     registration.add_argument(
         "--zoom-noise", type=_non_negative_float, default=0.02, help="closed loop: relative zoom landing error, 1 sigma"
     )
-    _add_recording_arguments(experiment)
-    experiment.set_defaults(handler=experiment_command)
+    registration.add_argument("--frames", type=_positive_int, help="closed loop: overrides the scenario's number of steps")
+    _add_tracker_arguments(registration)
+    _add_executor_arguments(registration, "the registration errors and the closed-loop rows")
+    _add_recording_arguments(registration)
+    registration.set_defaults(handler=registration_experiment_command)
     return root
 
 
-def _add_association_argument(command: argparse.ArgumentParser) -> None:
-    """The tracker's choices: association and measurement source."""
-    command.add_argument(
-        "--association", choices=("hungarian", "cjpdaf"), help="overrides the scenario's tracker.association"
-    )
+def _strategies(policies: list[str]) -> list[str]:
+    """The tables' strategy names ('rnd' for the 'random' policy) and every other registered policy."""
+    return list(dict.fromkeys([*STRATEGIES, *(name for name in policies if name != "random")]))
+
+
+def _add_executor_arguments(command: argparse.ArgumentParser, rows: str) -> None:
+    command.add_argument("--executor", choices=EXECUTORS, default="local")
+    command.add_argument("--workers", type=_positive_int, help="processes of the local executor (default: all cores)")
+    command.add_argument("--json", type=Path, help=f"write {rows} here")
+
+
+def _add_tracker_arguments(command: argparse.ArgumentParser) -> None:
+    _add_association_argument(command)
     command.add_argument(
         "--measurement-source",
         choices=("detector", "spatiogram"),
         help="overrides the scenario's tracker.measurement_source (spatiogram: templates between detector steps)",
+    )
+
+
+def _add_association_argument(command: argparse.ArgumentParser) -> None:
+    command.add_argument(
+        "--association", choices=("hungarian", "cjpdaf"), help="overrides the scenario's tracker.association"
     )
 
 
@@ -318,6 +339,13 @@ def _non_negative_float(text: str) -> float:
     value = float(text)
     if not value >= 0:
         raise argparse.ArgumentTypeError(f"must be at least 0 (got {text})")
+    return value
+
+
+def _non_negative_int(text: str) -> int:
+    value = int(text)
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"must be at least 0 (got {value})")
     return value
 
 

@@ -6,15 +6,14 @@ camera mounting chosen in :mod:`ptztrack.scene.synthetic`.
 
 from importlib import resources
 from pathlib import Path
-from typing import Annotated, Literal
+from typing import Annotated, Any, Literal
 
 import numpy as np
 import pydantic
 import yaml
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import AfterValidator, BaseModel, ConfigDict, Field, model_validator
 
-from ptztrack.camera.actions import ActionGrid
-from ptztrack.geometry.ptz import PTZCamera
+from ptztrack import registry
 
 PositiveFloat = Annotated[float, Field(gt=0)]
 NonNegativeFloat = Annotated[float, Field(ge=0)]
@@ -22,6 +21,21 @@ NonNegativeFloat = Annotated[float, Field(ge=0)]
 
 class ScenarioError(ValueError):
     """A scenario that cannot be run; the message is one line naming the field and value."""
+
+
+def _registered(kind: str):
+    """A field that names an implementation registered under ``kind`` (:mod:`ptztrack.registry`)."""
+
+    def check(name: str | None) -> str | None:
+        if name is not None and name not in registry.names(kind):
+            raise ValueError(f"expected one of {', '.join(registry.names(kind))}")
+        return name
+
+    return AfterValidator(check)
+
+
+Options = dict[str, Any]
+"""Parameters of an implementation registered by another package, passed to its factory unread."""
 
 
 class _Strict(BaseModel):
@@ -62,10 +76,15 @@ class PoseError(_Strict):
 
 
 class Camera(_Strict):
+    """The PTZ camera. backend : a registered camera backend; by default 'simulated' for the
+    synthetic scene and 'virtual' (the virtual PTZ camera) for a recording."""
+
     position_m: tuple[float, float, PositiveFloat] = (7.5, -4.0, 7.0)
     image_size_px: tuple[Annotated[int, Field(gt=0)], Annotated[int, Field(gt=0)]] = (640, 480)
     f_min_px: PositiveFloat = 400.0
     pose_error: PoseError = PoseError()
+    backend: Annotated[str | None, _registered("cameras")] = None
+    options: Options = Field(default_factory=dict)
 
 
 class PoseFeedback(_Strict):
@@ -121,12 +140,15 @@ class Actions(_Strict):
 
 
 class Detector(_Strict):
-    """The detector: simulated (ideal, realistic) or OpenCV's HOG on a recording's virtual view.
+    """The detector: simulated (ideal, realistic), OpenCV's HOG on a recording's virtual view, or any
+    detector registered by another package (``options`` are its parameters).
 
-    The policies model HOG with the realistic recall (the paper's equation 13).
+    The policies plan with recall 1 for 'ideal' and with the recall curve ``recall_kd``,
+    ``recall_r0_px`` (the paper's equation 13) for every other kind.
     """
 
-    kind: Literal["ideal", "realistic", "hog"] = "realistic"
+    kind: Annotated[str, _registered("detectors")] = "realistic"
+    options: Options = Field(default_factory=dict)
     recall_kd: PositiveFloat = 0.0098
     recall_r0_px: NonNegativeFloat = 21.29
     pixel_noise_px: NonNegativeFloat = 2.0
@@ -137,7 +159,7 @@ class Detector(_Strict):
 
 
 class Tracker(_Strict):
-    """The ground-plane EKF tracker and its data association.
+    """The ground-plane tracker: by default (``kind`` 'ekf') one EKF per person, and its data association.
 
     association : 'hungarian' (one detection per track, assigned on the
     Mahalanobis distance) or 'cjpdaf' (Fitzgerald's Cheap JPDAF, equation 6
@@ -158,8 +180,11 @@ class Tracker(_Strict):
     each detected track's colour spatiogram; in between, each track is measured by searching for
     its spatiogram around its prediction, at the scale the head/feet homology gives;
     :mod:`ptztrack.track.templates`). Needs a recording with a video.
+    kind : a registered tracker (another package's, with ``options`` its parameters).
     """
 
+    kind: Annotated[str, _registered("trackers")] = "ekf"
+    options: Options = Field(default_factory=dict)
     acceleration_sigma_m_s2: PositiveFloat = 1.5
     initial_speed_sigma_m_s: PositiveFloat = 0.9
     gate_probability: float = Field(0.99, gt=0, lt=1)
@@ -232,18 +257,6 @@ class Scenario(_Strict):
         """[[x0, y0], [x1, y1]] of the synthetic area, whose corner is the origin."""
         return np.array([[0.0, 0.0], list(self.area_m)])
 
-    def ptz_camera(self) -> PTZCamera:
-        width_px, height_px = self.camera.image_size_px
-        return PTZCamera(tuple(self.camera.position_m), width_px, height_px, self.camera.f_min_px)
-
-    def action_grid(self) -> ActionGrid:
-        return ActionGrid(
-            pan_deg=self.actions.pan_deg.values(),
-            tilt_deg=self.actions.tilt_deg.values(),
-            zoom=np.asarray(self.actions.zoom, dtype=float),
-            max_steps=tuple(self.actions.max_steps),
-        )
-
 
 def _first_error_line(error: pydantic.ValidationError, source: str) -> str:
     first = error.errors()[0]
@@ -251,6 +264,8 @@ def _first_error_line(error: pydantic.ValidationError, source: str) -> str:
     message = first["msg"]
     if first["type"] == "extra_forbidden":
         message = "unknown key"
+    elif first["type"] == "value_error":
+        message = str(first["ctx"]["error"])
     return f"{source}: {field}: {message} (got {first['input']!r})"
 
 

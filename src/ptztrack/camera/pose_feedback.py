@@ -1,8 +1,8 @@
 """Where the camera looks: the pose it lands at, and the pose the tracker believes.
 
 A real PTZ camera lands near, not at, the pose it is sent to
-(:class:`~ptztrack.config.PoseError`). The tracker maps detections to the
-ground with one of three poses (:class:`~ptztrack.config.PoseFeedback`):
+(:class:`LandingError`). The tracker maps detections to the ground with one
+of three poses (``pose_feedback.source`` of a scenario):
 the commanded one, the true one (an oracle, for experiments), or the one
 registered from the camera's own image against bundle-adjusted reference
 views (the scale-invariant tracking paper; :mod:`ptztrack.geometry.registration`).
@@ -12,28 +12,30 @@ poses (pan_deg, tilt_deg, zoom) and returns the (3,) pose the tracker uses,
 or None when it cannot tell (the loop then uses the commanded pose).
 """
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable
 
 import numpy as np
 
-from ptztrack.camera.virtual import VirtualPTZ, virtual_ptz
-from ptztrack.config import PoseError, PoseFeedback, Scenario
-from ptztrack.geometry.calibration import load_calibration
+from ptztrack.camera.virtual import VirtualPTZ
 from ptztrack.geometry.registration import ReferenceIndex, build_index, load_index, register, save_index
 from ptztrack.scene.pets import RecordedVideo
 
-PoseSource = Callable[[int, np.ndarray, np.ndarray], np.ndarray | None]
-# The reference views are rendered from this frame of the recording; live views come from later frames,
-# where people have moved.
-REFERENCE_FRAME = 0
-# The stream that draws how roughly the reference views' poses are known: one for all runs and seeds,
-# so that they share one reference index.
-REFERENCE_SEED = 20091
+
+@dataclass(frozen=True)
+class LandingError:
+    """How far a camera lands from the pose it is sent to: pan and tilt off by ``pan_tilt_bias_deg``
+    plus Gaussian errors of ``pan_tilt_sigma_deg``, zoom times ``zoom_bias`` times (1 + a Gaussian
+    error of ``zoom_sigma``)."""
+
+    pan_tilt_sigma_deg: float
+    pan_tilt_bias_deg: tuple[float, float]
+    zoom_sigma: float
+    zoom_bias: float
 
 
-def landed_pose(commanded, error: PoseError, rng: np.random.Generator) -> np.ndarray:
+def landed_pose(commanded, error: LandingError, rng: np.random.Generator) -> np.ndarray:
     """Where a camera sent to ``commanded`` (3,) lands: (pan_deg, tilt_deg, zoom) with the error model's
     bias and one draw of its noise. The zoom is not clipped to the lens's range: the error is symmetric."""
     commanded = np.asarray(commanded, dtype=float)
@@ -52,31 +54,39 @@ def true_pose(step: int, commanded, actual) -> np.ndarray:
     return np.asarray(actual, dtype=float)
 
 
-def reference_poses(whole_frame_pose, pan_range_deg, tilt_range_deg, feedback: PoseFeedback) -> np.ndarray:
-    """(L, 3) reference poses: a grid over the pan and tilt ranges (offsets from ``whole_frame_pose``) at
-    each reference zoom, the whole-frame pose itself first (the calibrated view fixes the gauge).
+def reference_poses(
+    whole_frame_pose, pan_range_deg, tilt_range_deg, pan_steps: int, tilt_steps: int, zooms
+) -> np.ndarray:
+    """(L, 3) reference poses: a grid of ``pan_steps`` x ``tilt_steps`` over the pan and tilt ranges
+    (offsets from ``whole_frame_pose``) at each of ``zooms``, the whole-frame pose itself first (the
+    calibrated view fixes the gauge).
 
     The tilt range is shrunk by 20 %: the extreme tilts of the action grid look mostly outside the
     recording, and their zoomed views are still matched against views a little inside.
     """
-    pan_deg = np.linspace(*pan_range_deg, feedback.reference_pan_steps)
-    tilt_deg = 0.8 * np.linspace(*tilt_range_deg, feedback.reference_tilt_steps)
-    grid = np.array([[pan, tilt, zoom] for zoom in feedback.reference_zooms for tilt in tilt_deg for pan in pan_deg])
+    pan_deg = np.linspace(*pan_range_deg, pan_steps)
+    tilt_deg = 0.8 * np.linspace(*tilt_range_deg, tilt_steps)
+    grid = np.array([[pan, tilt, zoom] for zoom in zooms for tilt in tilt_deg for pan in pan_deg])
     grid[:, :2] += np.asarray(whole_frame_pose)[:2]
     first = np.array([whole_frame_pose[0], whole_frame_pose[1], 1.0])
     return np.vstack([first, grid[np.any(np.abs(grid - first) > 1e-9, axis=1)]])
 
 
 def build_reference_index(
-    virtual: VirtualPTZ, frame_bgr: np.ndarray, poses, feedback: PoseFeedback, rng: np.random.Generator
+    virtual: VirtualPTZ,
+    frame_bgr: np.ndarray,
+    poses,
+    pose_sigma_deg: float,
+    zoom_spread: float,
+    rng: np.random.Generator,
 ) -> ReferenceIndex:
     """The reference index of a virtual camera: views of ``frame_bgr`` rendered at ``poses`` (L, 3),
-    bundle-adjusted from poses known only roughly (``reference_pose_sigma_deg``,
-    ``reference_zoom_spread``), as a real camera's reference views would be; the first exactly."""
+    bundle-adjusted from poses known only roughly (pan and tilt to ``pose_sigma_deg``, zoom within
+    ``zoom_spread``), as a real camera's reference views would be; the first exactly."""
     poses = np.asarray(poses, dtype=float)
     rough = poses.copy()
-    rough[1:, :2] += rng.normal(0.0, feedback.reference_pose_sigma_deg, (len(poses) - 1, 2))
-    rough[1:, 2] *= rng.uniform(1 - feedback.reference_zoom_spread, 1 + feedback.reference_zoom_spread, len(poses) - 1)
+    rough[1:, :2] += rng.normal(0.0, pose_sigma_deg, (len(poses) - 1, 2))
+    rough[1:, 2] *= rng.uniform(1 - zoom_spread, 1 + zoom_spread, len(poses) - 1)
     return build_index(virtual.camera, [virtual.render(frame_bgr, pose) for pose in poses], rough)
 
 
@@ -115,42 +125,3 @@ class RegisteredPose:
         image = self.virtual.render(self.video.frame(int(self.video_frame[step])), actual)
         registration = register(self.virtual.camera, self.index, image)
         return None if registration is None else registration.pose
-
-
-def registration_camera(scenario: Scenario) -> tuple[VirtualPTZ, np.ndarray]:
-    """The recording scenario's virtual camera at ``pose_feedback.image_size_px``, and its whole-frame pose."""
-    recording = scenario.recording
-    calibration = load_calibration(recording.calibration, recording.view)
-    return virtual_ptz(calibration, recording.recorded_size_px, scenario.pose_feedback.image_size_px)
-
-
-def reference_index(scenario: Scenario, camera: tuple[VirtualPTZ, np.ndarray] | None = None) -> ReferenceIndex:
-    """The reference index of a recording scenario: views over its action grid's pan and tilt range,
-    rendered from the recording's frame ``REFERENCE_FRAME``. Read from ``pose_feedback.index`` when
-    that file exists; built otherwise (about a minute), and written there when a path is given.
-
-    camera : ``registration_camera(scenario)``, when the caller has it already.
-    """
-    recording, feedback = scenario.recording, scenario.pose_feedback
-    virtual, whole_frame_pose = camera or registration_camera(scenario)
-    offsets = scenario.action_grid()
-    poses = reference_poses(
-        whole_frame_pose,
-        (offsets.pan_deg.min(), offsets.pan_deg.max()),
-        (offsets.tilt_deg.min(), offsets.tilt_deg.max()),
-        feedback,
-    )
-
-    def build():
-        frame = RecordedVideo(recording.video, recording.recorded_size_px).frame(REFERENCE_FRAME)
-        return build_reference_index(virtual, frame, poses, feedback, np.random.default_rng(REFERENCE_SEED))
-
-    return cached_reference_index(feedback.index, build)
-
-
-def registered_pose_source(scenario: Scenario, video_frame: np.ndarray) -> RegisteredPose:
-    """The registered pose source of a recording scenario whose step ``t`` shows frame ``video_frame[t]``."""
-    recording = scenario.recording
-    camera = registration_camera(scenario)
-    video = RecordedVideo(recording.video, recording.recorded_size_px)
-    return RegisteredPose(camera[0], reference_index(scenario, camera), video, video_frame)

@@ -1,58 +1,49 @@
-"""Camera backend over a recording: a virtual PTZ camera seeing annotated people (paper section 5.2).
+"""Camera backend over a recording: a virtual PTZ camera inside a calibrated video (paper section 5.2).
 
-With the HOG detector, the virtual view of the step's recorded frame is
-rendered and OpenCV's people detector runs on it (:mod:`ptztrack.detect.hog`),
-which gives each box's feet and height; nobody knows which person a box is
-(``person_index`` -1).
-
-The ideal detector of the paper's Table 3: the annotated boxes of the step's
-frame are moved into the virtual view; a person is detected when the whole
-box is inside the view and no more than ``occluded_above`` of it is hidden
-by the boxes of people nearer the camera (the paper "removes the occluded
-ones"; the boxes overlap a little even when nobody is really hidden, hence a
-threshold). The feet point is the annotated feet moved into the view, with
-the detector's pixel noise.
+Its image at a step and pose is the view of the step's recorded frame
+rendered by the virtual camera (:mod:`ptztrack.camera.virtual`). It also
+knows the annotated people, moved into the view: a person is wholly in view
+when the whole annotated box is, and hidden by the fraction of the box that
+the boxes of people nearer the camera cover in the recorded frame.
 """
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from ptztrack.camera.virtual import VirtualPTZ
-from ptztrack.config import Detector
-from ptztrack.detect.hog import HogPeopleDetector, feet_and_height_px
-from ptztrack.detect.simulated import Detections, occluded_fraction
+from ptztrack.geometry.occlusion import occluded_fraction
 from ptztrack.scene.pets import RecordedScene, RecordedVideo
+from ptztrack.types import PeopleInView
 
 
-@dataclass(frozen=True)
+@dataclass
 class RecordedPTZ:
-    """virtual : the camera; scene : the annotated people; video : the frames (needed by HOG only)."""
+    """virtual : the camera; scene : the annotated people; video : the frames (None: no images).
+
+    The last view rendered is kept, so that a detector and a tracker looking at the same step and
+    pose share one rendering.
+    """
 
     virtual: VirtualPTZ
     scene: RecordedScene
-    detector: Detector
-    occluded_above: float
     video: RecordedVideo | None = None
-    hog: HogPeopleDetector | None = None
+    _last_view: tuple = field(default=(None, None, None), init=False, repr=False)
 
-    def observe(self, step: int, pose, rng: np.random.Generator) -> Detections:
-        """Detections (virtual-view feet pixels) of the people of ``step`` seen at ``pose``."""
-        if self.hog is not None:
-            feet_px, height_px = feet_and_height_px(self.observe_hog_boxes(step, pose))
-            return Detections(feet_px=feet_px, height_px=height_px, person_index=np.full(len(feet_px), -1))
-        return self.observe_annotations(step, pose, rng)
-
-    def view(self, step: int, pose) -> np.ndarray:
+    def image(self, step: int, pose) -> np.ndarray | None:
         """The virtual view (h, w, 3) uint8 BGR of ``step``'s recorded frame at ``pose``."""
-        return self.virtual.render(self.video.frame(int(self.scene.video_frame[step])), pose)
+        if self.video is None:
+            return None
+        pose = np.asarray(pose, dtype=float)
+        last_step, last_pose, last_view = self._last_view
+        if last_step == step and np.array_equal(last_pose, pose):
+            return last_view
+        view = self.virtual.render(self.video.frame(int(self.scene.video_frame[step])), pose)
+        self._last_view = (step, pose.copy(), view)
+        return view
 
-    def observe_hog_boxes(self, step: int, pose) -> np.ndarray:
-        """HOG boxes (K, 4) (left, top, width, height) in the virtual view of ``step`` at ``pose``."""
-        return self.hog.detect(self.view(step, pose))[0]
-
-    def observe_annotations(self, step: int, pose, rng: np.random.Generator, pixel_noise: bool = True) -> Detections:
-        """The ideal detector: annotated people fully in view and not occluded, feet with the detector's noise."""
+    def people(self, step: int, pose) -> PeopleInView:
+        """The annotated people of ``step``'s frame, moved into the view at ``pose``."""
         annotations = self.scene.annotations
         people = annotations.select(annotations.frame == self.scene.video_frame[step])
         left, top, width, height = people.box_px.T
@@ -66,14 +57,10 @@ class RecordedPTZ:
         centre_m = np.asarray(camera.position_m)
         range_m = np.linalg.norm(np.c_[people.ground_m, np.zeros(len(people.frame))] - centre_m, axis=1)
         boxes = np.stack([left, top, left + width, top + height], axis=-1)
-        hidden = occluded_fraction(boxes, range_m, np.ones(len(boxes), dtype=bool))
-        luck_noise = rng.normal(0.0, self.detector.pixel_noise_px if pixel_noise else 0.0, size=(len(boxes), 2))
-        seen = np.flatnonzero(inside & (hidden <= self.occluded_above))
-        feet_px = self.virtual.recorded_to_virtual(people.feet_px[seen], pose) + luck_noise[seen]
-        heights_px = virtual_corners[seen, 2:, 1].mean(axis=1) - virtual_corners[seen, :2, 1].mean(axis=1)
-        return Detections(
-            feet_px=feet_px,
-            height_px=heights_px,
-            person_index=np.searchsorted(self.scene.person_id, people.person_id[seen]),
+        return PeopleInView(
+            person_index=np.searchsorted(self.scene.person_id, people.person_id),
+            feet_px=self.virtual.recorded_to_virtual(people.feet_px, pose),
+            height_px=virtual_corners[:, 2:, 1].mean(axis=1) - virtual_corners[:, :2, 1].mean(axis=1),
+            in_view=inside,
+            hidden=occluded_fraction(boxes, range_m, np.ones(len(boxes), dtype=bool)),
         )
-

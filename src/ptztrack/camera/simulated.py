@@ -1,28 +1,40 @@
-"""Simulated PTZ camera: the synthetic scene seen through the camera model and a detector model."""
+"""Simulated PTZ camera: the synthetic scene seen through the camera model.
+
+It renders no images: a simulated detector draws its detections from the
+people it knows to be in view (:class:`~ptztrack.types.PeopleInView`).
+"""
 
 from dataclasses import dataclass
 
 import numpy as np
 
-from ptztrack.config import Detector
-from ptztrack.detect.simulated import Detections, detect, occlusion_in_centred_views
-from ptztrack.geometry.ptz import PTZCamera, project_people
-from ptztrack.scene.synthetic import GroundTruth
+from ptztrack.geometry.occlusion import occlusion_in_centred_views
+from ptztrack.geometry.ptz import PTZCamera, person_in_view, project_people
+from ptztrack.types import GroundTruth, PeopleInView
 
 
 @dataclass(frozen=True)
 class SimulatedPTZ:
-    """A camera backend that renders detections, not images."""
+    """A camera backend over simulated people: everybody of ``truth``, seen by ``camera`` at a pose."""
 
     camera: PTZCamera
     truth: GroundTruth
-    detector: Detector
 
-    def observe(self, frame: int, pose, rng: np.random.Generator) -> Detections:
-        """Detections (feet pixels) of the people present at ``frame`` seen at ``pose`` (3,)."""
-        present = self.truth.present[frame]
-        positions_m = np.where(present[:, None], self.truth.positions_m[frame], 0.0)
+    def image(self, step: int, pose) -> None:
+        return None
+
+    def people(self, step: int, pose) -> PeopleInView:
+        """All N people of the scene at ``step``, absent ones included (never in view), so that a
+        detector can draw for each person in a fixed order."""
+        present = self.truth.present[step]
+        positions_m = np.where(present[:, None], self.truth.positions_m[step], 0.0)
         heights_m, widths_m = self.truth.heights_m, self.truth.widths_m
         people = project_people(self.camera, pose, positions_m, heights_m, widths_m)
         hidden = occlusion_in_centred_views(self.camera, positions_m, heights_m, widths_m, present)
-        return detect(self.camera, people, hidden, present, self.detector, rng)
+        return PeopleInView(
+            person_index=np.arange(len(present)),
+            feet_px=people.feet_px,
+            height_px=people.height_px,
+            in_view=present & person_in_view(self.camera, people),
+            hidden=hidden,
+        )

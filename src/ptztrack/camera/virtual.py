@@ -61,9 +61,11 @@ class VirtualPTZ:
         normalised = cv2.undistortPoints(
             np.asarray(recorded_px, dtype=float).reshape(-1, 1, 2), self.recording.K, self.recording.dist
         )[:, 0, :]
-        rays = np.concatenate([normalised, np.ones((len(normalised), 1))], axis=-1) @ self.recording.R
         pose = np.asarray(pose, dtype=float)
-        homogeneous = rays @ rotation_world_to_camera(pose[0], pose[1]).T @ intrinsics(self.camera, pose[2]).T
+        # (u, v, 1) R_rec R_v^T K^T, written out per point: a matrix product over all points at once
+        # rounds each row differently depending on how many there are.
+        M = self.recording.R @ rotation_world_to_camera(pose[0], pose[1]).T @ intrinsics(self.camera, pose[2]).T
+        homogeneous = normalised[:, :1] * M[0] + normalised[:, 1:] * M[1] + M[2]
         with np.errstate(divide="ignore", invalid="ignore"):
             pixels = homogeneous[:, :2] / homogeneous[:, 2:]
         return np.where(homogeneous[:, 2:] > 0, pixels, np.nan)

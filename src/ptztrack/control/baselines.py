@@ -5,8 +5,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ptztrack.camera.actions import ActionGrid
-from ptztrack.control.policy import DecisionContext
 from ptztrack.geometry.ptz import PTZCamera, person_in_view, project_people
+from ptztrack.types import DecisionContext
 
 REFERENCE_PERSON_HEIGHT_M = 1.75
 

@@ -38,8 +38,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ptztrack.config import Control, Detector
-from ptztrack.detect.simulated import recall
+from ptztrack.detect.simulated import RecallModel
 from ptztrack.geometry.ptz import PTZCamera, person_in_view, project_people
 
 
@@ -49,11 +48,11 @@ def binary_entropy_nats(p) -> np.ndarray:
 
 
 def cell_detection_probability(
-    camera: PTZCamera, poses, cell_centres_m, detector: Detector, person_height_m: float
+    camera: PTZCamera, poses, cell_centres_m, recall: RecallModel, person_height_m: float
 ) -> np.ndarray:
     """``q_c(a)``: (L, C) probability of detecting an unoccluded person standing at each cell."""
     people = project_people(camera, poses, cell_centres_m, person_height_m, 0.0)
-    return np.where(person_in_view(camera, people), recall(people.height_px, detector), 0.0)
+    return np.where(person_in_view(camera, people), recall(people.height_px), 0.0)
 
 
 @dataclass
@@ -81,17 +80,25 @@ class ExplorationMap:
 
 
 def exploration_map(
-    camera: PTZCamera, poses, area_bounds_m, detector: Detector, control: Control, dt_s: float
+    camera: PTZCamera,
+    poses,
+    area_bounds_m,
+    recall: RecallModel,
+    person_height_m: float,
+    cell_m: float,
+    prior_occupancy: float,
+    arrival_rate_per_m2_s: float,
+    dt_s: float,
 ) -> ExplorationMap:
-    """A fresh map over the area ``[[x0, y0], [x1, y1]]`` with cells of ``control.exploration_cell_m``."""
-    cell_m = control.exploration_cell_m
+    """A fresh map over the area ``[[x0, y0], [x1, y1]]`` with square cells ``cell_m`` wide, every cell
+    believed occupied with ``prior_occupancy``, people arriving at ``arrival_rate_per_m2_s``, steps of ``dt_s``."""
     (x0, y0), (x1, y1) = np.asarray(area_bounds_m, dtype=float)
     xs = np.arange(x0 + cell_m / 2, x1, cell_m)
     ys = np.arange(y0 + cell_m / 2, y1, cell_m)
     centres = np.stack(np.meshgrid(xs, ys), axis=-1).reshape(-1, 2)
-    arrival = -np.expm1(-control.arrival_rate_per_m2_s * cell_m**2 * dt_s)
+    arrival = -np.expm1(-arrival_rate_per_m2_s * cell_m**2 * dt_s)
     return ExplorationMap(
-        detection_probability=cell_detection_probability(camera, poses, centres, detector, control.person_height_m),
-        occupancy=np.full(len(centres), control.prior_occupancy),
+        detection_probability=cell_detection_probability(camera, poses, centres, recall, person_height_m),
+        occupancy=np.full(len(centres), prior_occupancy),
         arrival_probability=np.full(len(centres), arrival),
     )

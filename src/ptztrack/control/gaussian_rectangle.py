@@ -6,11 +6,15 @@ The bivariate normal CDF is written with Owen's T function (Owen 1956),
     a_h = (k - rho h) / (h sqrt(1 - rho^2)),  a_k = (h - rho k) / (k sqrt(1 - rho^2)),
     beta = 1/2 if h k < 0, else 0,
 
-and the rectangle by inclusion-exclusion over its corners. ``T`` and ``Phi``
-are SciPy's own compiled ``owens_t`` and ``ndtr`` (from
-``scipy.special.cython_special``), called from Numba: the information-gain
-reward evaluates this for every action and track, and NumPy's per-call
-overhead on thousands of small arrays was ten times the arithmetic.
+and the rectangle by inclusion-exclusion over its corners. ``T`` is SciPy's
+compiled ``owens_t`` from ``scipy.special.cython_special``, bound for Numba
+by its public name the way Numba documents
+(``numba.extending.get_cython_function_address``); ``Phi(x) = erfc(-x /
+sqrt(2)) / 2`` with the C library's ``erfc``, which Numba compiles (SciPy's
+own ``ndtr`` is a fused function whose compiled symbol has no public
+name). The information-gain reward evaluates this for every action and
+track, and NumPy's per-call overhead on thousands of small arrays was ten
+times the arithmetic.
 ``owens_t`` is the costly part, so it is evaluated only where it matters:
 when the Gaussian lies well within one pair of edges (the marginal
 probability along that axis is 1 to within 1e-12) the rectangle probability
@@ -33,13 +37,17 @@ from numba.extending import get_cython_function_address
 SHORTCUT_TOLERANCE = 1e-12
 # Phi(-8) = 6e-16: beyond 8 standard deviations a corner is at infinity.
 FAR_SIGMA = 8.0
+SQRT_HALF = math.sqrt(0.5)
 
-_ndtr = ctypes.CFUNCTYPE(ctypes.c_double, ctypes.c_double)(
-    get_cython_function_address("scipy.special.cython_special", "__pyx_fuse_1ndtr")
-)
 _owens_t = ctypes.CFUNCTYPE(ctypes.c_double, ctypes.c_double, ctypes.c_double)(
     get_cython_function_address("scipy.special.cython_special", "owens_t")
 )
+
+
+@numba.njit
+def _ndtr(x):
+    """The standard normal CDF."""
+    return 0.5 * math.erfc(-x * SQRT_HALF)
 
 
 @numba.njit

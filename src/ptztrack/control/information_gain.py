@@ -25,9 +25,9 @@ import numba
 import numpy as np
 from scipy.stats import norm, qmc
 
-from ptztrack.config import Detector
 from ptztrack.control.gaussian_rectangle import rectangle_probability_scalar
-from ptztrack.detect.simulated import occluded_fraction, realistic_recall
+from ptztrack.detect.simulated import RecallModel, realistic_recall
+from ptztrack.geometry.occlusion import occluded_fraction
 from ptztrack.geometry.ptz import (
     PTZCamera,
     ground_to_image,
@@ -153,7 +153,7 @@ def _detection_weight_integral(
 
 
 def detection_weight_integral(
-    camera: PTZCamera, geometry: ActionGeometry, detector: Detector, mean_m, position_cov_m2, V
+    camera: PTZCamera, geometry: ActionGeometry, recall: RecallModel, mean_m, position_cov_m2, V
 ) -> np.ndarray:
     """``alpha(a)`` of equation 8 in closed form: 'intg'.
 
@@ -185,9 +185,9 @@ def detection_weight_integral(
         np.asarray(V, float),
         float(camera.image_width_px),
         float(camera.image_height_px),
-        detector.kind != "ideal",
-        detector.recall_kd,
-        detector.recall_r0_px,
+        not recall.perfect,
+        recall.kd_per_px,
+        recall.r0_px,
     )
 
 
@@ -222,7 +222,7 @@ def _detection_weight_sampled(
 def detection_weight_sampled(
     camera: PTZCamera,
     geometry: ActionGeometry,
-    detector: Detector,
+    recall: RecallModel,
     mean_m,
     position_cov_m2,
     person_height_m: float,
@@ -267,7 +267,7 @@ def detection_weight_sampled(
         1.0 - hidden,
         float(camera.image_width_px),
         float(camera.image_height_px),
-        detector.kind != "ideal",
-        detector.recall_kd,
-        detector.recall_r0_px,
+        not recall.perfect,
+        recall.kd_per_px,
+        recall.r0_px,
     )

@@ -15,7 +15,6 @@ from typing import Literal
 import numpy as np
 
 from ptztrack.camera.actions import ActionGrid
-from ptztrack.config import Control, Detector
 from ptztrack.control.exploration import ExplorationMap
 from ptztrack.control.information_gain import (
     ActionGeometry,
@@ -24,32 +23,37 @@ from ptztrack.control.information_gain import (
     detection_weight_sampled,
     information_if_detected_nats,
 )
-from ptztrack.control.policy import DecisionContext
+from ptztrack.detect.simulated import RecallModel
 from ptztrack.geometry.ptz import PTZCamera, look_at
+from ptztrack.types import DecisionContext, Tracks
 
 
 @dataclass
 class InformationGainPolicy:
     """Greedy expected-information-gain control.
 
-    method : 'intg' (equation 8, closed form) or 'smpl' (equation 19, ``control.samples`` draws).
-    exploration : the patrolling term's map, or None when ``control.beta`` is 0.
+    recall : the detector model the policy plans with; V : (2, 2) px^2 the feet-pixel noise.
+    person_height_m, person_width_m : the person the policy expects.
+    method : 'intg' (equation 8, closed form) or 'smpl' (equation 19, ``samples`` draws).
+    beta, exploration : the patrolling term's weight and map (None: no patrolling term).
     """
 
     camera: PTZCamera
     grid: ActionGrid
-    detector: Detector
-    control: Control
+    recall: RecallModel
     V: np.ndarray
+    person_height_m: float
     person_width_m: float
     method: Literal["intg", "smpl"]
+    samples: int
+    beta: float = 0.0
     exploration: ExplorationMap | None = None
     geometry: ActionGeometry = field(init=False, repr=False)
 
     def __post_init__(self):
-        self.geometry = action_geometry(self.camera, self.grid.poses, self.control.person_height_m)
+        self.geometry = action_geometry(self.camera, self.grid.poses, self.person_height_m)
 
-    def rewards(self, actions, tracks, rng: np.random.Generator) -> np.ndarray:
+    def rewards(self, actions, tracks: Tracks, rng: np.random.Generator) -> np.ndarray:
         """Expected information (nats) of each of ``actions`` (flat indices) about ``tracks``; (len(actions),)."""
         geometry = self.geometry.take(actions)
         reward = np.zeros(len(actions))
@@ -57,27 +61,25 @@ class InformationGainPolicy:
             mean_m = tracks.mean[:, :2]
             position_cov_m2 = tracks.covariance[:, :2, :2]
             if self.method == "intg":
-                alpha = detection_weight_integral(
-                    self.camera, geometry, self.detector, mean_m, position_cov_m2, self.V
-                )
+                alpha = detection_weight_integral(self.camera, geometry, self.recall, mean_m, position_cov_m2, self.V)
             else:
                 reference_pose = look_at(self.camera, mean_m.mean(axis=0), zoom=1.0)
                 alpha = detection_weight_sampled(
                     self.camera,
                     geometry,
-                    self.detector,
+                    self.recall,
                     mean_m,
                     position_cov_m2,
-                    self.control.person_height_m,
+                    self.person_height_m,
                     self.person_width_m,
                     reference_pose,
                     rng,
-                    self.control.samples,
+                    self.samples,
                 )
             information = information_if_detected_nats(geometry, mean_m, position_cov_m2, self.V)
             reward += np.sum(alpha * information, axis=-1)
         if self.exploration is not None:
-            reward += self.control.beta * self.exploration.information_nats(actions)
+            reward += self.beta * self.exploration.information_nats(actions)
         return reward
 
     def choose(self, context: DecisionContext) -> int:

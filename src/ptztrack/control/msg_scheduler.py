@@ -29,8 +29,8 @@ from dataclasses import dataclass
 
 import networkx as nx
 
-from ptztrack.control.msg import refresh
-from ptztrack.track.tracklets import TrackletTracker
+from ptztrack.track.msg import refresh
+from ptztrack.scene.road_tracklets import TrackletOracle
 
 # alpha's boost for a source and beta for a target expected to leave within this many zoom durations.
 SOURCE_WEIGHT = 2.0
@@ -48,17 +48,17 @@ class Candidate:
     joins_soon: bool
 
 
-def candidates(tracker: TrackletTracker, step: int) -> list[Candidate]:
+def candidates(oracle: TrackletOracle, step: int) -> list[Candidate]:
     """The tracklets a zoom-in could label at ``step``: solo, unlabelled, E_s true."""
     found = []
-    for unit, vertex in tracker.unit_vertex.items():
-        if len(unit) != 1 or tracker.graph.nodes[vertex]["labeled"]:
+    for unit, vertex in oracle.unit_vertex.items():
+        if len(unit) != 1 or oracle.graph.nodes[vertex]["labeled"]:
             continue
         (person,) = unit
-        if not tracker.capture_succeeds(step, person):
+        if not oracle.capture_succeeds(step, person):
             continue
-        joins_soon = tracker.joins_within(step, person, round(tracker.config.join_horizon_s * tracker.frame_rate_hz))
-        found.append(Candidate(vertex, unit, tracker.steps_to_exit(step, person), joins_soon))
+        joins_soon = oracle.joins_within(step, person, round(oracle.config.join_horizon_s * oracle.frame_rate_hz))
+        found.append(Candidate(vertex, unit, oracle.steps_to_exit(step, person), joins_soon))
     return found
 
 
@@ -72,20 +72,20 @@ def labeling_score(graph: nx.DiGraph, candidate: Candidate, zoom_steps: int) -> 
     return alpha * future + beta * past
 
 
-def msg_choice(tracker: TrackletTracker, step: int, zoom_out_score: float) -> Candidate | None:
+def msg_choice(oracle: TrackletOracle, step: int, zoom_out_score: float) -> Candidate | None:
     """The paper's scheduler: the candidate of highest S_L, if above the zoom-out score S_zo."""
     best, best_score = None, zoom_out_score
-    for candidate in candidates(tracker, step):
-        refresh(tracker.graph, candidate.vertex)
-        score = labeling_score(tracker.graph, candidate, tracker.config.zoom_steps)
+    for candidate in candidates(oracle, step):
+        refresh(oracle.graph, candidate.vertex)
+        score = labeling_score(oracle.graph, candidate, oracle.config.zoom_steps)
         if score > best_score:
             best, best_score = candidate, score
     return best
 
 
-def naive_choice(tracker: TrackletTracker, step: int, zoom_out_score: float) -> Candidate | None:
+def naive_choice(oracle: TrackletOracle, step: int, zoom_out_score: float) -> Candidate | None:
     """The naive scheduler: the candidate predicted to leave first."""
-    found = candidates(tracker, step)
+    found = candidates(oracle, step)
     return min(found, key=lambda c: (c.steps_to_exit, c.vertex)) if found else None
 
 

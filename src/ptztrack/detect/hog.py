@@ -15,13 +15,16 @@ annotated feet, against 4.5 px for the bottom edge; 1.6 px at 160 px wide is
 about 0.3 m on the ground at 20 m.
 """
 
-PERSON_IN_WINDOW = 96 / 128  # of the box height
-FEET_ABOVE_BOTTOM = 16 / 128  # of the box height
-
 from dataclasses import dataclass, field
 
 import cv2
 import numpy as np
+
+from ptztrack.roles import CameraBackend
+from ptztrack.types import Detections
+
+PERSON_IN_WINDOW = 96 / 128  # of the box height
+FEET_ABOVE_BOTTOM = 16 / 128  # of the box height
 
 
 @dataclass
@@ -42,7 +45,16 @@ class HogPeopleDetector:
         self._hog = cv2.HOGDescriptor()
         self._hog.setSVMDetector(cv2.HOGDescriptor_getDefaultPeopleDetector())
 
-    def detect(self, image) -> tuple[np.ndarray, np.ndarray]:
+    def detect(self, camera: CameraBackend, step: int, pose, rng: np.random.Generator) -> Detections:
+        """People in the camera's view at ``pose``: feet and heights from the boxes, SVM scores."""
+        image = camera.image(step, pose)
+        if image is None:
+            raise RuntimeError("the HOG detector needs a camera backend that renders images")
+        boxes, scores = self.boxes(image)
+        feet_px, height_px = feet_and_height_px(boxes)
+        return Detections(feet_px, height_px, np.full(len(feet_px), -1), scores)
+
+    def boxes(self, image) -> tuple[np.ndarray, np.ndarray]:
         """People in a BGR image: boxes (K, 4) as (left, top, width, height) px and SVM scores (K,)."""
         enlarged = cv2.resize(image, None, fx=self.upsample, fy=self.upsample, interpolation=cv2.INTER_LINEAR)
         boxes, scores = self._hog.detectMultiScale(

@@ -8,7 +8,7 @@ allowed only within ``gate_m`` (1 m).
 import motmetrics as mm
 import numpy as np
 
-from ptztrack.episode import Episode
+from ptztrack.loop import Episode
 
 GATE_M = 1.0
 # How each figure is shown in tables: label and format.

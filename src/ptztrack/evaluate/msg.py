@@ -2,8 +2,8 @@
 
 One run: a road-grid scene (:mod:`ptztrack.scene.roads`) watched by one PTZ
 camera. Every zoomed-out step the scheduler either stays zoomed out or zooms
-in on one walker for ``zoom_steps`` to capture a face; the tracker layer
-(:mod:`ptztrack.track.tracklets`) grows the tracklet graph meanwhile, and a
+in on one walker for ``zoom_steps`` to capture a face; the tracklet oracle
+(:mod:`ptztrack.scene.road_tracklets`) grows the tracklet graph meanwhile, and a
 captured face labels the walker's tracklet, matches it and (unless switched
 off) untangles the graph. The three schedulers of a run see the same scene.
 
@@ -15,17 +15,17 @@ only child, a parent that is its child's only parent), as in the paper's
 experiments; only tracklets that really hold the target count.
 """
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import matplotlib
 import networkx as nx
 import numpy as np
 from matplotlib.figure import Figure
 
-from ptztrack.control.msg import label
 from ptztrack.control.msg_scheduler import CHOOSERS
+from ptztrack.scene.road_tracklets import TrackletOracle, TrackletOracleConfig
 from ptztrack.scene.roads import RoadScene, RoadSceneConfig, joins_and_splits, walk_roads
-from ptztrack.track.tracklets import TrackletConfig, TrackletTracker
+from ptztrack.track.msg import label
 
 DEFAULT_ZOOM_OUT_SCORE = 5.0
 
@@ -43,7 +43,7 @@ class MsgRun:
 def run_msg(
     scene: RoadScene,
     scheduler: str,
-    config: TrackletConfig = TrackletConfig(),
+    config: TrackletOracleConfig = TrackletOracleConfig(),
     zoom_out_score: float = DEFAULT_ZOOM_OUT_SCORE,
 ) -> MsgRun:
     """Run one scheduler ('msg', 'msg-no-untangling' or 'naive') over a scene."""
@@ -51,7 +51,7 @@ def run_msg(
         raise ValueError(f"unknown scheduler {scheduler!r}; expected one of {', '.join(CHOOSERS)}")
     choose = CHOOSERS[scheduler]
     untangling = scheduler == "msg"
-    tracker = TrackletTracker(
+    oracle = TrackletOracle(
         scene.positions_m,
         scene.group_id,
         scene.heading,
@@ -65,18 +65,18 @@ def run_msg(
     zoomed, zoom_end = None, -1
     for step in range(len(scene.positions_m)):
         if zoomed is not None and step <= zoom_end:
-            tracker.observe(step, zoomed.unit)
+            oracle.observe(step, zoomed.unit)
             continue
         if zoomed is not None:
-            vertex = tracker.unit_vertex[zoomed.unit]
-            tracker.relabel(label(tracker.graph, vertex, untangling))
+            vertex = oracle.unit_vertex[zoomed.unit]
+            oracle.relabel(label(oracle.graph, vertex, untangling))
             captures.append((step - 1, next(iter(zoomed.unit))))
             zoomed = None
-        tracker.observe(step)
-        zoomed = choose(tracker, step, zoom_out_score)
+        oracle.observe(step)
+        zoomed = choose(oracle, step, zoom_out_score)
         zoom_end = step + config.zoom_steps
-    m = labelled_fraction(tracker.graph, chains=scheduler != "naive")
-    return MsgRun(tracker.graph, captures, m, int(joins_and_splits(scene).sum()))
+    m = labelled_fraction(oracle.graph, chains=scheduler != "naive")
+    return MsgRun(oracle.graph, captures, m, int(joins_and_splits(scene).sum()))
 
 
 def labelled_fraction(graph: nx.DiGraph, chains: bool = True) -> float:
@@ -128,7 +128,7 @@ class MsgCell:
 
     seed: int
     scene: RoadSceneConfig
-    tracklets: TrackletConfig = TrackletConfig()
+    tracklets: TrackletOracleConfig = TrackletOracleConfig()
     zoom_out_score: float = DEFAULT_ZOOM_OUT_SCORE
 
 
@@ -139,7 +139,7 @@ def msg_cells(runs: int, base: RoadSceneConfig = EXPERIMENT_SCENE) -> list[MsgCe
         rng = np.random.default_rng([seed, 1])
         people = int(rng.integers(*PEOPLE_RANGE))
         join_probability = float(rng.uniform(*JOIN_PROBABILITY_RANGE))
-        cells.append(MsgCell(seed, base.model_copy(update={"people": people, "join_probability": join_probability})))
+        cells.append(MsgCell(seed, replace(base, people=people, join_probability=join_probability)))
     return cells
 
 

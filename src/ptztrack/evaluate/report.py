@@ -1,4 +1,15 @@
-"""What a run leaves behind: metrics.json, tracks.csv, episode.png and episode.mp4, each written atomically."""
+"""What a run leaves behind, each file written atomically.
+
+* ``metrics.json``: the run's metrics;
+* ``steps.csv``: per step the action, the commanded, landed and believed poses and the decision time;
+* ``detections.csv``: per step every measurement the tracker was updated with, in the image and on the ground;
+* ``tracks.csv``: per step every reported track's state and position covariance;
+* ``tracks_mot.txt`` and ``truth_mot.txt``: the tracks and the truth in the MOTChallenge layout
+  ``frame,id,left,top,width,height,conf,x,y,z`` (frames from 1, one per step; x and y on the ground
+  in metres, printed so that they read back exactly; no boxes: -1), so that a run can be re-scored
+  by any MOT tool;
+* ``episode.png`` and ``episode.mp4``: pictures.
+"""
 
 import csv
 import io
@@ -10,31 +21,130 @@ import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.patches import Rectangle
 
-from ptztrack.episode import Episode
-from ptztrack.files import write_atomically
 from ptztrack.evaluate.video import RenderView, write_episode_video
+from ptztrack.files import write_atomically
 from ptztrack.geometry.ptz import ground_footprint
+from ptztrack.loop import Episode
+from ptztrack.track.tracker import ground_points
 
 TRACK_COLUMNS = ("frame", "id", "x_m", "y_m", "vx_m_s", "vy_m_s", "var_x_m2", "cov_xy_m2", "var_y_m2")
+STEP_COLUMNS = (
+    "step",
+    "action",
+    "commanded_pan_deg",
+    "commanded_tilt_deg",
+    "commanded_zoom",
+    "pan_deg",
+    "tilt_deg",
+    "zoom",
+    "tracker_pan_deg",
+    "tracker_tilt_deg",
+    "tracker_zoom",
+    "pose_known",
+    "decision_ms",
+)
+DETECTION_COLUMNS = ("step", "feet_u_px", "feet_v_px", "height_px", "score", "x_m", "y_m", "person")
+MOT_COLUMNS = ("frame", "id", "left", "top", "width", "height", "conf", "x", "y", "z")
+RUN_FILES = (
+    "metrics.json",
+    "steps.csv",
+    "detections.csv",
+    "tracks.csv",
+    "tracks_mot.txt",
+    "truth_mot.txt",
+    "episode.png",
+    "episode.mp4",
+)
 
 
 def metrics_json(metrics: dict) -> bytes:
     return (json.dumps(metrics, indent=2, sort_keys=True) + "\n").encode()
 
 
-def tracks_csv(episode: Episode) -> bytes:
-    """One row per track and frame: position, velocity and position covariance."""
+def _csv(header, rows) -> bytes:
     text = io.StringIO()
     writer = csv.writer(text, lineterminator="\n")
-    writer.writerow(TRACK_COLUMNS)
-    for frame, tracks in enumerate(episode.tracks):
-        for track_id, mean, covariance in zip(tracks.ids, tracks.mean, tracks.covariance, strict=True):
-            writer.writerow(
-                [frame, int(track_id)]
-                + [f"{value:.6f}" for value in mean]
-                + [f"{covariance[0, 0]:.6g}", f"{covariance[0, 1]:.6g}", f"{covariance[1, 1]:.6g}"]
-            )
+    if header:
+        writer.writerow(header)
+    writer.writerows(rows)
     return text.getvalue().encode()
+
+
+def _exact(value: float) -> str:
+    """A float printed so that it reads back to the same value."""
+    return repr(float(value))
+
+
+def steps_csv(episode: Episode) -> bytes:
+    """One row per step: the action, the commanded, landed and believed poses, the decision time."""
+    rows = (
+        [step, int(action)]
+        + [f"{value:.6g}" for value in (*commanded, *pose, *believed)]
+        + [int(known), f"{1e3 * decision_s:.4f}"]
+        for step, (action, commanded, pose, believed, known, decision_s) in enumerate(
+            zip(
+                episode.actions,
+                episode.commanded,
+                episode.poses,
+                episode.tracker_poses,
+                episode.pose_known,
+                episode.decision_s,
+                strict=True,
+            )
+        )
+    )
+    return _csv(STEP_COLUMNS, rows)
+
+
+def detections_csv(episode: Episode) -> bytes:
+    """One row per measurement: its feet in the image, height, score, its ground point through the
+    pose the tracker used (empty where the feet lie above the horizon), and the true person's index
+    where a simulation knows it (else -1)."""
+    rows = []
+    for step, (detections, pose) in enumerate(zip(episode.detections, episode.tracker_poses, strict=True)):
+        ground_xy, on_ground = ground_points(detections.feet_px, episode.camera, pose)
+        for feet, height, score, ground, ok, person in zip(
+            detections.feet_px, detections.height_px, detections.score, ground_xy, on_ground, detections.person_index,
+            strict=True,
+        ):  # fmt: skip
+            rows.append(
+                [step, f"{feet[0]:.4f}", f"{feet[1]:.4f}", f"{height:.4f}", f"{score:.6g}"]
+                + ([f"{ground[0]:.6f}", f"{ground[1]:.6f}"] if ok else ["", ""])
+                + [int(person)]
+            )
+    return _csv(DETECTION_COLUMNS, rows)
+
+
+def tracks_mot(episode: Episode) -> bytes:
+    """The reported tracks in the MOTChallenge layout, one row per track and step, no header."""
+    rows = (
+        [step + 1, int(track_id), -1, -1, -1, -1, 1, _exact(mean[0]), _exact(mean[1]), 0]
+        for step, tracks in enumerate(episode.tracks)
+        for track_id, mean in zip(tracks.ids, tracks.mean, strict=True)
+    )
+    return _csv((), rows)
+
+
+def truth_mot(episode: Episode) -> bytes:
+    """The truth in the MOTChallenge layout, one row per present person and step, ids from 0 by column."""
+    positions_m = episode.truth.positions_m
+    rows = (
+        [step + 1, person, -1, -1, -1, -1, 1, _exact(positions_m[step, person, 0]), _exact(positions_m[step, person, 1]), 0]
+        for step, person in zip(*np.nonzero(episode.truth.present), strict=True)
+    )
+    return _csv((), rows)
+
+
+def tracks_csv(episode: Episode) -> bytes:
+    """One row per track and frame: position, velocity and position covariance."""
+    rows = (
+        [frame, int(track_id)]
+        + [f"{value:.6f}" for value in mean]
+        + [f"{covariance[0, 0]:.6g}", f"{covariance[0, 1]:.6g}", f"{covariance[1, 1]:.6g}"]
+        for frame, tracks in enumerate(episode.tracks)
+        for track_id, mean, covariance in zip(tracks.ids, tracks.mean, tracks.covariance, strict=True)
+    )
+    return _csv(TRACK_COLUMNS, rows)
 
 
 def episode_figure(episode: Episode, title: str = "") -> Figure:
@@ -82,12 +192,19 @@ def write_figure(path: Path, figure: Figure) -> None:
 def write_outputs(
     directory: Path, episode: Episode, metrics: dict, title: str = "", render_view: RenderView | None = None
 ) -> None:
-    """Write metrics.json, tracks.csv and episode.png into ``directory`` (created if needed),
-    and with ``render_view`` (see :mod:`ptztrack.evaluate.video`) episode.mp4, captioned with ``title``."""
+    """Write the files of ``RUN_FILES`` into ``directory`` (created if needed): episode.mp4 only with
+    ``render_view`` (see :mod:`ptztrack.evaluate.video`); the pictures captioned with ``title``."""
     directory = Path(directory)
     directory.mkdir(parents=True, exist_ok=True)
     write_atomically(directory / "metrics.json", metrics_json(metrics))
-    write_atomically(directory / "tracks.csv", tracks_csv(episode))
+    for name, contents in (
+        ("steps.csv", steps_csv),
+        ("detections.csv", detections_csv),
+        ("tracks.csv", tracks_csv),
+        ("tracks_mot.txt", tracks_mot),
+        ("truth_mot.txt", truth_mot),
+    ):
+        write_atomically(directory / name, contents(episode))
     write_figure(directory / "episode.png", episode_figure(episode, title))
     if render_view is not None:
         write_episode_video(directory / "episode.mp4", episode, render_view, title)

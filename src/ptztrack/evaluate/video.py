@@ -10,9 +10,10 @@ the camera's field of view on the ground (blue) and the area where people
 can be (black frame). Below, a caption: step, pose, label, legend.
 
 The view comes from a caller's ``render_view(step, pose)``;
-:func:`view_renderer` builds it for a :class:`~ptztrack.episode.World`: the
-recorded frame seen by the virtual camera, or for the synthetic scene the
-camera model's picture of the true people. Everything is drawn with OpenCV
+:func:`view_renderer` builds it for a :class:`~ptztrack.loop.World`: the
+camera backend's image (the recorded frame seen by the virtual camera, say),
+or where the backend renders none, the camera model's picture of the true
+people. Everything is drawn with OpenCV
 and encoded by OpenCV's MPEG-4 Part 2 writer ('mp4v'; its H.264 encoder is
 not in the pip wheels).
 """
@@ -20,19 +21,16 @@ not in the pip wheels).
 import os
 import tempfile
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from pathlib import Path
 
 import cv2
 import numpy as np
 
-from ptztrack.config import Scenario
-from ptztrack.detect.simulated import Detections
-from ptztrack.episode import Episode, World
 from ptztrack.geometry.ptz import PTZCamera, feet_jacobian, ground_footprint, project_people
-from ptztrack.scene.pets import RecordedVideo
-from ptztrack.scene.synthetic import GroundTruth
-from ptztrack.track.tracker import Tracks, predicted_feet_px
+from ptztrack.loop import Episode, World
+from ptztrack.track.tracker import predicted_feet_px
+from ptztrack.types import Detections, GroundTruth, Tracks
 
 RenderView = Callable[[int, np.ndarray], np.ndarray]
 """``render_view(step, pose) -> (h, w, 3) uint8 BGR``: the camera's image at a step and a (pan_deg, tilt_deg, zoom)."""
@@ -123,9 +121,10 @@ def map_transform(episode: Episode) -> MapTransform:
 
 
 def model_view(camera: PTZCamera, truth: GroundTruth, step: int, pose) -> np.ndarray:
-    """The camera model's picture (h, w, 3) uint8 BGR: the present people's boxes, nearer ones on top."""
+    """The camera model's picture (h, w, 3) uint8 BGR: the present people's boxes, nearer ones on top
+    (people of unknown height are not drawn)."""
     image = np.full((camera.image_height_px, camera.image_width_px, 3), MODEL_BACKGROUND_BGR, np.uint8)
-    present = truth.present[step]
+    present = truth.present[step] & np.isfinite(truth.heights_m)
     people = project_people(
         camera, pose, truth.positions_m[step, present], truth.heights_m[present], truth.widths_m[present]
     )
@@ -137,21 +136,15 @@ def model_view(camera: PTZCamera, truth: GroundTruth, step: int, pose) -> np.nda
     return image
 
 
-def view_renderer(scenario: Scenario, world: World) -> RenderView:
-    """``render_view`` for an episode of ``scenario`` in ``world``.
+def view_renderer(world: World) -> RenderView:
+    """``render_view`` for an episode in ``world``: the camera backend's image, or where it renders
+    none, :func:`model_view`."""
 
-    A recording: its frame of the step seen by the virtual camera (a blank
-    view if the scenario names no video). The synthetic scene: :func:`model_view`.
-    """
-    if scenario.recording is None:
-        return lambda step, pose: model_view(world.camera, world.truth, step, pose)
-    backend = world.backend
-    if backend.video is None and scenario.recording.video is not None:
-        backend = replace(backend, video=RecordedVideo(scenario.recording.video, scenario.recording.recorded_size_px))
-    if backend.video is None:
-        blank = np.full((world.camera.image_height_px, world.camera.image_width_px, 3), MODEL_BACKGROUND_BGR, np.uint8)
-        return lambda step, pose: blank
-    return backend.view
+    def render(step: int, pose) -> np.ndarray:
+        image = world.backend.image(step, pose)
+        return model_view(world.camera, world.truth, step, pose) if image is None else image
+
+    return render
 
 
 def write_episode_video(path: str | Path, episode: Episode, render_view: RenderView, label: str = "") -> None:

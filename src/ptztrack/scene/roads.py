@@ -31,42 +31,51 @@ intersection goes unnoticed, and a meeting takes one partner at a time
 from dataclasses import dataclass
 
 import numpy as np
-from pydantic import Field, model_validator
-
-from ptztrack.config import NonNegativeFloat, PositiveFloat, _Strict
 
 _EPS = 1e-9
 # Direction codes 0-3 walk along +w1, +w2, -w1, -w2: axis = code % 2, back = (code + 2) % 4.
 _HEADINGS = np.array([[1.0, 1.0], [1.0, -1.0], [-1.0, -1.0], [-1.0, 1.0]]) / np.sqrt(2)
 
 
-class RoadSceneConfig(_Strict):
-    """Parameters of the road-grid scene; times in seconds, lengths in metres."""
+@dataclass(frozen=True)
+class RoadSceneConfig:
+    """Parameters of the road-grid scene; times in seconds, lengths in metres. Checked when made:
+    a ValueError names the parameter."""
 
-    area_m: PositiveFloat = 40.0
-    road_spacing_m: PositiveFloat = 10.0
-    duration_s: PositiveFloat = 120.0
-    frame_rate_hz: PositiveFloat = 5.0
-    people: int = Field(12, ge=0)
-    entry_window_s: tuple[NonNegativeFloat, NonNegativeFloat] = (0.0, 90.0)
-    speed_m_s: tuple[PositiveFloat, PositiveFloat] = (0.8, 1.6)
-    turn_probability: float = Field(0.5, ge=0, le=1)
-    meet_radius_m: PositiveFloat = 1.5
-    join_probability: float = Field(0.5, ge=0, le=1)
-    group_duration_s: tuple[NonNegativeFloat, NonNegativeFloat] = (5.0, 25.0)
-    refractory_s: NonNegativeFloat = 5.0
+    area_m: float = 40.0
+    road_spacing_m: float = 10.0
+    duration_s: float = 120.0
+    frame_rate_hz: float = 5.0
+    people: int = 12
+    entry_window_s: tuple[float, float] = (0.0, 90.0)
+    speed_m_s: tuple[float, float] = (0.8, 1.6)
+    turn_probability: float = 0.5
+    meet_radius_m: float = 1.5
+    join_probability: float = 0.5
+    group_duration_s: tuple[float, float] = (5.0, 25.0)
+    refractory_s: float = 5.0
     # How long a walker wants to stay; until then it turns away from the border at intersections.
     # None: it leaves at the first border it walks to.
-    stay_s: tuple[NonNegativeFloat, NonNegativeFloat] | None = None
+    stay_s: tuple[float, float] | None = None
 
-    @model_validator(mode="after")
-    def _consistent(self):
+    def __post_init__(self):
+        for name in ("area_m", "road_spacing_m", "duration_s", "frame_rate_hz", "meet_radius_m"):
+            if not getattr(self, name) > 0:
+                raise ValueError(f"{name} must be positive (got {getattr(self, name)!r})")
+        for name in ("people", "refractory_s"):
+            if not getattr(self, name) >= 0:
+                raise ValueError(f"{name} must be at least 0 (got {getattr(self, name)!r})")
+        for name in ("turn_probability", "join_probability"):
+            if not 0 <= getattr(self, name) <= 1:
+                raise ValueError(f"{name} must be a probability in [0, 1] (got {getattr(self, name)!r})")
         for name in ("entry_window_s", "speed_m_s", "group_duration_s", "stay_s"):
             if getattr(self, name) is None:
                 continue
             low, high = getattr(self, name)
-            if high < low:
-                raise ValueError(f"{name} must be [low, high] with low <= high (got {[low, high]})")
+            if not 0 <= low <= high:
+                raise ValueError(f"{name} must be [low, high] with 0 <= low <= high (got {[low, high]})")
+        if self.speed_m_s[0] <= 0:
+            raise ValueError(f"speed_m_s must be positive (got {list(self.speed_m_s)})")
         if self.entry_window_s[1] > self.duration_s:
             raise ValueError("entry_window_s must end within duration_s")
         # The stepping handles one intersection per step, and a unit within
@@ -76,7 +85,6 @@ class RoadSceneConfig(_Strict):
             raise ValueError("speed_m_s / frame_rate_hz must stay below road_spacing_m / sqrt(2)")
         if self.meet_radius_m >= block_m:
             raise ValueError("meet_radius_m must stay below road_spacing_m / sqrt(2)")
-        return self
 
 
 @dataclass(frozen=True)

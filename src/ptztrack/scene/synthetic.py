@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ptztrack.config import People
+from ptztrack.types import GroundTruth
 
 TURN_TIME_CONSTANT_S = 2.0
 LOOKAHEAD_S = 2.0
@@ -29,23 +29,22 @@ BORDER_MARGIN_M = 0.5
 
 
 @dataclass(frozen=True)
-class GroundTruth:
-    """Where everybody is, frame by frame.
+class Crowd:
+    """Who walks in the synthetic scene.
 
-    positions_m : (T, N, 2) feet positions in metres, NaN while absent.
-    heights_m, widths_m : (N,) body size in metres.
-    frame_rate_hz : frames per second.
+    count : people; speed_m_s, height_m : [low, high] of the uniform draws per person;
+    width_m : everybody's width; turn_rate_sigma_deg_s : stationary spread of the turn rate;
+    enter_leave : people enter through the border and leave after ``stay_s`` [low, high] seconds;
+    else they are there from the first frame to the last.
     """
 
-    positions_m: np.ndarray
-    heights_m: np.ndarray
-    widths_m: np.ndarray
-    frame_rate_hz: float
-
-    @property
-    def present(self) -> np.ndarray:
-        """(T, N) bool: the person is in the scene at that frame."""
-        return ~np.isnan(self.positions_m[..., 0])
+    count: int
+    speed_m_s: tuple[float, float]
+    height_m: tuple[float, float]
+    width_m: float
+    turn_rate_sigma_deg_s: float
+    enter_leave: bool
+    stay_s: tuple[float, float]
 
 
 def _wrap_angle(angle_rad):
@@ -53,7 +52,7 @@ def _wrap_angle(angle_rad):
 
 
 def walk_people(
-    people: People, area_m: tuple[float, float], frames: int, frame_rate_hz: float, rng: np.random.Generator
+    people: Crowd, area_m: tuple[float, float], frames: int, frame_rate_hz: float, rng: np.random.Generator
 ) -> GroundTruth:
     """Draw the trajectories of ``people.count`` walkers in the area ``[0, w] x [0, d]``.
 

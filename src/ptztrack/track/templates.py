@@ -44,14 +44,17 @@ zoom 1-3, people 16-98 px tall):
   it fits.
 """
 
+from dataclasses import dataclass, field
 from typing import NamedTuple
 
 import numpy as np
 
 from ptztrack.geometry.ptz import PTZCamera, apply_homography, head_from_feet_homology, inside_image
+from ptztrack.roles import ImageSource
 from ptztrack.track import kalman
 from ptztrack.track.appearance import Spatiogram, search, spatiogram
-from ptztrack.track.tracker import Tracks, associate, observation_matrix, predicted_feet_px
+from ptztrack.track.tracker import EkfTracker, observation_matrix, predicted_feet_px, update_own_tracks
+from ptztrack.types import Detections, Tracks, TrackUpdate
 
 MIN_SIMILARITY = 0.6
 MIN_RADIUS_PX = 3.0
@@ -93,37 +96,6 @@ def template_box_px(camera: PTZCamera, pose, feet_px, person_height_m: float, pe
     height_px = feet_px[:, 1] - head_px[:, 1]
     width_px = height_px * person_width_m / person_height_m
     return np.stack([feet_px[:, 0] - width_px / 2, head_px[:, 1], width_px, height_px], axis=-1)
-
-
-def detection_of_each_track(
-    predicted: Tracks, updated: Tracks, feet_px, camera: PTZCamera, pose, V, gate_probability: float
-) -> tuple[np.ndarray, np.ndarray]:
-    """Which detection each track was updated from or started at, after ``update_tracks``.
-
-    predicted : the tracks given to :func:`~ptztrack.track.tracker.update_tracks`;
-    updated : what it returned for the detections ``feet_px`` (K, 2) taken at
-    ``pose``, with pixel noise ``V`` (2, 2) px^2 and the tracker's gate
-    probability. Returns the ids (M,) of the tracks that were detected or
-    born, and the feet (M, 2) px of their detections.
-
-    A detected track (one whose hits grew) is paired with the detection the
-    Hungarian association gives it: the one that updated it under the
-    Hungarian association, the most likely one under the CJPDAF. A detection
-    the CJPDAF shares between tracks detects none of them, so it refreshes
-    no template. A new track's feet are its mean seen from ``pose``: the
-    pixel of the detection that started it.
-    """
-    feet_px = np.asarray(feet_px, dtype=float).reshape(-1, 2)
-    predicted_px, in_front = predicted_feet_px(camera, pose, predicted.mean)
-    S = kalman.innovation_covariance(predicted.covariance, observation_matrix(camera, pose, predicted.mean), V)
-    track_index, detection_index = associate(predicted_px, in_front, S, feet_px, gate_probability)
-    hits_after = dict(zip(updated.ids.tolist(), updated.hits.tolist()))
-    hits_before = predicted.hits[track_index]
-    detected = np.array([hits_after.get(i, 0) > h for i, h in zip(predicted.ids[track_index], hits_before)], dtype=bool)
-    born = updated.ids >= predicted.next_id
-    born_px, _ = predicted_feet_px(camera, pose, updated.mean[born])
-    ids = np.concatenate([predicted.ids[track_index][detected], updated.ids[born]])
-    return ids, np.concatenate([feet_px[detection_index][detected], born_px])
 
 
 def refresh_templates(
@@ -188,8 +160,8 @@ def template_measurements(
     similarity is at least ``min_similarity``.
 
     Each measurement belongs to its track and must not start a new one,
-    which ``update_tracks`` would do with a match its association leaves
-    unassigned.
+    which :func:`~ptztrack.track.tracker.update_tracks` would do with a match
+    its association leaves unassigned.
     """
     predicted_px, in_front = predicted_feet_px(camera, pose, tracks.mean)
     S = kalman.innovation_covariance(tracks.covariance, observation_matrix(camera, pose, tracks.mean), V)
@@ -214,3 +186,54 @@ def template_noise_covariance(camera: PTZCamera, pose, feet_px, person_height_m:
     person's height there per axis, and never below the detector's ``V`` (2, 2)."""
     height_px = template_box_px(camera, pose, feet_px, person_height_m, 1.0)[:, 3]
     return np.maximum((NOISE_HEIGHT_FRACTION * height_px)[:, None, None] ** 2 * np.eye(2), V)
+
+
+@dataclass
+class TemplateTracker:
+    """The ground tracker measuring people by their templates between detector steps (a
+    :class:`ptztrack.roles.Tracker`).
+
+    The detector runs every ``detector_every_steps`` steps; there ``tracker`` (the EKF tracker)
+    updates, starts and deletes tracks, and each track the update pairs with a detection takes its
+    template from that detection's box in the view. In between, each track with a template is
+    searched for in the view (:func:`template_measurements`) and a match updates that track alone
+    (:func:`~ptztrack.track.tracker.update_own_tracks`). People are ``person_height_m`` tall and
+    ``person_width_m`` wide.
+    """
+
+    tracker: EkfTracker
+    detector_every_steps: int
+    person_height_m: float
+    person_width_m: float
+    templates: Templates = field(default_factory=dict)
+
+    def predict(self) -> Tracks:
+        return self.tracker.predict()
+
+    def wants_detections(self, step: int) -> bool:
+        return step % self.detector_every_steps == 0
+
+    def update(self, detections: Detections | None, pose, view: ImageSource) -> TrackUpdate:
+        camera, height_m, width_m = self.tracker.camera, self.person_height_m, self.person_width_m
+        image = view()
+        if image is None:
+            raise RuntimeError("template matching needs a camera backend that renders images")
+        if detections is not None:
+            update = self.tracker.update(detections, pose, view)
+            feet_px = detections.feet_px[update.measurement_index]
+            self.templates = refresh_templates(
+                self.templates, update.tracks.ids, image, camera, pose, update.track_ids, feet_px, height_m, width_m
+            )
+            return update
+        tracks, V = self.tracker.tracks, self.tracker.V
+        found = template_measurements(image, camera, pose, tracks, self.templates, V, height_m, width_m)
+        noise = template_noise_covariance(camera, pose, found.feet_px, height_m, V)
+        max_sigma_m = self.tracker.parameters.max_position_sigma_m
+        self.tracker.tracks = update_own_tracks(tracks, found.track_ids, found.feet_px, camera, pose, noise, max_sigma_m)
+        height_px = template_box_px(camera, pose, found.feet_px, height_m, width_m)[:, 3]
+        measurements = Detections(found.feet_px, height_px, np.full(len(found.feet_px), -1), found.similarity)
+        alive = np.isin(found.track_ids, self.tracker.tracks.ids)
+        return TrackUpdate(self.tracker.tracks, found.track_ids[alive], np.flatnonzero(alive), measurements)
+
+    def reported(self) -> Tracks:
+        return self.tracker.reported()

@@ -4,16 +4,16 @@ Observations are feet pixels taken at a known pose; the observation function
 is the ground-to-image homography of that pose, linearised at the predicted
 state (the paper's section 3.1). Detections are associated with tracks by
 the Hungarian assignment (default) or by the Cheap JPDAF of
-:mod:`ptztrack.track.jpdaf` (``Tracker.association``).
+:mod:`ptztrack.track.jpdaf` (``TrackerParameters.association``).
 """
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
+from typing import Literal
 
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 from scipy.stats import chi2
 
-from ptztrack.config import Detector, Tracker
 from ptztrack.geometry.ptz import (
     PTZCamera,
     apply_homography,
@@ -22,8 +22,9 @@ from ptztrack.geometry.ptz import (
     image_to_ground,
     inside_image,
 )
+from ptztrack.roles import ImageSource
 from ptztrack.track import jpdaf, kalman
-
+from ptztrack.types import Detections, Tracks, TrackUpdate
 
 # Feet are found on a pixel grid: the tracker trusts them to half a pixel at
 # best, which also keeps the innovation covariance invertible for a
@@ -31,57 +32,30 @@ from ptztrack.track import jpdaf, kalman
 MIN_PIXEL_NOISE_PX = 0.5
 
 
-def pixel_noise_covariance(detector: Detector) -> np.ndarray:
+def pixel_noise_covariance(pixel_noise_px: float) -> np.ndarray:
     """``V`` (2, 2) px^2: the feet-pixel noise the tracker and the policies assume."""
-    return max(detector.pixel_noise_px, MIN_PIXEL_NOISE_PX) ** 2 * np.eye(2)
+    return max(pixel_noise_px, MIN_PIXEL_NOISE_PX) ** 2 * np.eye(2)
 
 
 @dataclass(frozen=True)
-class Tracks:
-    """All live tracks.
+class TrackerParameters:
+    """The ground-plane tracker's parameters (see :func:`update_tracks`).
 
-    ids : (n,) stable integer ids.
-    mean : (n, 4) states [x_m, y_m, vx_m_s, vy_m_s].
-    covariance : (n, 4, 4).
-    missed_steps : (n,) consecutive steps without an associated detection.
-    hits : (n,) steps with an associated detection, the one that started the track included.
-    next_id : the id the next new track gets.
+    initial_speed_sigma_m_s : spread of a new track's velocity per axis.
+    gate_probability : the chi-square gate (2 degrees of freedom) of the association.
+    max_missed_steps, max_position_sigma_m : when a track is deleted.
+    confirmation_hits : hits before a track is reported (until then it dies at its first miss).
+    association : 'hungarian' or 'cjpdaf' (:mod:`ptztrack.track.jpdaf`).
+    clutter_density_per_px2 : the CJPDAF's C.
     """
 
-    ids: np.ndarray
-    mean: np.ndarray
-    covariance: np.ndarray
-    missed_steps: np.ndarray
-    hits: np.ndarray
-    next_id: int = 0
-
-    def __len__(self) -> int:
-        return len(self.ids)
-
-    def select(self, keep) -> "Tracks":
-        return replace(
-            self,
-            ids=self.ids[keep],
-            mean=self.mean[keep],
-            covariance=self.covariance[keep],
-            missed_steps=self.missed_steps[keep],
-            hits=self.hits[keep],
-        )
-
-    def confirmed(self, config: Tracker) -> "Tracks":
-        """The tracks the tracker reports: those detected at least ``config.confirmation_hits`` times."""
-        return self.select(self.hits >= config.confirmation_hits)
-
-    @property
-    def position_sigma_m(self) -> np.ndarray:
-        """(n,) standard deviation along the most uncertain ground direction."""
-        return np.sqrt(np.linalg.eigvalsh(self.covariance[:, :2, :2])[:, -1])
-
-
-def no_tracks() -> Tracks:
-    return Tracks(
-        np.zeros(0, dtype=int), np.zeros((0, 4)), np.zeros((0, 4, 4)), np.zeros(0, dtype=int), np.zeros(0, dtype=int)
-    )
+    initial_speed_sigma_m_s: float
+    gate_probability: float
+    max_missed_steps: int
+    max_position_sigma_m: float
+    confirmation_hits: int
+    association: Literal["hungarian", "cjpdaf"]
+    clutter_density_per_px2: float
 
 
 def observation_matrix(camera: PTZCamera, pose, mean) -> np.ndarray:
@@ -139,23 +113,31 @@ def associate(predicted_px, in_front, S, feet_px, gate_probability: float) -> tu
     return rows[keep], cols[keep]
 
 
-def start_tracks(feet_px, camera: PTZCamera, pose, V, config: Tracker, first_id: int) -> Tracks:
+def ground_points(feet_px, camera: PTZCamera, pose) -> tuple[np.ndarray, np.ndarray]:
+    """The ground points (K, 2) m of feet pixels (K, 2) at ``pose``, and which lie in front of the
+    camera (K,): a pixel at or above the horizon has no ground point (its row is then meaningless)."""
+    G = image_to_ground(camera, pose)
+    # G (u, v, 1) = (x, y, 1) / depth, so its last entry is positive only for
+    # pixels whose ray meets the ground in front of the camera.
+    homogeneous = np.asarray(feet_px, dtype=float).reshape(-1, 2) @ G[:, :2].T + G[:, 2]
+    ok = homogeneous[:, 2] > 0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return homogeneous[:, :2] / homogeneous[:, 2:], ok
+
+
+def start_tracks(feet_px, camera: PTZCamera, pose, V, initial_speed_sigma_m_s: float, first_id: int) -> Tracks:
     """New tracks at the ground points of detections, with the pixel noise carried to the ground.
 
     Velocity starts at 0 with spread ``initial_speed_sigma_m_s`` per axis.
     Detections at or above the horizon cannot start a track and are dropped.
     """
-    G = image_to_ground(camera, pose)
-    # G (u, v, 1) = (x, y, 1) / depth, so its last entry is positive only for
-    # pixels whose ray meets the ground in front of the camera.
-    homogeneous = feet_px @ G[:, :2].T + G[:, 2]
-    ok = homogeneous[:, 2] > 0
-    ground_xy = homogeneous[ok, :2] / homogeneous[ok, 2:]
+    ground_xy, ok = ground_points(feet_px, camera, pose)
+    ground_xy = ground_xy[ok]
     count = len(ground_xy)
     J_inv = np.linalg.inv(feet_jacobian(camera, pose, ground_xy))
     covariance = np.zeros((count, 4, 4))
     covariance[:, :2, :2] = J_inv @ V @ np.swapaxes(J_inv, -1, -2)
-    covariance[:, 2:, 2:] = config.initial_speed_sigma_m_s**2 * np.eye(2)
+    covariance[:, 2:, 2:] = initial_speed_sigma_m_s**2 * np.eye(2)
     return Tracks(
         ids=first_id + np.arange(count),
         mean=np.concatenate([ground_xy, np.zeros((count, 2))], axis=-1),
@@ -166,10 +148,10 @@ def start_tracks(feet_px, camera: PTZCamera, pose, V, config: Tracker, first_id:
     )
 
 
-def update_tracks(tracks: Tracks, feet_px, camera: PTZCamera, pose, V, config: Tracker) -> Tracks:
+def update_tracks(tracks: Tracks, feet_px, camera: PTZCamera, pose, V, parameters: TrackerParameters) -> TrackUpdate:
     """Associate, update, start and delete: the tracker's step after prediction.
 
-    feet_px : (K, 2) detections taken at ``pose``. ``config.association``
+    feet_px : (K, 2) detections taken at ``pose``. ``parameters.association``
     chooses the association: 'hungarian' updates a track with at most one
     detection, and a detection assigned to no track starts one; 'cjpdaf'
     updates every track with all detections in its gate (see
@@ -186,19 +168,27 @@ def update_tracks(tracks: Tracks, feet_px, camera: PTZCamera, pose, V, config: T
     longer looks at). A track not yet confirmed (fewer than
     ``confirmation_hits`` hits) is deleted at its first missed step: a
     detector's false positive rarely repeats at the same ground point.
+
+    The update's ``track_ids`` and ``measurement_index`` pair each surviving detected track with
+    its detection (under the CJPDAF, with the detection the Hungarian assignment would give it;
+    a detection shared by tracks detects none of them) and each new track with the detection
+    that started it.
     """
     feet_px = np.asarray(feet_px, dtype=float).reshape(-1, 2)
     predicted_px, in_front = predicted_feet_px(camera, pose, tracks.mean)
     C = observation_matrix(camera, pose, tracks.mean)
     S = kalman.innovation_covariance(tracks.covariance, C, V)
-    if config.association == "cjpdaf":
-        innovation, distance2, gated = gated_innovations(predicted_px, in_front, S, feet_px, config.gate_probability)
-        mean, covariance, detected = jpdaf.cjpdaf_step(
-            tracks.mean, tracks.covariance, innovation, distance2, gated, S, C, V, config.clutter_density_per_px2
+    track_index, detection_index = associate(predicted_px, in_front, S, feet_px, parameters.gate_probability)
+    if parameters.association == "cjpdaf":
+        innovation, distance2, gated = gated_innovations(
+            predicted_px, in_front, S, feet_px, parameters.gate_probability
         )
-        track_index = np.flatnonzero(detected)
+        mean, covariance, detected = jpdaf.cjpdaf_step(
+            tracks.mean, tracks.covariance, innovation, distance2, gated, S, C, V, parameters.clutter_density_per_px2
+        )
+        paired = detected[track_index]
+        track_index, detection_index, updated_index = track_index[paired], detection_index[paired], np.flatnonzero(detected)
     else:
-        track_index, detection_index = associate(predicted_px, in_front, S, feet_px, config.gate_probability)
         mean, covariance = tracks.mean.copy(), tracks.covariance.copy()
         mean[track_index], covariance[track_index] = kalman.update(
             tracks.mean[track_index],
@@ -207,23 +197,33 @@ def update_tracks(tracks: Tracks, feet_px, camera: PTZCamera, pose, V, config: T
             C[track_index],
             V,
         )
-    survivors, keep = _after_update(tracks, mean, covariance, track_index, predicted_px, in_front, camera, config)
-    if config.association == "cjpdaf":
+        updated_index = track_index
+    survivors, keep = _after_update(tracks, mean, covariance, updated_index, predicted_px, in_front, camera, parameters)
+    if parameters.association == "cjpdaf":
         unmatched = np.flatnonzero(~gated[keep].any(axis=0))
     else:
         unmatched = np.setdiff1d(np.arange(len(feet_px)), detection_index)
-    born = start_tracks(feet_px[unmatched], camera, pose, V, config, tracks.next_id)
-    return Tracks(
-        ids=np.concatenate([survivors.ids, born.ids]),
-        mean=np.concatenate([survivors.mean, born.mean]),
-        covariance=np.concatenate([survivors.covariance, born.covariance]),
-        missed_steps=np.concatenate([survivors.missed_steps, born.missed_steps]),
-        hits=np.concatenate([survivors.hits, born.hits]),
-        next_id=born.next_id,
+    _, on_ground = ground_points(feet_px[unmatched], camera, pose)
+    starting = unmatched[on_ground]
+    born = start_tracks(feet_px[starting], camera, pose, V, parameters.initial_speed_sigma_m_s, tracks.next_id)
+    alive = keep[track_index]
+    return TrackUpdate(
+        tracks=Tracks(
+            ids=np.concatenate([survivors.ids, born.ids]),
+            mean=np.concatenate([survivors.mean, born.mean]),
+            covariance=np.concatenate([survivors.covariance, born.covariance]),
+            missed_steps=np.concatenate([survivors.missed_steps, born.missed_steps]),
+            hits=np.concatenate([survivors.hits, born.hits]),
+            next_id=born.next_id,
+        ),
+        track_ids=np.concatenate([tracks.ids[track_index[alive]], born.ids]),
+        measurement_index=np.concatenate([detection_index[alive], starting]),
     )
 
 
-def _after_update(tracks: Tracks, mean, covariance, track_index, predicted_px, in_front, camera: PTZCamera, config: Tracker):
+def _after_update(
+    tracks: Tracks, mean, covariance, track_index, predicted_px, in_front, camera: PTZCamera, parameters: TrackerParameters
+):
     """The updated tracks' misses, hits and deletions (see :func:`update_tracks`); returns the survivors
     and which of the tracks survived (n,) bool."""
     missed = tracks.missed_steps + (in_front & inside_image(camera, predicted_px))
@@ -231,19 +231,21 @@ def _after_update(tracks: Tracks, mean, covariance, track_index, predicted_px, i
     hits = tracks.hits.copy()
     hits[track_index] += 1
     updated = replace(tracks, mean=mean, covariance=covariance, missed_steps=missed, hits=hits)
-    allowed_missed_steps = np.where(hits >= config.confirmation_hits, config.max_missed_steps, 0)
-    keep = (updated.missed_steps <= allowed_missed_steps) & (updated.position_sigma_m <= config.max_position_sigma_m)
+    allowed_missed_steps = np.where(hits >= parameters.confirmation_hits, parameters.max_missed_steps, 0)
+    keep = (updated.missed_steps <= allowed_missed_steps) & (
+        updated.position_sigma_m <= parameters.max_position_sigma_m
+    )
     return updated.select(keep), keep
 
 
-def update_own_tracks(tracks: Tracks, track_ids, feet_px, camera: PTZCamera, pose, V, config: Tracker) -> Tracks:
+def update_own_tracks(tracks: Tracks, track_ids, feet_px, camera: PTZCamera, pose, V, max_position_sigma_m: float) -> Tracks:
     """Update each track with its own measurement: no association, no new tracks, no missed steps.
 
     track_ids : (K,) the track each measurement ``feet_px`` (K, 2) px belongs to (as template
     matching finds them); V : (2, 2) or (K, 2, 2) px^2 their noise. Such measurements neither count
     as hits nor clear missed steps: a template can settle on the background and keep matching it,
-    so only the detector confirms a track or keeps it alive. Tracks too uncertain are deleted as in
-    :func:`update_tracks`.
+    so only the detector confirms a track or keeps it alive. Tracks more uncertain than
+    ``max_position_sigma_m`` are deleted as in :func:`update_tracks`.
     """
     feet_px = np.asarray(feet_px, dtype=float).reshape(-1, 2)
     index_of_id = {track_id: index for index, track_id in enumerate(tracks.ids.tolist())}
@@ -258,4 +260,36 @@ def update_own_tracks(tracks: Tracks, track_ids, feet_px, camera: PTZCamera, pos
         tracks.mean[track_index], tracks.covariance[track_index], feet_px - predicted_px[track_index], C[track_index], V
     )
     updated = replace(tracks, mean=mean, covariance=covariance)
-    return updated.select(updated.position_sigma_m <= config.max_position_sigma_m)
+    return updated.select(updated.position_sigma_m <= max_position_sigma_m)
+
+
+@dataclass
+class EkfTracker:
+    """The ground-plane tracker as a role of the loop (:class:`ptztrack.roles.Tracker`).
+
+    camera : the camera model; F, U : the motion model (:func:`ptztrack.track.kalman.constant_velocity_model`);
+    V : (2, 2) px^2 the detections' noise; parameters : see :func:`update_tracks`.
+    """
+
+    camera: PTZCamera
+    F: np.ndarray
+    U: np.ndarray
+    V: np.ndarray
+    parameters: TrackerParameters
+    tracks: Tracks = field(default_factory=Tracks.empty)
+
+    def predict(self) -> Tracks:
+        self.tracks = predict_tracks(self.tracks, self.F, self.U)
+        return self.tracks
+
+    def wants_detections(self, step: int) -> bool:
+        return True
+
+    def update(self, detections: Detections | None, pose, view: ImageSource) -> TrackUpdate:
+        detections = Detections.empty() if detections is None else detections
+        update = update_tracks(self.tracks, detections.feet_px, self.camera, pose, self.V, self.parameters)
+        self.tracks = update.tracks
+        return update
+
+    def reported(self) -> Tracks:
+        return self.tracks.confirmed(self.parameters.confirmation_hits)

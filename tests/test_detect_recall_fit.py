@@ -1,14 +1,15 @@
 import numpy as np
 import pytest
 
-from ptztrack.evaluate.recall import fit_recall, recall_curve
+from ptztrack.detect.recall_fit import fit_recall
+from ptztrack.detect.simulated import realistic_recall
 
 
 @pytest.mark.parametrize("kd, r0", [(0.0098, 21.29), (0.3, 12.0)])
 def test_the_fit_recovers_the_curve_that_drew_the_trials(kd, r0):
     rng = np.random.default_rng(1)
     heights = rng.uniform(5, 200, size=20000)
-    detected = rng.random(heights.size) < recall_curve(heights, kd, r0)
+    detected = rng.random(heights.size) < realistic_recall(heights, kd, r0)
     fitted_kd, fitted_r0 = fit_recall(heights, detected)
     assert fitted_kd == pytest.approx(kd, rel=0.1)
     assert fitted_r0 == pytest.approx(r0, abs=1.0)
@@ -16,7 +17,7 @@ def test_the_fit_recovers_the_curve_that_drew_the_trials(kd, r0):
 
 def test_the_curve_is_zero_below_r0_and_rises_towards_one():
     heights = np.array([5.0, 21.29, 50.0, 500.0])
-    values = recall_curve(heights, 0.0098, 21.29)
+    values = realistic_recall(heights, 0.0098, 21.29)
     assert values[0] == 0 and values[1] == 0
     assert values[2] == pytest.approx(1 - np.exp(-0.0098 * (50 - 21.29)))
     assert values[3] > 0.98

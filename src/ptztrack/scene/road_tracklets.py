@@ -1,7 +1,9 @@
-"""The tracker layer of the face-capture experiment: what the MSG paper assumes a tracker provides.
+"""The tracklet oracle of the face-capture simulation: what the MSG paper assumes a tracker provides,
+read off the simulated truth.
 
-From the true walkers of the road grid (:mod:`ptztrack.scene.roads`) and
-the camera's mode, it maintains the tracklet graph (:mod:`ptztrack.control.msg`):
+It is not a tracker: it reads the true walkers of the road grid
+(:mod:`ptztrack.scene.roads`), their groups and their future, and from them
+and the camera's mode it maintains the tracklet graph (:mod:`ptztrack.track.msg`):
 
 - zoomed out, it sees every *unit* (a walker alone, or a group walking
   together, indistinguishable as everyone looks alike at low resolution);
@@ -26,11 +28,11 @@ from dataclasses import dataclass, field
 import networkx as nx
 import numpy as np
 
-from ptztrack.control import msg
+from ptztrack.track import msg
 
 
 @dataclass(frozen=True)
-class TrackletConfig:
+class TrackletOracleConfig:
     """zoom_steps : how long a face capture keeps the camera zoomed in.
     camera_m : (x, y) of the camera, which sees the faces of people walking towards it; None: the
         area's centre (everyone faces it while walking in, nobody while walking out).
@@ -59,7 +61,7 @@ def units_at(group_id_row: np.ndarray, present_row: np.ndarray) -> list[frozense
 
 
 @dataclass
-class TrackletTracker:
+class TrackletOracle:
     """The tracklet graph and which vertex each visible unit's tracklet is, step by step.
 
     positions_m : (T, N, 2) NaN absent; group_id : (T, N) -1 when alone; heading : (T, N, 2).
@@ -72,7 +74,7 @@ class TrackletTracker:
     frame_rate_hz: float
     max_speed_m_s: float
     road_spacing_m: float
-    config: TrackletConfig = TrackletConfig()
+    config: TrackletOracleConfig = TrackletOracleConfig()
     graph: nx.DiGraph = field(default_factory=msg.new_graph)
     unit_vertex: dict = field(default_factory=dict)
     lost: dict = field(default_factory=dict)

@@ -17,9 +17,9 @@ candidate association between consecutive tracklets. Node attributes:
 The recursions sum over parents, so an origin reachable along several
 unlabelled paths counts once per path (without untangling these counts
 double at every blind-gap X ambiguity and soon pass any float; lengths are
-whole steps, so all of it is exact integer arithmetic); :mod:`ptztrack.control.msg_traversal`
-computes the same quantities by traversal, and a property test holds the two
-equal. ``length`` of an active vertex grows every step, which changes its
+whole steps, so all of it is exact integer arithmetic); the tests' traversal
+reference (``tests/msg_traversal.py``) computes the same quantities by
+traversal, and a property test holds the two equal. ``length`` of an active vertex grows every step, which changes its
 own ``L_notdir`` and ``dL_dir``: :func:`refresh` recomputes them in
 O(|parents|) before a decision (its descendants do not exist yet).
 """

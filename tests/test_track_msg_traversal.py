@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from ptztrack.control.msg_traversal import (
+from msg_traversal import (
     future_ambiguity_score,
     is_labeled,
     is_solo,

@@ -4,8 +4,8 @@ import networkx as nx
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from ptztrack.control import msg
-from ptztrack.control.msg_traversal import traversal_data
+from ptztrack.track import msg
+from msg_traversal import traversal_data
 
 # Weighted so that labels often come after joins and splits: untangling through compound vertices.
 OPERATIONS = ("enter", "enter", "extend", "join", "join", "split", "split", "blind_gap", "exit", "label", "label", "label")

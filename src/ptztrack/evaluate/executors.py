@@ -1,4 +1,4 @@
-"""Experiments as data: a grid of (scenario, strategy, seed) cells, run by an executor, summarised as the paper's tables.
+"""Executors: run an experiment's cells in this process, on local processes, or on a Ray cluster.
 
 Every cell is a pure function of its inputs (the seed fixes every draw), so
 the serial, the local-process and the Ray executors give identical rows, in
@@ -9,72 +9,15 @@ import os
 import sys
 from collections.abc import Callable, Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
-from dataclasses import dataclass
-
-import numpy as np
-
-from ptztrack.config import Scenario
-from ptztrack.episode import run_episode
-from ptztrack.evaluate.metrics import DISPLAY, episode_metrics
-
-STRATEGIES = ("fix", "patrol", "rnd", "intg", "smpl")
-# The paper's column names; 'rnd' is the 'random' policy.
-POLICY_OF_STRATEGY = {"rnd": "random"}
 EXECUTORS = ("local", "ray", "serial")
-# The paper's rows.
-SUMMARY_KEYS = ("mota", "motp_m", "height_px", "detections", "zoom")
-
-
-@dataclass(frozen=True)
-class Cell:
-    """One episode of an experiment: a scenario run with one strategy and one sequence seed.
-
-    label : the table column it belongs to (the strategy, with beta where the table has several).
-    """
-
-    scenario: Scenario
-    strategy: str
-    seed: int
-    label: str = ""
-
-    @property
-    def column(self) -> str:
-        return self.label or self.strategy
-
-
-def synthetic_cells(scenario: Scenario, sequences: int, strategies: Sequence[str] = STRATEGIES) -> list[Cell]:
-    """The paper's synthetic protocol: every strategy on the same ``sequences`` sequences (seeds 0..n-1)."""
-    unknown = sorted(set(strategies) - set(STRATEGIES))
-    if unknown:
-        raise ValueError(f"unknown strategies {unknown}; expected some of {', '.join(STRATEGIES)}")
-    return [Cell(scenario, strategy, seed) for strategy in strategies for seed in range(sequences)]
-
-
-def recording_cells(scenario: Scenario, betas: Sequence[float], strategies: Sequence[str] = STRATEGIES) -> list[Cell]:
-    """The paper's realistic protocol (section 5.2): one run of each strategy over the recording,
-    the information-gain ones once per ``beta`` of the patrolling term."""
-    cells = [Cell(scenario, strategy, 0) for strategy in strategies if strategy not in ("intg", "smpl")]
-    for beta in betas:
-        with_beta = scenario.model_copy(update={"control": scenario.control.model_copy(update={"beta": beta})})
-        for strategy in strategies:
-            if strategy in ("intg", "smpl"):
-                cells.append(Cell(with_beta, strategy, 0, f"{strategy} b{beta:g}"))
-    return cells
-
-
-def run_cell(cell: Cell) -> dict:
-    """Run one cell; returns its metrics with ``strategy``, ``label``, ``beta`` (None for baselines) and ``seed``."""
-    episode = run_episode(cell.scenario, POLICY_OF_STRATEGY.get(cell.strategy, cell.strategy), cell.seed)
-    beta = cell.scenario.control.beta if cell.strategy in ("intg", "smpl") else None
-    return {"strategy": cell.strategy, "label": cell.column, "beta": beta, "seed": cell.seed, **episode_metrics(episode)}
 
 
 def run_cells(
     cells: Sequence,
+    run: Callable,
     executor: str = "local",
     workers: int | None = None,
     progress: Callable[[int, int], None] | None = None,
-    run: Callable = run_cell,
 ) -> list:
     """Run every cell with ``run`` (a module-level function, so that it pickles) and return the results
     in cell order.
@@ -149,29 +92,6 @@ def _run_on_ray(cells: Sequence, report: Callable[[int, int], None], run: Callab
         rows[pending[finished[0]]] = ray.get(finished[0])
         report(len(cells) - len(remaining), len(cells))
     return rows
-
-
-def summarise(rows: Sequence[dict]) -> list[dict]:
-    """Per table column, in the order of first appearance, the mean over sequences of the paper's figures
-    (the paper averages per-sequence results)."""
-    summary = []
-    for label in dict.fromkeys(row["label"] for row in rows):
-        mine = [row for row in rows if row["label"] == label]
-        means = {key: float(np.mean([row[key] for row in mine])) for key in SUMMARY_KEYS}
-        first = mine[0]
-        summary.append({"strategy": first["strategy"], "label": label, "beta": first["beta"], "sequences": len(mine), **means})
-    return summary
-
-
-def format_table(summary: Sequence[dict], title: str = "") -> str:
-    """The paper's layout: a row per figure, a column per strategy."""
-    width = max(len(DISPLAY[key][0]) for key in SUMMARY_KEYS)
-    lines = [title] if title else []
-    lines.append(" " * width + "".join(f"{row['label']:>10}" for row in summary))
-    for key in SUMMARY_KEYS:
-        label, fmt = DISPLAY[key]
-        lines.append(f"{label:<{width}}" + "".join(f"{fmt.format(row[key]):>10}" for row in summary))
-    return "\n".join(lines)
 
 
 def print_progress(done: int, total: int, noun: str = "episodes") -> None:

@@ -1,0 +1,135 @@
+"""The closed loop: scene -> camera -> detector -> tracker -> policy, step by step, recorded.
+
+:func:`run_loop` knows only the roles of :mod:`ptztrack.roles`: a camera
+backend, a detector, a tracker and a policy, and where the camera lands and
+which pose the tracker believes. Random draws come from independent streams
+spawned from the seed (:func:`episode_seeds`): the scene, one detector
+stream per frame, the policy, and the camera's landing errors. So different
+policies run with the same seed meet the same people and, frame by frame,
+the same detector luck (common random numbers), which makes their paired
+comparison far less noisy.
+"""
+
+import time
+from dataclasses import dataclass
+from functools import partial
+
+import numpy as np
+
+from ptztrack.camera.actions import ActionGrid
+from ptztrack.camera.pose_feedback import LandingError, landed_pose
+from ptztrack.geometry.ptz import PTZCamera
+from ptztrack.roles import CameraBackend, Detector, Policy, PoseSource, Tracker
+from ptztrack.types import DecisionContext, Detections, GroundTruth, Tracks
+
+
+@dataclass(frozen=True)
+class World:
+    """Everything a run's loop needs besides the policy and the tracker.
+
+    camera, grid : the PTZ camera model and its action grid.
+    truth : the people, for the metrics.
+    backend : what the camera shows; detector : what finds people in it.
+    area_bounds_m : [[x0, y0], [x1, y1]], where people can be.
+    start_action : the flat action the camera is at before the first step.
+    pose_source : the pose the tracker maps detections with (:mod:`ptztrack.camera.pose_feedback`).
+    landing_error : where the camera lands when sent to a pose.
+    """
+
+    camera: PTZCamera
+    grid: ActionGrid
+    truth: GroundTruth
+    backend: CameraBackend
+    detector: Detector
+    area_bounds_m: np.ndarray
+    start_action: int
+    pose_source: PoseSource
+    landing_error: LandingError
+
+
+@dataclass(frozen=True)
+class Episode:
+    """What happened in one run.
+
+    truth : the people.
+    camera : the PTZ camera that looked; area_bounds_m : [[x0, y0], [x1, y1]] where people can be.
+    actions : (T,) flat action index taken at each step; commanded poses are ``grid.poses[actions]``.
+    commanded : (T, 3) the poses of the actions.
+    poses : (T, 3) the poses the camera took, as (pan_deg, tilt_deg, zoom): the actions' poses
+        unless the camera lands off them.
+    tracker_poses : (T, 3) the poses the tracker mapped detections with.
+    pose_known : (T,) whether the pose source gave a pose; where not, the tracker used the commanded one.
+    decision_s : (T,) wall time the policy took to choose each action.
+    tracks : per step, the tracks the tracker reported after that step's update.
+    detections : per step, the measurements the tracker was updated with (the detector's).
+    """
+
+    truth: GroundTruth
+    camera: PTZCamera
+    area_bounds_m: np.ndarray
+    actions: np.ndarray
+    commanded: np.ndarray
+    poses: np.ndarray
+    tracker_poses: np.ndarray
+    pose_known: np.ndarray
+    decision_s: np.ndarray
+    tracks: list[Tracks]
+    detections: list[Detections]
+
+
+# What the loop records at every step, as the fields of Episode.
+PER_STEP = ("actions", "commanded", "poses", "tracker_poses", "pose_known", "decision_s", "tracks", "detections")
+
+
+def episode_seeds(seed: int) -> list[np.random.SeedSequence]:
+    """The independent streams of an episode: scene, detector, policy, the camera's landing errors."""
+    return np.random.SeedSequence(seed).spawn(4)
+
+
+def run_loop(world: World, policy: Policy, tracker: Tracker, seed: int) -> Episode:
+    """Run the closed loop for every frame of ``world.truth``, with the streams of ``seed``."""
+    _, detector_seed, policy_seed, landing_seed = episode_seeds(seed)
+    steps = world.truth.positions_m.shape[0]
+    frame_seeds = detector_seed.spawn(steps)
+    policy_rng = np.random.default_rng(policy_seed)
+    landing_rng = np.random.default_rng(landing_seed)
+
+    action = world.start_action
+    per_step = {name: [] for name in PER_STEP}
+    for step in range(steps):
+        predicted = tracker.predict()
+        context = DecisionContext(step, action, world.grid.reachable(action), predicted, policy_rng)
+        previous_action, started = action, time.perf_counter()
+        action = int(policy.choose(context))
+        decision_s = time.perf_counter() - started
+        commanded = world.grid.poses[action]
+        if step == 0 or action != previous_action:
+            pose = landed_pose(commanded, world.landing_error, landing_rng)
+        believed = world.pose_source(step, commanded, pose)
+        tracker_pose = commanded if believed is None else believed
+        detections = None
+        if tracker.wants_detections(step):
+            detections = world.detector.detect(world.backend, step, pose, np.random.default_rng(frame_seeds[step]))
+        update = tracker.update(detections, tracker_pose, partial(world.backend.image, step, pose))
+        measured = update.measurements if update.measurements is not None else detections
+        record = {
+            "actions": action,
+            "commanded": commanded,
+            "poses": pose,
+            "tracker_poses": tracker_pose,
+            "pose_known": believed is not None,
+            "decision_s": decision_s,
+            "tracks": tracker.reported(),
+            "detections": Detections.empty() if measured is None else measured,
+        }
+        for name, value in record.items():
+            per_step[name].append(value)
+    arrays = {name: np.asarray(per_step[name]) for name in PER_STEP if name not in ("tracks", "detections")}
+    return Episode(
+        world.truth,
+        world.camera,
+        world.area_bounds_m,
+        tracks=per_step["tracks"],
+        detections=per_step["detections"],
+        **arrays,
+    )

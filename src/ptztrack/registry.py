@@ -1,0 +1,97 @@
+"""Names for implementations of the roles, so that scenario files and the command line can use them.
+
+Four kinds: ``policies``, ``detectors``, ``cameras`` (camera backends) and
+``trackers``. A name maps to a *factory*, called by the builders
+(:mod:`ptztrack.build`) with the validated scenario and what is built so far:
+
+* ``policies`` and ``trackers``: ``factory(scenario, world) -> Policy | Tracker``,
+  ``world`` a :class:`ptztrack.loop.World`;
+* ``detectors`` and ``cameras``: ``factory(scenario, scene) -> Detector | CameraBackend``,
+  ``scene`` a :class:`ptztrack.build.world.BuiltScene`.
+
+Names come from three places, in this order of precedence: ptztrack's own
+(imported only when used), the entry points of installed packages in the
+groups ``ptztrack.policies``, ``ptztrack.detectors``, ``ptztrack.cameras``
+and ``ptztrack.trackers``, and :func:`register` at run time::
+
+    # pyproject.toml of another package
+    [project.entry-points."ptztrack.policies"]
+    greedy = "my_package.policies:make_greedy"
+
+This module imports nothing else of ptztrack: the built-in factories are
+named by their import paths.
+"""
+
+import functools
+import importlib
+from collections.abc import Callable
+from importlib.metadata import entry_points
+from typing import Any
+
+KINDS = ("policies", "detectors", "cameras", "trackers")
+ENTRY_POINT_GROUPS = {kind: f"ptztrack.{kind}" for kind in KINDS}
+_SINGULAR = {"policies": "policy", "detectors": "detector", "cameras": "camera backend", "trackers": "tracker"}
+
+_FACTORIES = "ptztrack.build.factories"
+_BUILT_IN: dict[str, dict[str, str]] = {
+    "policies": {name: f"{_FACTORIES}:{name}_policy" for name in ("fix", "patrol", "random", "intg", "smpl")},
+    "detectors": {name: f"{_FACTORIES}:{name}_detector" for name in ("ideal", "realistic", "hog")},
+    "cameras": {"simulated": f"{_FACTORIES}:simulated_camera", "virtual": f"{_FACTORIES}:virtual_camera"},
+    "trackers": {"ekf": f"{_FACTORIES}:ekf_tracker"},
+}
+_registered: dict[str, dict[str, Callable[..., Any]]] = {kind: {} for kind in KINDS}
+
+
+class UnknownName(ValueError):
+    """A name that no implementation of the kind has; the message lists the names there are."""
+
+
+def _check_kind(kind: str) -> None:
+    if kind not in KINDS:
+        raise ValueError(f"unknown kind {kind!r}; expected one of {', '.join(KINDS)}")
+
+
+@functools.cache
+def _entry_points(kind: str) -> dict:
+    return {point.name: point for point in entry_points(group=ENTRY_POINT_GROUPS[kind])}
+
+
+def names(kind: str) -> list[str]:
+    """Every name of the kind: the built-in ones first, then installed, then registered at run time."""
+    _check_kind(kind)
+    return list(dict.fromkeys([*_BUILT_IN[kind], *_entry_points(kind), *_registered[kind]]))
+
+
+def factory(kind: str, name: str) -> Callable[..., Any]:
+    """The factory registered for ``name``; raises :class:`UnknownName` naming the choices."""
+    _check_kind(kind)
+    if name in _BUILT_IN[kind]:
+        module, _, attribute = _BUILT_IN[kind][name].partition(":")
+        return getattr(importlib.import_module(module), attribute)
+    if name in _entry_points(kind):
+        return _entry_points(kind)[name].load()
+    if name in _registered[kind]:
+        return _registered[kind][name]
+    raise UnknownName(f"unknown {_SINGULAR[kind]} {name!r}; expected one of {', '.join(names(kind))}")
+
+
+def register(kind: str, name: str, make: Callable[..., Any] | None = None):
+    """Register ``make`` as the factory of ``name``; without ``make``, a decorator that does so.
+
+    A name that is taken (built in, installed, or registered before) is refused.
+    """
+    _check_kind(kind)
+
+    def add(make: Callable[..., Any]) -> Callable[..., Any]:
+        if name in names(kind):
+            raise ValueError(f"{kind}: the name {name!r} is taken")
+        _registered[kind][name] = make
+        return make
+
+    return add if make is None else add(make)
+
+
+def unregister(kind: str, name: str) -> None:
+    """Forget a name registered at run time (built-in and installed names stay)."""
+    _check_kind(kind)
+    _registered[kind].pop(name, None)

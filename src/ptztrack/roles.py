@@ -1,0 +1,71 @@
+"""The roles of the closed loop, as protocols over :mod:`ptztrack.types`.
+
+Every run is the same loop (:func:`ptztrack.loop.run_loop`): a camera backend
+shows the scene at a pose, a detector finds people in it, a tracker keeps
+beliefs about them on the ground plane, and a policy chooses the next pose.
+A new backend, detector, tracker or policy implements one of these protocols
+and nothing else changes; :mod:`ptztrack.registry` gives it a name that
+scenario files and the command line can use.
+"""
+
+from collections.abc import Callable
+from typing import Protocol
+
+import numpy as np
+
+from ptztrack.types import DecisionContext, Detections, PeopleInView, Tracks, TrackUpdate
+
+ImageSource = Callable[[], np.ndarray | None]
+"""``view()``: the image the camera shows at the step and pose the tracker is updated for, or None."""
+
+PoseSource = Callable[[int, np.ndarray, np.ndarray], np.ndarray | None]
+"""``source(step, commanded, actual)``: the (3,) pose the tracker maps detections with, or None when it
+cannot tell (the loop then uses the commanded one)."""
+
+
+class CameraBackend(Protocol):
+    """What a camera shows at a step and a pose (pan_deg, tilt_deg, zoom)."""
+
+    def image(self, step: int, pose: np.ndarray) -> np.ndarray | None:
+        """The view, (h, w, 3) uint8 BGR, or None for a camera that renders no images."""
+        ...
+
+    def people(self, step: int, pose: np.ndarray) -> PeopleInView | None:
+        """The people in view as a simulation knows them, or None for a real camera."""
+        ...
+
+
+class Detector(Protocol):
+    """Finds people in what a camera shows."""
+
+    def detect(self, camera: CameraBackend, step: int, pose: np.ndarray, rng: np.random.Generator) -> Detections:
+        """Detections at ``pose``; ``rng`` is the step's own stream (draw only from it)."""
+        ...
+
+
+class Tracker(Protocol):
+    """Keeps beliefs about people on the ground plane, one step at a time."""
+
+    def predict(self) -> Tracks:
+        """Advance every track by one step; returns the predicted tracks, which the policy plans with."""
+        ...
+
+    def wants_detections(self, step: int) -> bool:
+        """Whether the detector should run at ``step`` (a tracker may measure on its own in between)."""
+        ...
+
+    def update(self, detections: Detections | None, pose: np.ndarray, view: ImageSource) -> TrackUpdate:
+        """Update with the step's detections (None where it did not ask for any), taken at ``pose``."""
+        ...
+
+    def reported(self) -> Tracks:
+        """The tracks the tracker reports now (the metrics score these)."""
+        ...
+
+
+class Policy(Protocol):
+    """Chooses the next action; may keep state across the steps of one episode."""
+
+    def choose(self, context: DecisionContext) -> int:
+        """The flat index of the next action, one of ``context.reachable``."""
+        ...
