@@ -13,9 +13,9 @@ import time
 
 import numpy as np
 
-from ptztrack.config import scenario_from_dict
 from ptztrack import registry
 from ptztrack.build.episode import run_episode
+from ptztrack.config import scenario_from_dict
 from ptztrack.evaluate.metrics import episode_metrics
 
 COLUMNS = ("mota", "motp_m", "idf1", "height_px", "detections", "zoom")
@@ -29,7 +29,7 @@ def main() -> None:
     print(f"{'detector':<10}{'policy':<8}" + "".join(f"{c:>11}" for c in COLUMNS) + f"{'steps/s':>10}")
     for detector in ("ideal", "realistic"):
         scenario = scenario_from_dict({"detector": {"kind": detector}, "frames": args.frames})
-        for policy in POLICIES:
+        for policy in registry.names("policies"):
             start = time.perf_counter()
             episodes = [run_episode(scenario, policy, seed) for seed in range(args.seeds)]
             steps_per_s = args.seeds * args.frames / (time.perf_counter() - start)

@@ -31,10 +31,10 @@ from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
 
-from ptztrack.build.world import action_grid
+from ptztrack.build.episode import make_policy, run_episode  # noqa: E402
+from ptztrack.build.world import action_grid, build_world  # noqa: E402
 from ptztrack.config import scenario_from_dict  # noqa: E402
-from ptztrack.episode import build_world, make_policy, run_episode  # noqa: E402
-from ptztrack.track.tracker import Tracks  # noqa: E402
+from ptztrack.types import Tracks  # noqa: E402
 
 SIZES = {
     "7x280": {"detector": {"kind": "ideal"}, "control": {"beta": 1.0}, "frames": 60},
@@ -95,7 +95,10 @@ def main() -> None:
             policy.rewards(actions, states[0], rng)
             rates[method] = decisions_per_second(policy, states, actions, rng)
         pairs = track_count * len(actions)
-        line = f"{size}: intg {rates['intg']:.0f} decisions/s, smpl (M={scenario.control.samples}) {rates['smpl']:.1f} decisions/s"
+        line = (
+            f"{size}: intg {rates['intg']:.0f} decisions/s, "
+            f"smpl (M={scenario.control.samples}) {rates['smpl']:.1f} decisions/s"
+        )
         if stonesoup_seconds_per_action_track is not None:
             reference_s = stonesoup_seconds_per_action_track(track_count, len(actions))
             ratios = {method: reference_s * rate * pairs for method, rate in rates.items()}

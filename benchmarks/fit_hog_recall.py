@@ -11,10 +11,10 @@ recall per height band, next to the paper's Caltech curve (Kd 0.0098, r0 21.29).
 
 import numpy as np
 
-from ptztrack.config import pets_scenario
 from ptztrack.build.world import build_world
-from ptztrack.detect.recall_fit import fit_recall
-from ptztrack.detect.simulated import realistic_recall, recorded_hog_trials
+from ptztrack.config import pets_scenario
+from ptztrack.detect.recall_fit import detection_trials, fit_recall
+from ptztrack.detect.simulated import realistic_recall
 
 
 def main() -> None:
@@ -23,7 +23,7 @@ def main() -> None:
     grid = world.grid
     poses = grid.poses[np.all(np.abs(grid.axis_indices[:, :2] - [3, 2]) <= [2, 1], axis=1)]
     steps = range(0, world.truth.positions_m.shape[0], 20)
-    heights, detected = recorded_hog_trials(world.backend, poses, steps)
+    heights, detected = detection_trials(world.backend, world.detector, poses, steps, scenario.recording.occluded_above)
     kd, r0 = fit_recall(heights, detected)
     print(f"{len(heights)} annotated people in view, {detected.sum()} found by HOG")
     print(f"fitted Kd = {kd:.4f} per px, r0 = {r0:.2f} px (paper, Caltech HOG: 0.0098, 21.29)")

@@ -12,20 +12,17 @@ C = lambda (1 - P_D P_G) / P_D with P_G = 0.99, the value of
     python benchmarks/hog_clutter.py
 """
 
-import dataclasses
-
 import numpy as np
 from scipy.spatial.distance import cdist
 
-from ptztrack.config import pets_scenario
 from ptztrack.build.world import build_world
+from ptztrack.config import pets_scenario
 
 
 def main() -> None:
     scenario = pets_scenario("hog")
     world = build_world(scenario, np.random.default_rng(0))
     grid, backend = world.grid, world.backend
-    everybody = dataclasses.replace(backend, occluded_above=1.0)
     rng = np.random.default_rng(0)
     width_px, height_px = scenario.camera.image_size_px
     steps = range(0, world.truth.positions_m.shape[0], 8)
@@ -35,9 +32,10 @@ def main() -> None:
         radius_px = 5.0 * pose[2]
         false = found = visible = 0
         for step in steps:
-            boxes = backend.observe(step, pose, rng).feet_px
-            annotated = everybody.observe_annotations(step, pose, rng, pixel_noise=False).feet_px
-            seen = backend.observe_annotations(step, pose, rng, pixel_noise=False).feet_px
+            boxes = world.detector.detect(backend, step, pose, rng).feet_px
+            people = backend.people(step, pose)
+            annotated = people.feet_px[people.in_view]
+            seen = people.feet_px[people.in_view & (people.hidden <= scenario.recording.occluded_above)]
             if len(boxes):
                 nearest = cdist(boxes, annotated).min(axis=1) if len(annotated) else np.full(len(boxes), np.inf)
                 false += int((nearest > radius_px).sum())

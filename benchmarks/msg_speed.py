@@ -62,7 +62,7 @@ def grow(graph, active: dict, rng: np.random.Generator, next_target: list) -> No
         if solos:
             msg.label(graph, solos[rng.integers(len(solos))], untangling=False)
     created = msg.add_tracklets(graph, events, step)
-    for (targets, parents), v in zip(events, created):
+    for (targets, parents), v in zip(events, created, strict=True):
         for p in parents:
             active.pop(p, None)
         active[v] = frozenset(targets)

@@ -15,8 +15,8 @@ import time
 import cv2
 import numpy as np
 
+from ptztrack.build.registration import reference_index, registration_camera
 from ptztrack.build.world import action_grid
-from ptztrack.camera.pose_feedback import reference_index, registration_camera
 from ptztrack.config import pets_scenario
 from ptztrack.geometry.registration import LIVE_FEATURES, register, sift_features, within_view_ratio_matches
 from ptztrack.scene.pets import RecordedVideo
@@ -33,7 +33,8 @@ def main() -> None:
     scenario = pets_scenario("ideal", pose_feedback={"image_size_px": tuple(args.size), "index": args.index})
     start = time.perf_counter()
     index = reference_index(scenario)
-    print(f"reference index: {len(index.poses)} views, {len(index.descriptors)} features, {time.perf_counter() - start:.1f} s")
+    seconds = time.perf_counter() - start
+    print(f"reference index: {len(index.poses)} views, {len(index.descriptors)} features, {seconds:.1f} s")
     virtual, whole_frame_pose = registration_camera(scenario)
     grid = action_grid(scenario)
     rng = np.random.default_rng(0)
@@ -57,16 +58,20 @@ def main() -> None:
         matched = time.perf_counter()
         register(virtual.camera, index, image)
         registered = time.perf_counter()
-        cv2.SIFT_create().detectAndCompute(cv2.cvtColor(image, cv2.COLOR_BGR2GRAY), None)
+        cv2.SIFT.create().detectAndCompute(cv2.cvtColor(image, cv2.COLOR_BGR2GRAY), None)
         reference = time.perf_counter()
         timings.append((registered - matched, features - start, matched - features, reference - registered))
     total, sift, matching, full_size_sift = np.median(timings, axis=0) * 1e3
     p90 = np.percentile([row[0] for row in timings], 90) * 1e3
     print(f"register one {args.size[0]} x {args.size[1]} view, one thread, {args.views} views:")
-    print(f"  median {total:.1f} ms (p90 {p90:.1f} ms): SIFT {sift:.1f} ms, FLANN and ratio test {matching:.1f} ms, "
-          f"RANSAC and pose {total - sift - matching:.1f} ms")
-    print(f"  reference, OpenCV SIFT alone at full size and default settings: {full_size_sift:.1f} ms "
-          f"({full_size_sift / total:.2f}x the whole registration)")
+    print(
+        f"  median {total:.1f} ms (p90 {p90:.1f} ms): SIFT {sift:.1f} ms, FLANN and ratio test {matching:.1f} ms, "
+        f"RANSAC and pose {total - sift - matching:.1f} ms"
+    )
+    print(
+        f"  reference, OpenCV SIFT alone at full size and default settings: {full_size_sift:.1f} ms "
+        f"({full_size_sift / total:.2f}x the whole registration)"
+    )
 
 
 if __name__ == "__main__":

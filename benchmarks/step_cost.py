@@ -1,6 +1,6 @@
 """Cost of one closed-loop step on PETS 2009 with the HOG detector, split by role.
 
-Runs the loop of :func:`ptztrack.episode.run_episode` on the built-in PETS
+Runs the loop of :func:`ptztrack.loop.run_loop` on the built-in PETS
 scenario with OpenCV's HOG detector (``pets_scenario("hog")``, beta 1, seed
 0) for the policies ``fix``, ``intg`` and ``smpl``, and times each role of a
 step with ``time.perf_counter``:
@@ -8,14 +8,15 @@ step with ``time.perf_counter``:
 * read: decoding the step's recorded frame (``RecordedVideo.frame``);
 * warp: rendering the 160 x 120 virtual view from it (``VirtualPTZ.render``);
 * detect: HOG on the view, 6x upsampling and non-maximum suppression
-  included (``HogPeopleDetector.detect``), then ``feet_and_height_px``;
-* track: ``predict_tracks`` and ``update_tracks``;
+  included (``HogPeopleDetector.boxes``), then ``feet_and_height_px``;
+* track: the tracker's ``predict`` and ``update``;
 * decide: the reachable actions and ``policy.choose``.
 
-The roles are the backend's own pieces (``RecordedPTZ.observe`` is
-``video.frame`` -> ``virtual.render`` -> ``hog.detect`` ->
-``feet_and_height_px``), called in the same order with the same seeds, so
-the timed steps are the episode's real steps. Building the world and the
+The roles are the backend's and the detector's own pieces
+(``RecordedPTZ.image`` is ``video.frame`` -> ``virtual.render``; the HOG
+detector's ``detect`` is ``boxes`` -> ``feet_and_height_px``), called in the
+same order with the same seeds, so the timed steps are the episode's real
+steps. Building the world and the
 policy (the patrolling term's map) is set-up, not timed. The first
 ``--warmup`` steps (default 5) run but are excluded, so that Numba's
 compilation and the first calls into OpenCV are not counted; the next
@@ -42,19 +43,18 @@ for _variable in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", 
 import argparse  # noqa: E402  (the thread counts must be set before NumPy, Numba and OpenCV load)
 import json  # noqa: E402
 import time  # noqa: E402
+from functools import partial  # noqa: E402
 from pathlib import Path  # noqa: E402
 
 import cv2  # noqa: E402
 import numpy as np  # noqa: E402
 
+from ptztrack.build.episode import make_policy, make_tracker  # noqa: E402
+from ptztrack.build.world import build_world  # noqa: E402
 from ptztrack.config import pets_scenario  # noqa: E402
-from ptztrack.control.baselines import widest_view_action  # noqa: E402
-from ptztrack.types import DecisionContext  # noqa: E402
-from ptztrack.detect.hog import feet_and_height_px  # noqa: E402
-from ptztrack.types import Detections  # noqa: E402
-from ptztrack.episode import build_world, make_policy  # noqa: E402
-from ptztrack.track.kalman import constant_velocity_model  # noqa: E402
-from ptztrack.track.tracker import no_tracks, pixel_noise_covariance, predict_tracks, update_tracks  # noqa: E402
+from ptztrack.detect.hog import HogPeopleDetector, feet_and_height_px  # noqa: E402
+from ptztrack.loop import episode_seeds  # noqa: E402
+from ptztrack.types import DecisionContext, Detections  # noqa: E402
 
 cv2.setNumThreads(1)
 
@@ -65,25 +65,24 @@ POLICIES = ("fix", "intg", "smpl")
 def step_costs(scenario, policy_name: str, steps: int, warmup: int, seed: int = 0) -> dict:
     """Seconds spent in each part over ``steps`` steps after ``warmup`` untimed ones, and the wall time.
 
-    The loop is run_episode's with the HOG backend's observe split into its pieces.
+    The loop is run_loop's (a perfect camera, the commanded pose) with the backend's image split
+    into reading and warping.
     """
-    scene_seed, _detector_seed, policy_seed = np.random.SeedSequence(seed).spawn(3)
+    scene_seed, _detector_seed, policy_seed, _landing_seed = episode_seeds(seed)
     world = build_world(scenario, np.random.default_rng(scene_seed))
-    backend = world.backend
-    if backend.hog is None:
+    backend, detector = world.backend, world.detector
+    if not isinstance(detector, HogPeopleDetector):
         raise ValueError("the scenario must use the HOG detector")
     available = world.truth.positions_m.shape[0]
     if warmup + steps > available:
         raise ValueError(f"{warmup} + {steps} steps asked, the recording has {available}")
     policy = make_policy(policy_name, scenario, world)
+    tracker = make_tracker(None, scenario, world)
     policy_rng = np.random.default_rng(policy_seed)
-    F, U = constant_velocity_model(1.0 / scenario.frame_rate_hz, scenario.tracker.acceleration_sigma_m_s2)
-    V = pixel_noise_covariance(scenario.detector)
-    grid, camera = world.grid, world.camera
+    grid = world.grid
 
     clock = time.perf_counter
-    action = widest_view_action(camera, grid, world.area_bounds_m)
-    tracks = no_tracks()
+    action = world.start_action
     seconds = dict.fromkeys(PARTS, 0.0)
     actions = []
     start, cpu_start = clock(), time.process_time()
@@ -92,20 +91,20 @@ def step_costs(scenario, policy_name: str, steps: int, warmup: int, seed: int = 
             seconds = dict.fromkeys(PARTS, 0.0)
             start, cpu_start = clock(), time.process_time()
         t0 = clock()
-        tracks = predict_tracks(tracks, F, U)
+        predicted = tracker.predict()
         t1 = clock()
-        context = DecisionContext(step, action, grid.reachable(action), tracks, policy_rng)
-        action = policy.choose(context)
+        action = policy.choose(DecisionContext(step, action, grid.reachable(action), predicted, policy_rng))
         pose = grid.poses[action]
         t2 = clock()
         frame = backend.video.frame(int(backend.scene.video_frame[step]))
         t3 = clock()
         view = backend.virtual.render(frame, pose)
         t4 = clock()
-        feet_px, height_px = feet_and_height_px(backend.hog.detect(view)[0])
-        detections = Detections(feet_px=feet_px, height_px=height_px, person_index=np.full(len(feet_px), -1))
+        boxes, scores = detector.boxes(view)
+        feet_px, height_px = feet_and_height_px(boxes)
+        detections = Detections(feet_px, height_px, np.full(len(feet_px), -1), scores)
         t5 = clock()
-        tracks = update_tracks(tracks, detections.feet_px, camera, pose, V, scenario.tracker)
+        tracker.update(detections, pose, partial(backend.image, step, pose))
         t6 = clock()
         seconds["track"] += (t1 - t0) + (t6 - t5)
         seconds["decide"] += t2 - t1

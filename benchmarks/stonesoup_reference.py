@@ -118,14 +118,14 @@ def _make_tracks(num_tracks: int, rng: np.random.Generator, start: datetime.date
     velocities = rng.normal(0.0, 1.0, (num_tracks, 2))
     covar = CovarianceMatrix(np.diag([0.5**2, 0.2**2, 0.5**2, 0.2**2]))
     return {
-        Track([GaussianState(
-            StateVector([r * np.cos(b), v[0], r * np.sin(b), v[1]]), covar, timestamp=start)])
-        for b, r, v in zip(bearings, ranges, velocities)
+        Track([GaussianState(StateVector([r * np.cos(b), v[0], r * np.sin(b), v[1]]), covar, timestamp=start)])
+        for b, r, v in zip(bearings, ranges, velocities, strict=True)
     }
 
 
-def measure_stonesoup(num_tracks: int, num_actions: int, repeats: int = 3, seed: int = 0,
-                      fov_deg: float = FOV_DEG) -> StoneSoupTiming:
+def measure_stonesoup(
+    num_tracks: int, num_actions: int, repeats: int = 3, seed: int = 0, fov_deg: float = FOV_DEG
+) -> StoneSoupTiming:
     """Time Stone Soup choosing one dwell centre among ~num_actions for num_tracks tracks."""
     if num_tracks < 1 or num_actions < 1 or repeats < 1:
         raise ValueError("num_tracks, num_actions and repeats must be >= 1")
@@ -134,8 +134,7 @@ def measure_stonesoup(num_tracks: int, num_actions: int, repeats: int = 3, seed:
     sensor = _make_sensor(num_actions, fov_deg, start)
     tracks = _make_tracks(num_tracks, np.random.default_rng(seed), start)
 
-    transition = CombinedLinearGaussianTransitionModel(
-        [ConstantVelocity(0.05), ConstantVelocity(0.05)])  # [m^2/s^3]
+    transition = CombinedLinearGaussianTransitionModel([ConstantVelocity(0.05), ConstantVelocity(0.05)])  # [m^2/s^3]
     # The updater takes the measurement model from each simulated detection,
     # i.e. the radar's model for the candidate dwell centre.
     updater = _CountingUpdater(measurement_model=None)
@@ -160,8 +159,9 @@ def measure_stonesoup(num_tracks: int, num_actions: int, repeats: int = 3, seed:
     return StoneSoupTiming(num_tracks, num_actions, evaluated, best, updates)
 
 
-def stonesoup_seconds_per_action_track(num_tracks: int, num_actions: int, repeats: int = 3,
-                                       seed: int = 0, *, fov_deg: float = FOV_DEG) -> float:
+def stonesoup_seconds_per_action_track(
+    num_tracks: int, num_actions: int, repeats: int = 3, seed: int = 0, *, fov_deg: float = FOV_DEG
+) -> float:
     """Seconds Stone Soup's BruteForceSensorManager + UncertaintyRewardFunction spends per
     (action, track) evaluation, choosing among ~num_actions actions for num_tracks Gaussian tracks.
 
@@ -172,8 +172,7 @@ def stonesoup_seconds_per_action_track(num_tracks: int, num_actions: int, repeat
     divides by the counted reward-function calls times num_tracks. Runs the full
     action count (no subsampling). Returns seconds [s].
     """
-    return measure_stonesoup(num_tracks, num_actions, repeats, seed,
-                             fov_deg).seconds_per_action_track
+    return measure_stonesoup(num_tracks, num_actions, repeats, seed, fov_deg).seconds_per_action_track
 
 
 def main() -> None:
@@ -185,11 +184,12 @@ def main() -> None:
     parser.add_argument("--fov-deg", type=float, default=FOV_DEG)
     args = parser.parse_args()
     timing = measure_stonesoup(args.tracks, args.actions, args.repeats, args.seed, args.fov_deg)
-    print(f"tracks: {timing.num_tracks}  actions requested: {timing.requested_actions}  "
-          f"fov: {args.fov_deg:g} deg")
+    print(f"tracks: {timing.num_tracks}  actions requested: {timing.requested_actions}  fov: {args.fov_deg:g} deg")
     print(f"actions evaluated: {timing.evaluated_actions}")
-    print(f"Kalman updates per decision: {timing.updates_per_decision} "
-          f"(of {timing.evaluated_actions * timing.num_tracks} action-track pairs)")
+    print(
+        f"Kalman updates per decision: {timing.updates_per_decision} "
+        f"(of {timing.evaluated_actions * timing.num_tracks} action-track pairs)"
+    )
     print(f"seconds per decision: {timing.seconds_per_decision:.4f}")
     print(f"seconds per action-track evaluation: {timing.seconds_per_action_track:.3e}")
 

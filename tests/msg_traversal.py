@@ -35,8 +35,8 @@ iterative, so 10^5-vertex chains need no recursion.
 """
 
 from collections import deque
+from collections.abc import Hashable
 from dataclasses import dataclass
-from typing import Hashable
 
 import networkx as nx
 
@@ -125,9 +125,7 @@ def _origin_path_counts(cone: _UnlabeledCone) -> dict:
     for member in reversed(cone.order[:-1]):
         paths_to_vertex[member] = sum(paths_to_vertex[child] for child in cone.children[member])
     return {
-        member: paths
-        for member, paths in paths_to_vertex.items()
-        if member in cone.labeled or not cone.parents[member]
+        member: paths for member, paths in paths_to_vertex.items() if member in cone.labeled or not cone.parents[member]
     }
 
 
@@ -140,9 +138,7 @@ def origins(graph: nx.DiGraph, vertex: Vertex) -> dict:
     """
     cone = _unlabeled_cone(graph, vertex)
     return {
-        origin: paths
-        for origin, paths in _origin_path_counts(cone).items()
-        if cone.attributes[origin]["count"] == 1
+        origin: paths for origin, paths in _origin_path_counts(cone).items() if cone.attributes[origin]["count"] == 1
     }
 
 

@@ -14,7 +14,12 @@ from ptztrack.evaluate.registration import summarise_registration
 from ptztrack.geometry.registration import register
 
 # Small enough to build in seconds, large enough to register most views (13 references at 480 x 360).
-SMALL_REGISTRATION = {"image_size_px": (480, 360), "reference_zooms": (1.0, 2.0), "reference_pan_steps": 3, "reference_tilt_steps": 2}
+SMALL_REGISTRATION = {
+    "image_size_px": (480, 360),
+    "reference_zooms": (1.0, 2.0),
+    "reference_pan_steps": 3,
+    "reference_tilt_steps": 2,
+}
 
 
 def test_a_perfect_camera_lands_exactly_where_it_is_sent():
@@ -24,7 +29,9 @@ def test_a_perfect_camera_lands_exactly_where_it_is_sent():
 
 
 def test_bias_and_noise_of_the_landing_pose_have_the_configured_size():
-    error = pose_feedback.LandingError(pan_tilt_sigma_deg=2.0, pan_tilt_bias_deg=(1.0, -0.5), zoom_sigma=0.03, zoom_bias=1.1)
+    error = pose_feedback.LandingError(
+        pan_tilt_sigma_deg=2.0, pan_tilt_bias_deg=(1.0, -0.5), zoom_sigma=0.03, zoom_bias=1.1
+    )
     rng = np.random.default_rng(1)
     commanded = np.array([10.0, 20.0, 2.0])
     landed = np.array([pose_feedback.landed_pose(commanded, error, rng) for _ in range(20000)])
@@ -114,12 +121,15 @@ def test_a_view_of_nothing_is_not_registered(small_registration):
     assert register(virtual.camera, index, np.zeros((360, 480, 3), dtype=np.uint8)) is None
 
 
+@pytest.mark.slow
 def test_the_tracker_uses_the_commanded_the_true_or_the_registered_pose(small_registration):
     scenario, _ = small_registration
     scenario = scenario.model_copy(
         update={
             "frames": 12,
-            "camera": scenario.camera.model_copy(update={"pose_error": PoseError(pan_tilt_sigma_deg=2.0, zoom_sigma=0.02)}),
+            "camera": scenario.camera.model_copy(
+                update={"pose_error": PoseError(pan_tilt_sigma_deg=2.0, zoom_sigma=0.02)}
+            ),
         }
     )
     episodes = {}

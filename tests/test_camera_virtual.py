@@ -47,7 +47,9 @@ def test_ignoring_the_distortion_would_misplace_the_corners_of_the_wide_view():
     ground_m = apply_homography(image_to_ground(VIRTUAL.camera, CENTRE_POSE), corner_px)
     points_mm = np.c_[ground_m * MM_PER_M, np.zeros(2)]
     without_distortion = type(RECORDING)(RECORDING.K, np.zeros(5), RECORDING.R, RECORDING.t)
-    shift_px = np.linalg.norm(project_pinhole(without_distortion, points_mm) - project_pinhole(RECORDING, points_mm), axis=1)
+    shift_px = np.linalg.norm(
+        project_pinhole(without_distortion, points_mm) - project_pinhole(RECORDING, points_mm), axis=1
+    )
     assert np.all(shift_px > 5.0)
     sampled = np.stack([map_u[100, [3, 156]], map_v[100, [3, 156]]], -1) + 0.5
     np.testing.assert_allclose(sampled, project_pinhole(RECORDING, points_mm), atol=1e-3)
@@ -62,5 +64,7 @@ def test_rendered_views_show_the_recording():
     assert np.mean(zoomed.sum(axis=-1) == 0) == 0.0
     # the zoomed view's centre shows the recorded image's centre, three times larger
     centre = frame[288 - 6 : 288 + 6, 384 - 8 : 384 + 8].astype(float).mean(axis=(0, 1))
-    zoomed_centre = zoomed[60 - 6 * 3 // 5 : 60 + 6 * 3 // 5, 80 - 8 * 3 // 5 : 80 + 8 * 3 // 5].astype(float).mean(axis=(0, 1))
+    zoomed_centre = (
+        zoomed[60 - 6 * 3 // 5 : 60 + 6 * 3 // 5, 80 - 8 * 3 // 5 : 80 + 8 * 3 // 5].astype(float).mean(axis=(0, 1))
+    )
     assert np.max(np.abs(centre - zoomed_centre)) < 25

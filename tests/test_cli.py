@@ -100,7 +100,14 @@ def test_a_bad_recording_file_exits_2_naming_the_file_and_the_problem(tmp_path, 
 def test_msg_experiment_prints_the_table_and_writes_rows_plot_and_trails(tmp_path, capsys):
     paths = {name: tmp_path / name for name in ("rows.json", "figure7.png", "trails.png")}
     arguments = ["experiment", "msg", "--runs", "3", "--executor", "serial"]
-    arguments += ["--json", str(paths["rows.json"]), "--plot", str(paths["figure7.png"]), "--trails", str(paths["trails.png"])]
+    arguments += [
+        "--json",
+        str(paths["rows.json"]),
+        "--plot",
+        str(paths["figure7.png"]),
+        "--trails",
+        str(paths["trails.png"]),
+    ]
     assert main(arguments) == 0
     assert "N_j/s" in capsys.readouterr().out
     rows = json.loads(paths["rows.json"].read_text())

@@ -38,6 +38,8 @@ def detector_model(kind="realistic"):
 
 def policy_for(name, scenario):
     return make_policy(name, scenario, build_world(scenario, np.random.default_rng(0)))
+
+
 CAMERA, GRID = ptz_camera(SCENARIO), action_grid(SCENARIO)
 V = 4.0 * np.eye(2)
 HEIGHT_M = 1.75
@@ -206,7 +208,10 @@ def test_one_reference_view_gives_the_detectors_occlusion_on_average():
     reference = project_people(CAMERA, look_at(CAMERA, [7.5, 7.5], 1.0), ground_m, HEIGHT_M, 0.5)
     at_reference = occluded_fraction(reference.box_px, reference.range_m, reference.in_front)
     centred = np.stack(
-        [occlusion_in_centred_views(CAMERA, g, np.full(7, HEIGHT_M), np.full(7, 0.5), np.ones(7, bool)) for g in ground_m]
+        [
+            occlusion_in_centred_views(CAMERA, g, np.full(7, HEIGHT_M), np.full(7, 0.5), np.ones(7, bool))
+            for g in ground_m
+        ]
     )
     assert np.mean(np.abs(at_reference - centred)) < 0.01
     assert np.mean(at_reference) == pytest.approx(np.mean(centred), rel=0.15)
@@ -228,7 +233,9 @@ def test_patrolling_term_grows_while_unobserved_and_clears_where_the_camera_look
     policy = policy_for("intg", scenario)
     exploration = policy.exploration
     wide = int(np.argmax(exploration.detection_probability.sum(axis=1)))
-    elsewhere = int(np.argmin(exploration.detection_probability[:, exploration.detection_probability[wide] > 0.5].sum(axis=1)))
+    elsewhere = int(
+        np.argmin(exploration.detection_probability[:, exploration.detection_probability[wide] > 0.5].sum(axis=1))
+    )
     before = exploration.information_nats(np.array([wide]))[0]
     for _ in range(10):
         exploration.advance(elsewhere)

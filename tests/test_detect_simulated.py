@@ -10,7 +10,14 @@ from ptztrack.build.world import ptz_camera
 from ptztrack.config import Scenario
 from ptztrack.detect.simulated import RecallDetector, RecallModel, detection_probability
 from ptztrack.geometry.occlusion import occluded_fraction, occlusion_in_centred_views
-from ptztrack.geometry.ptz import apply_homography, image_to_ground, inside_image, look_at, person_in_view, project_people
+from ptztrack.geometry.ptz import (
+    apply_homography,
+    image_to_ground,
+    inside_image,
+    look_at,
+    person_in_view,
+    project_people,
+)
 from ptztrack.types import PeopleInView
 
 CAMERA = ptz_camera(Scenario())
@@ -259,9 +266,13 @@ def test_unoccluded_person_in_middle_has_recall_probability():
     p = detection_probability(in_view(people, np.ones(2, dtype=bool)), REALISTIC.recall)
     np.testing.assert_allclose(p, REALISTIC.recall(people.height_px), rtol=1e-14)
     assert 0.4 < p[0] < 0.6
-    np.testing.assert_array_equal(detection_probability(in_view(people, np.ones(2, dtype=bool)), IDEAL.recall), [1.0, 1.0])
+    np.testing.assert_array_equal(
+        detection_probability(in_view(people, np.ones(2, dtype=bool)), IDEAL.recall), [1.0, 1.0]
+    )
     # a person who is not present is never detected and does not count
-    np.testing.assert_array_equal(detection_probability(in_view(people, np.array([False, True])), IDEAL.recall), [0.0, 1.0])
+    np.testing.assert_array_equal(
+        detection_probability(in_view(people, np.array([False, True])), IDEAL.recall), [0.0, 1.0]
+    )
 
 
 def test_person_behind_another_is_reduced_by_visible_fraction():
@@ -431,7 +442,7 @@ def test_false_positives():
     mixed = [detect(people, present, ideal, rng) for _ in range(50)]
     for frame in mixed:
         true = frame.person_index >= 0
-        assert np.all(true[: true.sum()]) and not np.any(true[true.sum():])
+        assert np.all(true[: true.sum()]) and not np.any(true[true.sum() :])
         assert np.all(np.isfinite(frame.height_px[true])) and np.all(np.isnan(frame.height_px[~true]))
         np.testing.assert_array_equal(frame.person_index[true], [0, 3])
 
@@ -446,6 +457,7 @@ def test_same_seed_gives_identical_detections():
         np.testing.assert_array_equal(frame.feet_px, again.feet_px)
         np.testing.assert_array_equal(frame.height_px, again.height_px)
         np.testing.assert_array_equal(frame.person_index, again.person_index)
+
     # a stream of draws is reproducible too, and different seeds differ
     def stream(seed):
         rng = np.random.default_rng(seed)
@@ -461,7 +473,9 @@ def test_occlusion_in_centred_views_matches_the_view_on_the_scene():
     centred = occlusion_in_centred_views(CAMERA, xy, heights, np.full(4, 0.5), ALL)
     np.testing.assert_allclose(centred, hidden_of(scene(), ALL), atol=0.05)
     assert centred[2] == pytest.approx(1.0) and centred[0] == 0.0 and centred[3] == 0.0
-    nobody_in_front = occlusion_in_centred_views(CAMERA, xy, heights, np.full(4, 0.5), np.array([False, True, True, True]))
+    nobody_in_front = occlusion_in_centred_views(
+        CAMERA, xy, heights, np.full(4, 0.5), np.array([False, True, True, True])
+    )
     assert nobody_in_front[2] == 0.0
 
 

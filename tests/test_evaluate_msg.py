@@ -5,7 +5,6 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from ptztrack.track import msg
 from ptztrack.evaluate.executors import run_cells
 from ptztrack.evaluate.msg import (
     EXPERIMENT_SCENE,
@@ -15,8 +14,9 @@ from ptztrack.evaluate.msg import (
     run_msg_cell,
     summarise_by_ambiguity,
 )
-from ptztrack.scene.roads import walk_roads
 from ptztrack.scene.road_tracklets import TrackletOracle, TrackletOracleConfig
+from ptztrack.scene.roads import walk_roads
+from ptztrack.track import msg
 
 SPACING_M = 10.0
 
@@ -102,6 +102,7 @@ def test_a_run_is_reproducible_and_every_scheduler_captures_faces():
         run_msg(scene, "greedy")
 
 
+@pytest.mark.slow
 def test_the_paper_scheduler_labels_more_than_the_naive_one_and_untangling_helps():
     rows = [row for rows in run_cells(msg_cells(16), run_msg_cell, "serial") for row in rows]
     mean_m = {
@@ -114,6 +115,7 @@ def test_the_paper_scheduler_labels_more_than_the_naive_one_and_untangling_helps
     assert sum(row["runs"] for row in summary) == len(rows)
 
 
+@pytest.mark.slow
 def test_local_processes_and_serial_give_the_same_rows():
     cells = msg_cells(4)
     assert run_cells(cells, run_msg_cell, "local", workers=2) == run_cells(cells, run_msg_cell, "serial")

@@ -4,9 +4,9 @@ import cv2
 import numpy as np
 import pytest
 
+from ptztrack.build.episode import episode_world, run_episode
 from ptztrack.cli import main
 from ptztrack.config import scenario_from_dict
-from ptztrack.build.episode import episode_world, run_episode
 from ptztrack.evaluate.report import RUN_FILES
 from ptztrack.evaluate.video import (
     FRAME_SIZE_PX,
@@ -19,7 +19,6 @@ from ptztrack.evaluate.video import (
     write_episode_video,
 )
 from ptztrack.geometry.ptz import PTZCamera
-
 from test_camera_recorded import EXCERPT, excerpt_scenario
 
 

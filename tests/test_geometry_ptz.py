@@ -292,9 +292,7 @@ def test_project_people_box(sample, height_m, width_m):
     # the box spans the rows of feet and head and is centred between them
     np.testing.assert_allclose(box[:, 1], np.minimum(people.feet_px[:, 1], people.head_px[:, 1]), rtol=1e-12)
     np.testing.assert_allclose(box[:, 3], np.maximum(people.feet_px[:, 1], people.head_px[:, 1]), rtol=1e-12)
-    np.testing.assert_allclose(
-        box[:, 0] + box[:, 2], people.feet_px[:, 0] + people.head_px[:, 0], rtol=1e-9, atol=1e-6
-    )
+    np.testing.assert_allclose(box[:, 0] + box[:, 2], people.feet_px[:, 0] + people.head_px[:, 0], rtol=1e-9, atol=1e-6)
     # People shorter than the camera's 7 m who stand ahead of it (not past the nadir) have
     # the head above the feet in the image.
     pan = np.deg2rad(pose[0])

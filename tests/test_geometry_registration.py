@@ -32,7 +32,9 @@ def test_the_printed_equation_3_is_wrong_and_ours_is_right():
     reference, live = (0.0, 20.0, 1.0), (12.0, 25.0, 2.5)
     H = centred_homography(reference, live)
     f_m = CAMERA.f_min_px
-    printed = (f_m**2 * (H[0, 0] ** 2 + H[0, 1] ** 2) + H[0, 2] ** 2) / (f_m**2 * (H[1, 0] ** 2 + H[1, 1] ** 2) + H[1, 1] ** 2)
+    printed = (f_m**2 * (H[0, 0] ** 2 + H[0, 1] ** 2) + H[0, 2] ** 2) / (
+        f_m**2 * (H[1, 0] ** 2 + H[1, 1] ** 2) + H[1, 1] ** 2
+    )
     assert abs(np.sqrt(printed) - 2.5 * f_m) > 0.05 * 2.5 * f_m
     assert registration.focal_from_homography(H, f_m) == pytest.approx(2.5 * f_m, rel=1e-12)
 
@@ -99,9 +101,7 @@ def test_the_ratio_test_compares_neighbours_within_one_reference_view():
         ]
     ).astype(np.float32)
     view = np.array([0, 1, 2, 2, 0, 0, 1, 1, 2, 2, 0])
-    index = registration.ReferenceIndex(
-        np.zeros((3, 3)), np.zeros((len(view), 2)), descriptors, view, (640, 480)
-    )
+    index = registration.ReferenceIndex(np.zeros((3, 3)), np.zeros((len(view), 2)), descriptors, view, (640, 480))
     # Each live feature lies as near to two reference features.
     live = np.vstack([point + 0.25, twin_a + 0.25]).astype(np.float32)
     pairs = {tuple(pair) for pair in registration.within_view_ratio_matches(index, live)}

@@ -1,7 +1,7 @@
 import numpy as np
 
-from ptztrack.config import scenario_from_dict
 from ptztrack.build.episode import run_episode
+from ptztrack.config import scenario_from_dict
 from ptztrack.evaluate.metrics import episode_metrics
 
 SEEDS = range(6)

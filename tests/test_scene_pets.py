@@ -87,7 +87,7 @@ def test_the_two_annotation_formats_hold_the_same_boxes():
     mot = load_mot_ground_truth(EXCERPT / "gt_mot15.txt")
     cvml = load_cvml(EXCERPT / "PETS2009-S2L1.xml")
     assert mot.frame.min() == 0 and mot.frame.max() == 29
-    assert set(zip(mot.frame, mot.person_id)) <= set(zip(cvml.frame, cvml.person_id))
+    assert set(zip(mot.frame, mot.person_id, strict=True)) <= set(zip(cvml.frame, cvml.person_id, strict=True))
     by_key = {(f, i): box for f, i, box in zip(cvml.frame, cvml.person_id, cvml.box_px, strict=True)}
     for frame, person, box in zip(mot.frame, mot.person_id, mot.box_px, strict=True):
         np.testing.assert_allclose(by_key[(frame, person)], box, atol=0.6)
@@ -136,7 +136,9 @@ def test_malformed_calibrations_are_named_with_the_problem(tmp_path):
     with pytest.raises(CalibrationError, match="<Geometry> has no attribute 'height'"):
         load_tsai(bad_xml)
     bad_json = tmp_path / "pinhole.json"
-    bad_json.write_text('{"View_001": {"K": [[1, 0], [0, 1]], "dist": [0, 0, 0, 0, 0], "R": [[1,0,0],[0,1,0],[0,0,1]], "t": [0, 0, 0]}}')
+    bad_json.write_text(
+        '{"View_001": {"K": [[1, 0], [0, 1]], "dist": [0, 0, 0, 0, 0], "R": [[1,0,0],[0,1,0],[0,0,1]], "t": [0, 0, 0]}}'
+    )
     with pytest.raises(CalibrationError, match=r"View_001.K has shape \(2, 2\), expected \(3, 3\)"):
         load_pinhole(bad_json)
     with pytest.raises(CalibrationError, match="no view 'View_009'"):

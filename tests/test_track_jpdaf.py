@@ -9,7 +9,6 @@ from scipy.stats import chi2, multivariate_normal
 from ptztrack.cli import build_scenario, main
 from ptztrack.config import ScenarioError, scenario_from_dict
 from ptztrack.track import jpdaf, kalman
-from ptztrack.types import Tracks
 from ptztrack.track.kalman import constant_velocity_model
 from ptztrack.track.tracker import (
     gated_innovations,
@@ -19,6 +18,7 @@ from ptztrack.track.tracker import (
     start_tracks,
     update_tracks,
 )
+from ptztrack.types import Tracks
 from test_track_tracker import (
     ACCELERATION_SIGMA_M_S2,
     CAMERA,
@@ -103,7 +103,9 @@ def test_with_c_0_the_tracker_step_equals_the_hungarian_one_for_a_lone_person():
     for name, config in (("hungarian", hungarian), ("cjpdaf", replace(CJPDAF, clutter_density_per_px2=0))):
         state = Tracks.empty()
         for step in range(8):
-            state = update_tracks(predict_tracks(state, F, U), feet_px([[5.0 + 0.2 * step, 6.0]]), CAMERA, POSE, V, config).tracks
+            state = update_tracks(
+                predict_tracks(state, F, U), feet_px([[5.0 + 0.2 * step, 6.0]]), CAMERA, POSE, V, config
+            ).tracks
         tracks[name] = state
     np.testing.assert_array_equal(tracks["cjpdaf"].ids, tracks["hungarian"].ids)
     np.testing.assert_array_equal(tracks["cjpdaf"].hits, tracks["hungarian"].hits)
@@ -151,7 +153,9 @@ def mixture_moments(mean, covariance, innovation, beta, beta_0, C):
     """Mean and covariance of the mixture {prediction: beta_0, Kalman update with measurement i: beta_i}, by a loop."""
     K = covariance @ C.T @ np.linalg.inv(C @ covariance @ C.T + V)
     posterior = (np.eye(4) - K @ C) @ covariance
-    components = [(beta_0, mean, covariance)] + [(b, mean + K @ nu, posterior) for b, nu in zip(beta, innovation)]
+    components = [(beta_0, mean, covariance)] + [
+        (b, mean + K @ nu, posterior) for b, nu in zip(beta, innovation, strict=True)
+    ]
     total = sum(weight for weight, _, _ in components)
     centre = sum(weight * m for weight, m, _ in components) / total
     spread = sum(weight * (P + np.outer(m - centre, m - centre)) for weight, m, P in components) / total
@@ -209,9 +213,13 @@ def test_the_pda_covariance_is_the_mixture_covariance_grows_with_a_second_measur
 def test_a_lone_measurement_in_two_gates_keeps_only_the_likelier_track_alive_and_starts_none():
     F, U = constant_velocity_model(0.2, ACCELERATION_SIGMA_M_S2)
     config = replace(CJPDAF, clutter_density_per_px2=1e-6)
-    tracks = start_tracks(feet_px([[7.0, 6.0], [7.3, 6.0]]), CAMERA, POSE, V, config.initial_speed_sigma_m_s, first_id=0)
+    tracks = start_tracks(
+        feet_px([[7.0, 6.0], [7.3, 6.0]]), CAMERA, POSE, V, config.initial_speed_sigma_m_s, first_id=0
+    )
     # One measurement near both tracks, nearer track 0; another far from both.
-    updated = update_tracks(predict_tracks(tracks, F, U), feet_px([[7.1, 6.0], [12.0, 9.0]]), CAMERA, POSE, V, config).tracks
+    updated = update_tracks(
+        predict_tracks(tracks, F, U), feet_px([[7.1, 6.0], [12.0, 9.0]]), CAMERA, POSE, V, config
+    ).tracks
     np.testing.assert_array_equal(updated.ids, [0, 1, 2])
     np.testing.assert_array_equal(updated.missed_steps, [0, 1, 0])
     np.testing.assert_array_equal(updated.hits, [2, 1, 1])
@@ -222,8 +230,12 @@ def test_a_lone_measurement_in_two_gates_keeps_only_the_likelier_track_alive_and
 
 def test_two_people_each_detected_keep_both_tracks_alive_even_inside_each_others_gates():
     F, U = constant_velocity_model(0.2, ACCELERATION_SIGMA_M_S2)
-    tracks = start_tracks(feet_px([[7.0, 6.0], [7.3, 6.0]]), CAMERA, POSE, V, CJPDAF.initial_speed_sigma_m_s, first_id=0)
-    updated = update_tracks(predict_tracks(tracks, F, U), feet_px([[7.0, 6.0], [7.3, 6.0]]), CAMERA, POSE, V, CJPDAF).tracks
+    tracks = start_tracks(
+        feet_px([[7.0, 6.0], [7.3, 6.0]]), CAMERA, POSE, V, CJPDAF.initial_speed_sigma_m_s, first_id=0
+    )
+    updated = update_tracks(
+        predict_tracks(tracks, F, U), feet_px([[7.0, 6.0], [7.3, 6.0]]), CAMERA, POSE, V, CJPDAF
+    ).tracks
     np.testing.assert_array_equal(updated.ids, [0, 1])
     np.testing.assert_array_equal(updated.missed_steps, [0, 0])
     np.testing.assert_array_equal(updated.hits, [2, 2])
@@ -231,7 +243,9 @@ def test_two_people_each_detected_keep_both_tracks_alive_even_inside_each_others
 
 def test_a_measurement_only_in_the_gate_of_a_track_that_dies_starts_a_new_one():
     F, U = constant_velocity_model(0.2, ACCELERATION_SIGMA_M_S2)
-    tracks = predict_tracks(start_tracks(feet_px([[7.5, 6.0]]), CAMERA, POSE, V, CJPDAF.initial_speed_sigma_m_s, first_id=0), F, U)
+    tracks = predict_tracks(
+        start_tracks(feet_px([[7.5, 6.0]]), CAMERA, POSE, V, CJPDAF.initial_speed_sigma_m_s, first_id=0), F, U
+    )
     feet = feet_px([[7.7, 6.1]])
     _, distance2, allowed, S, _ = step_inputs(tracks.mean, tracks.covariance, feet)
     p = jpdaf.likelihoods(distance2, S, allowed)[0, 0]

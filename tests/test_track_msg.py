@@ -4,11 +4,24 @@ import networkx as nx
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from ptztrack.track import msg
 from msg_traversal import traversal_data
+from ptztrack.track import msg
 
 # Weighted so that labels often come after joins and splits: untangling through compound vertices.
-OPERATIONS = ("enter", "enter", "extend", "join", "join", "split", "split", "blind_gap", "exit", "label", "label", "label")
+OPERATIONS = (
+    "enter",
+    "enter",
+    "extend",
+    "join",
+    "join",
+    "split",
+    "split",
+    "blind_gap",
+    "exit",
+    "label",
+    "label",
+    "label",
+)
 
 
 def total_length(graph):
@@ -27,7 +40,7 @@ class Scene:
 
     def start(self, events):
         created = msg.add_tracklets(self.graph, events, self.step)
-        for (targets, parents), v in zip(events, created):
+        for (targets, parents), v in zip(events, created, strict=True):
             for p in parents:
                 self.active.pop(p, None)
             self.active[v] = frozenset(targets)

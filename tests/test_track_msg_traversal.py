@@ -74,7 +74,7 @@ def brute_force_data(graph, vertex):
     off_chain_length = 0.0
     for path in from_labeled:
         on_chain = True
-        for predecessor, x in zip(path, path[1:]):
+        for predecessor, x in zip(path, path[1:], strict=False):
             on_chain = on_chain and len(graph.succ[predecessor]) == 1
             off_chain_length += 0.0 if on_chain else graph.nodes[x]["length"]
 

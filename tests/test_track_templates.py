@@ -1,8 +1,8 @@
 import numpy as np
 import pytest
 
-from ptztrack.camera.virtual import virtual_ptz
 from ptztrack.build.episode import run_episode
+from ptztrack.camera.virtual import virtual_ptz
 from ptztrack.config import pets_scenario
 from ptztrack.evaluate.metrics import episode_metrics
 from ptztrack.geometry.calibration import load_calibration
@@ -201,8 +201,11 @@ def test_pets_people_are_found_two_frames_later_near_their_annotated_feet(pets_v
     assert np.all(found.similarity > 0.8)
 
 
+@pytest.mark.slow
 def test_between_detector_steps_the_closed_loop_measures_people_by_their_templates():
-    scenario = pets_scenario("ideal", frames=40, tracker={"measurement_source": "spatiogram", "detector_every_steps": 5})
+    scenario = pets_scenario(
+        "ideal", frames=40, tracker={"measurement_source": "spatiogram", "detector_every_steps": 5}
+    )
     episode = run_episode(scenario, "fix", 0)
     between = [detections for step, detections in enumerate(episode.detections) if step % 5]
     # The ideal detector names the person it saw; template matches know only their track.

@@ -3,7 +3,6 @@ import pytest
 
 from ptztrack.build.factories import tracker_parameters
 from ptztrack.config import Tracker, scenario_from_dict
-from ptztrack.types import Tracks
 from ptztrack.geometry.ptz import PTZCamera, apply_homography, feet_jacobian, ground_to_image, look_at
 from ptztrack.track import kalman
 from ptztrack.track.kalman import constant_velocity_model
@@ -15,6 +14,7 @@ from ptztrack.track.tracker import (
     update_own_tracks,
     update_tracks,
 )
+from ptztrack.types import Tracks
 
 CAMERA = PTZCamera((7.5, -4.0, 7.0), 640, 480, 400.0)
 POSE = look_at(CAMERA, [7.5, 6.0], 1.0)
@@ -54,7 +54,9 @@ def test_a_new_track_starts_at_the_ground_point_with_the_pixel_noise_carried_to_
 
 def test_pixels_above_the_horizon_start_no_track():
     pose = np.array([0.0, 5.0, 1.0])
-    tracks = start_tracks(np.array([[320.0, 10.0], [320.0, 400.0]]), CAMERA, pose, V, CONFIG.initial_speed_sigma_m_s, first_id=0)
+    tracks = start_tracks(
+        np.array([[320.0, 10.0], [320.0, 400.0]]), CAMERA, pose, V, CONFIG.initial_speed_sigma_m_s, first_id=0
+    )
     assert len(tracks) == 1
 
 
@@ -79,7 +81,9 @@ def test_tracks_follow_walkers_and_keep_their_ids():
 
 def test_hungarian_assignment_ignores_detection_order_and_gates_outliers():
     F, U = constant_velocity_model(0.2, ACCELERATION_SIGMA_M_S2)
-    tracks = start_tracks(feet_px([[5.0, 5.0], [9.0, 7.0]]), CAMERA, POSE, V, CONFIG.initial_speed_sigma_m_s, first_id=0)
+    tracks = start_tracks(
+        feet_px([[5.0, 5.0], [9.0, 7.0]]), CAMERA, POSE, V, CONFIG.initial_speed_sigma_m_s, first_id=0
+    )
     detections = feet_px([[9.0, 7.0], [14.0, 1.0], [5.0, 5.0]])
     updated = update_tracks(predict_tracks(tracks, F, U), detections, CAMERA, POSE, V, CONFIG).tracks
     np.testing.assert_array_equal(updated.ids, [0, 1, 2])
@@ -132,7 +136,9 @@ def test_with_confirmation_a_one_off_detection_is_never_reported_and_dies_at_its
 
 
 def test_a_track_measured_by_its_own_template_is_updated_without_becoming_more_or_less_alive():
-    tracks = start_tracks(feet_px(np.array([[7.0, 6.0], [9.0, 7.0]])), CAMERA, POSE, V, CONFIG.initial_speed_sigma_m_s, 0)
+    tracks = start_tracks(
+        feet_px(np.array([[7.0, 6.0], [9.0, 7.0]])), CAMERA, POSE, V, CONFIG.initial_speed_sigma_m_s, 0
+    )
     tracks = update_tracks(tracks, feet_px(np.array([[7.0, 6.0]])), CAMERA, POSE, V, CONFIG).tracks  # track 1 missed
     moved = feet_px(np.array([[9.1, 7.0]]))
     updated = update_own_tracks(tracks, [1], moved, CAMERA, POSE, V, CONFIG.max_position_sigma_m)

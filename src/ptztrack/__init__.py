@@ -1,7 +1,8 @@
 """ptztrack: multi-person tracking with cameras that move.
 
 The public API is flat: ``from ptztrack import run_episode, scenario_from_dict``.
-Names are imported on first use, so ``import ptztrack`` stays cheap.
+Names are imported on first use (from the modules named relative to this package), so
+``import ptztrack`` stays cheap.
 
 Roles (protocols a new implementation follows): ``CameraBackend``, ``Detector``,
 ``Tracker``, ``Policy``; the data they exchange: ``Detections``,
@@ -21,71 +22,71 @@ except PackageNotFoundError:  # a source tree that was not installed
 
 _HOME = {
     # configuration
-    "Scenario": "ptztrack.config",
-    "ScenarioError": "ptztrack.config",
-    "load_scenario": "ptztrack.config",
-    "scenario_from_dict": "ptztrack.config",
-    "pets_scenario": "ptztrack.config",
+    "Scenario": ".config",
+    "ScenarioError": ".config",
+    "load_scenario": ".config",
+    "scenario_from_dict": ".config",
+    "pets_scenario": ".config",
     # the roles and their data
-    "CameraBackend": "ptztrack.roles",
-    "Detector": "ptztrack.roles",
-    "Tracker": "ptztrack.roles",
-    "Policy": "ptztrack.roles",
-    "DecisionContext": "ptztrack.types",
-    "Detections": "ptztrack.types",
-    "GroundTruth": "ptztrack.types",
-    "PeopleInView": "ptztrack.types",
-    "Tracks": "ptztrack.types",
-    "TrackUpdate": "ptztrack.types",
+    "CameraBackend": ".roles",
+    "Detector": ".roles",
+    "Tracker": ".roles",
+    "Policy": ".roles",
+    "DecisionContext": ".types",
+    "Detections": ".types",
+    "GroundTruth": ".types",
+    "PeopleInView": ".types",
+    "Tracks": ".types",
+    "TrackUpdate": ".types",
     # models
-    "PTZCamera": "ptztrack.geometry.ptz",
-    "ActionGrid": "ptztrack.camera.actions",
+    "PTZCamera": ".geometry.ptz",
+    "ActionGrid": ".camera.actions",
     # running
-    "World": "ptztrack.loop",
-    "Episode": "ptztrack.loop",
-    "run_loop": "ptztrack.loop",
-    "BuiltScene": "ptztrack.build.world",
-    "build_world": "ptztrack.build.world",
-    "episode_world": "ptztrack.build.episode",
-    "run_episode": "ptztrack.build.episode",
-    "Cell": "ptztrack.build.experiments",
-    "synthetic_cells": "ptztrack.build.experiments",
-    "recording_cells": "ptztrack.build.experiments",
-    "run_cell": "ptztrack.build.experiments",
-    "run_cells": "ptztrack.evaluate.executors",
-    "summarise": "ptztrack.evaluate.tables",
-    "format_table": "ptztrack.evaluate.tables",
-    "episode_metrics": "ptztrack.evaluate.metrics",
-    "write_outputs": "ptztrack.evaluate.report",
+    "World": ".loop",
+    "Episode": ".loop",
+    "run_loop": ".loop",
+    "BuiltScene": ".build.world",
+    "build_world": ".build.world",
+    "episode_world": ".build.episode",
+    "run_episode": ".build.episode",
+    "Cell": ".build.experiments",
+    "synthetic_cells": ".build.experiments",
+    "recording_cells": ".build.experiments",
+    "run_cell": ".build.experiments",
+    "run_cells": ".evaluate.executors",
+    "summarise": ".evaluate.tables",
+    "format_table": ".evaluate.tables",
+    "episode_metrics": ".evaluate.metrics",
+    "write_outputs": ".evaluate.report",
 }
-_RENAMED = {"register": ("ptztrack.registry", "register"), "registered_names": ("ptztrack.registry", "names")}
+_RENAMED = {"register": (".registry", "register"), "registered_names": (".registry", "names")}
 
 __all__ = ["__version__", *_HOME, *_RENAMED]
 
 if TYPE_CHECKING:
-    from ptztrack.build.episode import episode_world, run_episode
-    from ptztrack.build.experiments import Cell, recording_cells, run_cell, synthetic_cells
-    from ptztrack.build.world import BuiltScene, build_world
-    from ptztrack.camera.actions import ActionGrid
-    from ptztrack.config import Scenario, ScenarioError, load_scenario, pets_scenario, scenario_from_dict
-    from ptztrack.evaluate.executors import run_cells
-    from ptztrack.evaluate.metrics import episode_metrics
-    from ptztrack.evaluate.report import write_outputs
-    from ptztrack.evaluate.tables import format_table, summarise
-    from ptztrack.geometry.ptz import PTZCamera
-    from ptztrack.loop import Episode, World, run_loop
-    from ptztrack.registry import names as registered_names
-    from ptztrack.registry import register
-    from ptztrack.roles import CameraBackend, Detector, Policy, Tracker
-    from ptztrack.types import DecisionContext, Detections, GroundTruth, PeopleInView, Tracks, TrackUpdate
+    from .build.episode import episode_world, run_episode
+    from .build.experiments import Cell, recording_cells, run_cell, synthetic_cells
+    from .build.world import BuiltScene, build_world
+    from .camera.actions import ActionGrid
+    from .config import Scenario, ScenarioError, load_scenario, pets_scenario, scenario_from_dict
+    from .evaluate.executors import run_cells
+    from .evaluate.metrics import episode_metrics
+    from .evaluate.report import write_outputs
+    from .evaluate.tables import format_table, summarise
+    from .geometry.ptz import PTZCamera
+    from .loop import Episode, World, run_loop
+    from .registry import names as registered_names
+    from .registry import register
+    from .roles import CameraBackend, Detector, Policy, Tracker
+    from .types import DecisionContext, Detections, GroundTruth, PeopleInView, Tracks, TrackUpdate
 
 
 def __getattr__(name: str):
     if name in _HOME:
-        return getattr(import_module(_HOME[name]), name)
+        return getattr(import_module(_HOME[name], __name__), name)
     if name in _RENAMED:
         module, attribute = _RENAMED[name]
-        return getattr(import_module(module), attribute)
+        return getattr(import_module(module, __name__), attribute)
     raise AttributeError(f"module 'ptztrack' has no attribute {name!r}")
 
 

@@ -62,7 +62,9 @@ def build_scenario(
     association : 'hungarian' or 'cjpdaf', replacing ``tracker.association``.
     measurement_source : 'detector' or 'spatiogram', replacing ``tracker.measurement_source``.
     """
-    overrides = {f"recording.{key}": str(path) for key, path in (recording_paths or {}).items() if path is not None}
+    overrides: dict[str, object] = {
+        f"recording.{key}": str(path) for key, path in (recording_paths or {}).items() if path is not None
+    }
     if association is not None:
         overrides["tracker.association"] = association
     if measurement_source is not None:
@@ -74,7 +76,7 @@ def build_scenario(
     if name_or_path == "synthetic":
         return scenario_from_dict({}, "synthetic", **overrides)
     if name_or_path == "pets":
-        return pets_scenario(overrides.pop("detector.kind", "ideal"), **overrides)
+        return pets_scenario(str(overrides.pop("detector.kind", "ideal")), **overrides)
     return load_scenario(name_or_path, **overrides)
 
 
@@ -233,7 +235,9 @@ def parser() -> argparse.ArgumentParser:
     commands = root.add_subparsers(dest="command", required=True)
     policies, detectors = registry.names("policies"), registry.names("detectors")
     run = commands.add_parser("run", help="run one closed-loop episode and print its metrics")
-    run.add_argument("--scenario", default="synthetic", help="'synthetic' or 'pets' (built in), or a scenario YAML file")
+    run.add_argument(
+        "--scenario", default="synthetic", help="'synthetic' or 'pets' (built in), or a scenario YAML file"
+    )
     run.add_argument("--policy", choices=policies, default="smpl")
     run.add_argument("--detector", choices=detectors, help="overrides the scenario's detector")
     run.add_argument("--seed", type=_non_negative_int, default=0)
@@ -258,7 +262,12 @@ def parser() -> argparse.ArgumentParser:
 
     pets = experiments.add_parser("pets", help="the PTZ paper's Tables 3-4 on PETS 2009 S2.L1")
     pets.add_argument("--detector", default="ideal", help="ideal (the annotations) or hog")
-    pets.add_argument("--beta", type=_non_negative_float, action="append", help="a weight of the patrolling term (repeatable; default 9 and 1)")
+    pets.add_argument(
+        "--beta",
+        type=_non_negative_float,
+        action="append",
+        help="a weight of the patrolling term (repeatable; default 9 and 1)",
+    )
     pets.add_argument("--strategies", nargs="+", choices=_strategies(policies), default=list(STRATEGIES))
     pets.add_argument("--frames", type=_positive_int, help="overrides the scenario's number of steps")
     _add_tracker_arguments(pets)
@@ -278,7 +287,9 @@ def parser() -> argparse.ArgumentParser:
     )
     registration.add_argument("--scenario", default="pets", help="'pets' (built in) or a recording scenario YAML file")
     registration.add_argument("--views", type=_positive_int, default=100, help="random live views to register")
-    registration.add_argument("--seed", type=_non_negative_int, default=0, help="draws the live views' poses and frames")
+    registration.add_argument(
+        "--seed", type=_non_negative_int, default=0, help="draws the live views' poses and frames"
+    )
     registration.add_argument(
         "--index", type=Path, help="reference index file: read if it exists, else built and written (default: built)"
     )
@@ -288,12 +299,17 @@ def parser() -> argparse.ArgumentParser:
         "--pose-sources", nargs="+", choices=POSE_SOURCES, default=list(POSE_SOURCES), help="closed-loop pose sources"
     )
     registration.add_argument(
-        "--pose-noise-deg", type=_non_negative_float, default=2.0, help="closed loop: pan and tilt landing error, 1 sigma"
+        "--pose-noise-deg",
+        type=_non_negative_float,
+        default=2.0,
+        help="closed loop: pan and tilt landing error, 1 sigma",
     )
     registration.add_argument(
         "--zoom-noise", type=_non_negative_float, default=0.02, help="closed loop: relative zoom landing error, 1 sigma"
     )
-    registration.add_argument("--frames", type=_positive_int, help="closed loop: overrides the scenario's number of steps")
+    registration.add_argument(
+        "--frames", type=_positive_int, help="closed loop: overrides the scenario's number of steps"
+    )
     _add_tracker_arguments(registration)
     _add_executor_arguments(registration, "the registration errors and the closed-loop rows")
     _add_recording_arguments(registration)

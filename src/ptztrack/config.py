@@ -257,6 +257,19 @@ class Scenario(_Strict):
         """[[x0, y0], [x1, y1]] of the synthetic area, whose corner is the origin."""
         return np.array([[0.0, 0.0], list(self.area_m)])
 
+    def required_recording(self, purpose: str) -> Recording:
+        """The scenario's recording; a :class:`ScenarioError` saying that ``purpose`` needs one if it has none."""
+        if self.recording is None:
+            raise ScenarioError(f"{purpose} needs a recording (recording)")
+        return self.recording
+
+    def required_video(self, purpose: str) -> str:
+        """The recording's video; a :class:`ScenarioError` saying that ``purpose`` needs one if it has none."""
+        video = self.required_recording(purpose).video
+        if video is None:
+            raise ScenarioError(f"{purpose} needs a recording with a video (recording.video)")
+        return video
+
 
 def _first_error_line(error: pydantic.ValidationError, source: str) -> str:
     first = error.errors()[0]

@@ -95,7 +95,7 @@ def run_loop(world: World, policy: Policy, tracker: Tracker, seed: int) -> Episo
     landing_rng = np.random.default_rng(landing_seed)
 
     action = world.start_action
-    per_step = {name: [] for name in PER_STEP}
+    per_step: dict[str, list] = {name: [] for name in PER_STEP}
     for step in range(steps):
         predicted = tracker.predict()
         context = DecisionContext(step, action, world.grid.reachable(action), predicted, policy_rng)

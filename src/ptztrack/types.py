@@ -8,7 +8,7 @@ pixel ``(i, j)`` at ``(i + 0.5, j + 0.5)``; ground coordinates are metres on
 the plane z = 0.
 """
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -26,11 +26,13 @@ class Detections:
     feet_px: np.ndarray
     height_px: np.ndarray
     person_index: np.ndarray
-    score: np.ndarray | None = None
+    score: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     def __post_init__(self):
-        if self.score is None:
+        if len(self.score) == 0 and len(self.feet_px) > 0:
             object.__setattr__(self, "score", np.full(len(self.feet_px), np.nan))
+        elif len(self.score) != len(self.feet_px):
+            raise ValueError(f"{len(self.score)} scores for {len(self.feet_px)} detections")
 
     def __len__(self) -> int:
         return len(self.feet_px)
@@ -103,7 +105,11 @@ class Tracks:
     @staticmethod
     def empty() -> "Tracks":
         return Tracks(
-            np.zeros(0, dtype=int), np.zeros((0, 4)), np.zeros((0, 4, 4)), np.zeros(0, dtype=int), np.zeros(0, dtype=int)
+            np.zeros(0, dtype=int),
+            np.zeros((0, 4)),
+            np.zeros((0, 4, 4)),
+            np.zeros(0, dtype=int),
+            np.zeros(0, dtype=int),
         )
 
     def select(self, keep) -> "Tracks":

@@ -64,8 +64,8 @@ def reference_poses(
     The tilt range is shrunk by 20 %: the extreme tilts of the action grid look mostly outside the
     recording, and their zoomed views are still matched against views a little inside.
     """
-    pan_deg = np.linspace(*pan_range_deg, pan_steps)
-    tilt_deg = 0.8 * np.linspace(*tilt_range_deg, tilt_steps)
+    pan_deg = np.linspace(pan_range_deg[0], pan_range_deg[1], pan_steps)
+    tilt_deg = 0.8 * np.linspace(tilt_range_deg[0], tilt_range_deg[1], tilt_steps)
     grid = np.array([[pan, tilt, zoom] for zoom in zooms for tilt in tilt_deg for pan in pan_deg])
     grid[:, :2] += np.asarray(whole_frame_pose)[:2]
     first = np.array([whole_frame_pose[0], whole_frame_pose[1], 1.0])

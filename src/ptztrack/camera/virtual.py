@@ -98,7 +98,12 @@ def virtual_ptz(
     """
     centre_m = -recording.R.T @ recording.t / MM_PER_M
     focal_px = 0.5 * (recording.K[0, 0] + recording.K[1, 1]) * image_size_px[0] / recorded_size_px[0]
-    camera = PTZCamera(tuple(float(x) for x in centre_m), int(image_size_px[0]), int(image_size_px[1]), float(focal_px))
+    camera = PTZCamera(
+        (float(centre_m[0]), float(centre_m[1]), float(centre_m[2])),
+        int(image_size_px[0]),
+        int(image_size_px[1]),
+        float(focal_px),
+    )
     image_centre_px = np.array([[recorded_size_px[0] / 2, recorded_size_px[1] / 2]], dtype=float)
     normalised = cv2.undistortPoints(image_centre_px.reshape(1, 1, 2), recording.K, recording.dist)[0, 0]
     forward = np.array([*normalised, 1.0]) @ recording.R

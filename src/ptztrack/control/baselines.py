@@ -79,7 +79,8 @@ def patrol_route(camera: PTZCamera, grid: ActionGrid, area_bounds_m, zoom_index:
     view at that zoom, so consecutive views touch; waypoints whose view does
     not meet the area are skipped. ``zoom_index`` defaults to the lower
     middle of the zoom range (2x of 1-4x: 8 waypoints on the default grid,
-    where 3x would need 19 and see each person about once in 50 steps). Returns the flat action indices in visiting order.
+    where 3x would need 19 and see each person about once in 50 steps).
+    Returns the flat action indices in visiting order.
     """
     zoom_index = (len(grid.zoom) - 1) // 2 if zoom_index is None else zoom_index
     focal_px = grid.zoom[zoom_index] * camera.f_min_px
@@ -88,11 +89,13 @@ def patrol_route(camera: PTZCamera, grid: ActionGrid, area_bounds_m, zoom_index:
     pan_stride = max(1, int(fov_pan_deg // np.min(np.diff(grid.pan_deg), initial=np.inf)))
     tilt_stride = max(1, int(fov_tilt_deg // np.min(np.diff(grid.tilt_deg), initial=np.inf)))
     pans = _spread_indices(len(grid.pan_deg), pan_stride)
-    route = []
-    for row, tilt in enumerate(_spread_indices(len(grid.tilt_deg), tilt_stride)):
-        for pan in pans if row % 2 == 0 else pans[::-1]:
-            route.append(grid.index(pan, tilt, zoom_index))
-    route = np.asarray(route)
+    route = np.asarray(
+        [
+            grid.index(pan, tilt, zoom_index)
+            for row, tilt in enumerate(_spread_indices(len(grid.tilt_deg), tilt_stride))
+            for pan in (pans if row % 2 == 0 else pans[::-1])
+        ]
+    )
     sees_area = area_coverage(camera, grid.poses[route], area_bounds_m) > 0
     return route[sees_area]
 

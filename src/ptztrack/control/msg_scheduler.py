@@ -29,8 +29,8 @@ from dataclasses import dataclass
 
 import networkx as nx
 
-from ptztrack.track.msg import refresh
 from ptztrack.scene.road_tracklets import TrackletOracle
+from ptztrack.track.msg import refresh
 
 # alpha's boost for a source and beta for a target expected to leave within this many zoom durations.
 SOURCE_WEIGHT = 2.0

@@ -43,7 +43,7 @@ class HogPeopleDetector:
 
     def __post_init__(self):
         self._hog = cv2.HOGDescriptor()
-        self._hog.setSVMDetector(cv2.HOGDescriptor_getDefaultPeopleDetector())
+        self._hog.setSVMDetector(cv2.HOGDescriptor.getDefaultPeopleDetector())
 
     def detect(self, camera: CameraBackend, step: int, pose, rng: np.random.Generator) -> Detections:
         """People in the camera's view at ``pose``: feet and heights from the boxes, SVM scores."""
@@ -57,14 +57,14 @@ class HogPeopleDetector:
     def boxes(self, image) -> tuple[np.ndarray, np.ndarray]:
         """People in a BGR image: boxes (K, 4) as (left, top, width, height) px and SVM scores (K,)."""
         enlarged = cv2.resize(image, None, fx=self.upsample, fy=self.upsample, interpolation=cv2.INTER_LINEAR)
-        boxes, scores = self._hog.detectMultiScale(
+        found, weights = self._hog.detectMultiScale(
             enlarged, hitThreshold=self.hit_threshold, winStride=(8, 8), padding=(8, 8), scale=1.05
         )
-        if len(boxes) == 0:
+        if len(found) == 0:
             return np.zeros((0, 4)), np.zeros(0)
-        scores = np.ravel(scores)
+        boxes, scores = np.asarray(found, dtype=float), np.ravel(weights).astype(float)
         keep = np.ravel(cv2.dnn.NMSBoxes(boxes.tolist(), scores.tolist(), self.hit_threshold, self.nms_iou))
-        return np.asarray(boxes, dtype=float)[keep] / self.upsample, scores[keep]
+        return boxes[keep] / self.upsample, scores[keep]
 
 
 def feet_and_height_px(boxes) -> tuple[np.ndarray, np.ndarray]:

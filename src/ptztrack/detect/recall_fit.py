@@ -57,6 +57,8 @@ def detection_trials(
     for step in steps:
         for pose in poses:
             people = camera.people(step, pose)
+            if people is None:
+                raise RuntimeError("fitting a recall curve needs a camera that knows who is in view (a simulation)")
             visible = people.in_view & (people.hidden <= max_hidden)
             if not visible.any():
                 continue

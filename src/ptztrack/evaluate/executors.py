@@ -5,10 +5,13 @@ the serial, the local-process and the Ray executors give identical rows, in
 cell order.
 """
 
+import logging
 import os
 import sys
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
+from contextlib import contextmanager
+
 EXECUTORS = ("local", "ray", "serial")
 
 
@@ -62,27 +65,43 @@ LOOPBACK_RAY_ENVIRONMENT = {
 }
 
 
+@contextmanager
+def _environment(values: dict[str, str]) -> Iterator[None]:
+    """The process environment with ``values`` set inside the block, and after it as it was before
+    (also undoing what the block itself set: ``ray.init`` sets variables of its own)."""
+    saved = dict(os.environ)
+    os.environ.update(values)
+    try:
+        yield
+    finally:
+        os.environ.clear()
+        os.environ.update(saved)
+
+
 def _run_on_ray(cells: Sequence, report: Callable[[int, int], None], run: Callable) -> list:
     """Run on the Ray cluster of ``RAY_ADDRESS`` or of an earlier ``ray.init()``; else start a local one.
 
     A local cluster is kept on the loopback interface only if Ray is first
-    imported here (Ray reads its network settings at import).
+    imported here: Ray reads its network settings when it is imported, and
+    the processes it starts inherit the environment. The environment is set
+    for the import and the start only, and restored after.
     """
     start_local_cluster = "ray" not in sys.modules and not os.environ.get("RAY_ADDRESS")
-    if start_local_cluster:
-        # Ray reads these when it is imported.
-        os.environ.update(LOOPBACK_RAY_ENVIRONMENT)
-    try:
-        import ray
-    except ImportError:
-        raise RuntimeError("the ray executor needs Ray: pip install 'ptztrack[ray]'") from None
-    if not ray.is_initialized():
-        if start_local_cluster:
-            ray.init(
-                _node_ip_address="127.0.0.1", include_dashboard=False, logging_level="ERROR", log_to_driver=False
-            )
-        else:
-            ray.init(log_to_driver=False)
+    with _environment(LOOPBACK_RAY_ENVIRONMENT if start_local_cluster else {}):
+        try:
+            import ray
+        except ImportError:
+            raise RuntimeError("the ray executor needs Ray: pip install 'ptztrack[ray]'") from None
+        if not ray.is_initialized():
+            if start_local_cluster:
+                ray.init(
+                    _node_ip_address="127.0.0.1",
+                    include_dashboard=False,
+                    logging_level=logging.ERROR,
+                    log_to_driver=False,
+                )
+            else:
+                ray.init(log_to_driver=False)
     remote_cell = ray.remote(run)
     pending = {remote_cell.remote(cell): index for index, cell in enumerate(cells)}
     rows: list = [None] * len(cells)

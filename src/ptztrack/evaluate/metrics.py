@@ -40,7 +40,16 @@ def clear_metrics(truth_positions_m, track_ids, track_positions_m, gate_m: float
         accumulator.update(present.tolist(), np.asarray(ids).tolist(), distance_m)
     summary = mm.metrics.create().compute(
         accumulator,
-        metrics=["mota", "motp", "idf1", "num_switches", "num_false_positives", "num_misses", "num_detections", "num_objects"],
+        metrics=[
+            "mota",
+            "motp",
+            "idf1",
+            "num_switches",
+            "num_false_positives",
+            "num_misses",
+            "num_detections",
+            "num_objects",
+        ],
         name="episode",
     )
     row = summary.loc["episode"]

@@ -43,10 +43,12 @@ class MsgRun:
 def run_msg(
     scene: RoadScene,
     scheduler: str,
-    config: TrackletOracleConfig = TrackletOracleConfig(),
+    config: TrackletOracleConfig | None = None,
     zoom_out_score: float = DEFAULT_ZOOM_OUT_SCORE,
 ) -> MsgRun:
-    """Run one scheduler ('msg', 'msg-no-untangling' or 'naive') over a scene."""
+    """Run one scheduler ('msg', 'msg-no-untangling' or 'naive') over a scene (``config``: the
+    oracle's, by default :class:`TrackletOracleConfig`'s defaults)."""
+    config = config or TrackletOracleConfig()
     if scheduler not in CHOOSERS:
         raise ValueError(f"unknown scheduler {scheduler!r}; expected one of {', '.join(CHOOSERS)}")
     choose = CHOOSERS[scheduler]
@@ -144,7 +146,8 @@ def msg_cells(runs: int, base: RoadSceneConfig = EXPERIMENT_SCENE) -> list[MsgCe
 
 
 def run_msg_cell(cell: MsgCell) -> list[dict]:
-    """One row per scheduler: ``scheduler``, ``nj_s``, ``m``, ``captures``, ``seed``, ``people``, ``join_probability``."""
+    """One row per scheduler: ``scheduler``, ``nj_s``, ``m``, ``captures``, ``seed``, ``people``,
+    ``join_probability``."""
     scene = walk_roads(cell.scene, np.random.default_rng(cell.seed))
     rows = []
     for scheduler in CHOOSERS:
@@ -204,7 +207,9 @@ def ambiguity_figure(rows: list[dict], bin_width: int = BIN_WIDTH) -> Figure:
     figure = Figure(figsize=(7, 4.5))
     axes = figure.add_subplot()
     summary = summarise_by_ambiguity(rows, bin_width)
-    for offset, scheduler in zip((-0.6, 0.0, 0.6), dict.fromkeys(row["scheduler"] for row in summary)):
+    schedulers = list(dict.fromkeys(row["scheduler"] for row in summary))
+    offsets = np.linspace(-0.6, 0.6, len(schedulers)) if len(schedulers) > 1 else [0.0]
+    for offset, scheduler in zip(offsets, schedulers, strict=True):
         mine = [row for row in summary if row["scheduler"] == scheduler]
         centres = np.array([row["nj_s"] for row in mine]) + offset
         axes.errorbar(

@@ -34,7 +34,7 @@ def registration_errors(
     """
     camera, views = virtual.camera, len(poses)
     rows = []
-    for number, (pose, frame) in enumerate(zip(poses, frames), start=1):
+    for number, (pose, frame) in enumerate(zip(poses, frames, strict=True), start=1):
         image = virtual.render(video.frame(int(frame)), pose)
         start = time.perf_counter()
         result = register(camera, index, image)
@@ -67,8 +67,8 @@ def summarise_registration(rows: Sequence[dict]) -> dict:
 
     A view that was not registered counts as an error larger than any, so it raises the percentiles
     rather than vanishing from them; percentiles are order statistics (no interpolation with such
-    views), None when they fall on such a view. A registered view that sees none of the walkable area has no ground error and is left
-    out of the ground error's statistics only.
+    views), None when they fall on such a view. A registered view that sees none of the walkable
+    area has no ground error and is left out of the ground error's statistics only.
     """
     registered = np.array([row["registered"] for row in rows])
     focal = np.array([row["focal_err_pct"] if row["registered"] else np.inf for row in rows], dtype=float)

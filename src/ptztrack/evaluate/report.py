@@ -129,7 +129,18 @@ def truth_mot(episode: Episode) -> bytes:
     """The truth in the MOTChallenge layout, one row per present person and step, ids from 0 by column."""
     positions_m = episode.truth.positions_m
     rows = (
-        [step + 1, person, -1, -1, -1, -1, 1, _exact(positions_m[step, person, 0]), _exact(positions_m[step, person, 1]), 0]
+        [
+            step + 1,
+            person,
+            -1,
+            -1,
+            -1,
+            -1,
+            1,
+            _exact(positions_m[step, person, 0]),
+            _exact(positions_m[step, person, 1]),
+            0,
+        ]
         for step, person in zip(*np.nonzero(episode.truth.present), strict=True)
     )
     return _csv((), rows)
@@ -162,22 +173,26 @@ def episode_figure(episode: Episode, title: str = "") -> Figure:
         axes.plot(*path.T, color="0.55", lw=3, alpha=0.6, solid_capstyle="round")
     colours = matplotlib.colormaps["tab20"]
     track_paths: dict[int, list] = {}
-    for frame, tracks in enumerate(episode.tracks):
+    for tracks in episode.tracks:
         for track_id, mean in zip(tracks.ids, tracks.mean, strict=True):
-            track_paths.setdefault(int(track_id), []).append((frame, *mean[:2]))
-    for track_id, rows in track_paths.items():
-        rows = np.asarray(rows)
-        axes.plot(rows[:, 1], rows[:, 2], ".-", ms=2, lw=1, color=colours(track_id % 20))
-        axes.annotate(str(track_id), rows[-1, 1:], fontsize=7, color=colours(track_id % 20))
+            track_paths.setdefault(int(track_id), []).append(mean[:2])
+    for track_id, points in track_paths.items():
+        path = np.asarray(points)
+        axes.plot(path[:, 0], path[:, 1], ".-", ms=2, lw=1, color=colours(track_id % 20))
+        axes.annotate(str(track_id), (path[-1, 0], path[-1, 1]), fontsize=7, color=colours(track_id % 20))
     axes.plot(*camera.centre_m[:2], "k^", ms=9)
-    axes.annotate("camera", camera.centre_m[:2], xytext=(6, -3), textcoords="offset points", fontsize=8)
+    axes.annotate(
+        "camera", (camera.centre_m[0], camera.centre_m[1]), xytext=(6, -3), textcoords="offset points", fontsize=8
+    )
     margin_m = 2.0
     axes.set_xlim(min(x0, camera.centre_m[0]) - margin_m, max(x1, camera.centre_m[0]) + margin_m)
     axes.set_ylim(min(y0, camera.centre_m[1]) - margin_m, max(y1, camera.centre_m[1]) + margin_m)
     axes.set_aspect("equal")
     axes.set_xlabel("x [m]")
     axes.set_ylabel("y [m]")
-    axes.set_title(title or "truth (grey), tracks (colour, id at the end), camera footprints (blue outlines, last one shaded)")
+    axes.set_title(
+        title or "truth (grey), tracks (colour, id at the end), camera footprints (blue outlines, last one shaded)"
+    )
     figure.tight_layout()
     return figure
 

@@ -157,7 +157,7 @@ def write_episode_video(path: str | Path, episode: Episode, render_view: RenderV
     handle, temporary = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".mp4")
     os.close(handle)
     try:
-        writer = cv2.VideoWriter(temporary, cv2.VideoWriter_fourcc(*"mp4v"), episode.truth.frame_rate_hz, FRAME_SIZE_PX)
+        writer = cv2.VideoWriter(temporary, cv2.VideoWriter.fourcc(*"mp4v"), episode.truth.frame_rate_hz, FRAME_SIZE_PX)
         try:
             if not writer.isOpened():
                 raise RuntimeError(f"{path}: OpenCV cannot write MPEG-4 video here")

@@ -92,7 +92,11 @@ def project_pinhole(calibration: PinholeCalibration, points_mm) -> np.ndarray:
     """World points (N, 3) mm to distorted image pixels (N, 2), with ``cv2.projectPoints``."""
     rotation_vector, _ = cv2.Rodrigues(calibration.R)
     pixels, _ = cv2.projectPoints(
-        np.asarray(points_mm, dtype=float).reshape(-1, 1, 3), rotation_vector, calibration.t, calibration.K, calibration.dist
+        np.asarray(points_mm, dtype=float).reshape(-1, 1, 3),
+        rotation_vector,
+        calibration.t,
+        calibration.K,
+        calibration.dist,
     )
     return pixels[:, 0, :]
 
@@ -115,7 +119,9 @@ def pinhole_from_tsai(calibration: TsaiCalibration) -> PinholeCalibration:
     )
     width, height = calibration.image_size_px
     corners_px = np.array([[0, 0], [width, 0], [0, height], [width, height]], dtype=float) - calibration.centre_px
-    corner_radius_d_mm = np.hypot(corners_px[:, 0] * calibration.dpx_mm / calibration.sx, corners_px[:, 1] * calibration.dy_mm)
+    corner_radius_d_mm = np.hypot(
+        corners_px[:, 0] * calibration.dpx_mm / calibration.sx, corners_px[:, 1] * calibration.dy_mm
+    )
     radius_d_mm = np.linspace(0.0, corner_radius_d_mm.max(), 200)[1:]
     radius_u_mm = radius_d_mm * (1 + calibration.kappa1 * radius_d_mm**2)
     normalised_radius = radius_u_mm / calibration.focal_mm

@@ -117,7 +117,7 @@ def sift_features(image_bgr: np.ndarray, features: int) -> tuple[np.ndarray, np.
     """
     gray = cv2.cvtColor(image_bgr, cv2.COLOR_BGR2GRAY)
     halved = cv2.resize(gray, None, fx=SIFT_IMAGE_SCALE, fy=SIFT_IMAGE_SCALE, interpolation=cv2.INTER_AREA)
-    detector = cv2.SIFT_create(nfeatures=features, contrastThreshold=SIFT_CONTRAST_THRESHOLD)
+    detector = cv2.SIFT.create(nfeatures=features, contrastThreshold=SIFT_CONTRAST_THRESHOLD)
     keypoints, descriptors = detector.detectAndCompute(halved, None)
     if descriptors is None:
         return np.zeros((0, 2)), np.zeros((0, 128), dtype=np.float32)
@@ -139,12 +139,17 @@ def rotation_homography(camera: PTZCamera, from_pose, to_pose) -> np.ndarray:
     from_pose, to_pose = np.asarray(from_pose, float), np.asarray(to_pose, float)
     R_a = rotation_world_to_camera(from_pose[..., 0], from_pose[..., 1])
     R_b = rotation_world_to_camera(to_pose[..., 0], to_pose[..., 1])
-    return intrinsics(camera, to_pose[..., 2]) @ R_b @ np.swapaxes(R_a, -1, -2) @ np.linalg.inv(
-        intrinsics(camera, from_pose[..., 2])
+    return (
+        intrinsics(camera, to_pose[..., 2])
+        @ R_b
+        @ np.swapaxes(R_a, -1, -2)
+        @ np.linalg.inv(intrinsics(camera, from_pose[..., 2]))
     )
 
 
-def bundle_adjust(camera: PTZCamera, initial_poses, matches: list[tuple[int, int, np.ndarray, np.ndarray]]) -> np.ndarray:
+def bundle_adjust(
+    camera: PTZCamera, initial_poses, matches: list[tuple[int, int, np.ndarray, np.ndarray]]
+) -> np.ndarray:
     """Refine the poses of views that share matches, jointly (``scipy.optimize.least_squares``).
 
     initial_poses : (L, 3); the first view's pose is held fixed (it fixes the gauge: its pose is the
@@ -191,9 +196,7 @@ def overlapping_pairs(camera: PTZCamera, poses, min_overlap: float = MIN_PAIR_OV
     a zoomed view inside a wide one overlaps it fully.
     """
     poses = np.asarray(poses, dtype=float)
-    u, v = np.meshgrid(
-        np.linspace(0, camera.image_width_px, 12), np.linspace(0, camera.image_height_px, 9)
-    )
+    u, v = np.meshgrid(np.linspace(0, camera.image_width_px, 12), np.linspace(0, camera.image_height_px, 9))
     grid = np.c_[u.ravel(), v.ravel(), np.ones(u.size)]
     H = rotation_homography(camera, poses[:, None], poses[None, :])  # (L, L, 3, 3): view i -> view j
     mapped = np.einsum("ijab,nb->ijna", H, grid)
@@ -201,7 +204,7 @@ def overlapping_pairs(camera: PTZCamera, poses, min_overlap: float = MIN_PAIR_OV
         inside = (mapped[..., 2] > 0) & inside_image(camera, mapped[..., :2] / mapped[..., 2:])
     overlap = inside.mean(axis=-1)
     overlap = np.maximum(overlap, overlap.T)
-    return [(int(i), int(j)) for i, j in zip(*np.nonzero(np.triu(overlap >= min_overlap, k=1)))]
+    return [(int(i), int(j)) for i, j in zip(*np.nonzero(np.triu(overlap >= min_overlap, k=1)), strict=True)]
 
 
 def pairwise_matches(keypoints: list, descriptors: list, pairs) -> list[tuple[int, int, np.ndarray, np.ndarray]]:
@@ -286,7 +289,7 @@ def load_index(path: str | Path) -> ReferenceIndex:
                 keypoints_px=data["keypoints_px"],
                 descriptors=data["descriptors"],
                 view=data["view"],
-                image_size_px=tuple(int(x) for x in data["image_size_px"]),
+                image_size_px=(int(data["image_size_px"][0]), int(data["image_size_px"][1])),
             )
     except FileNotFoundError:
         raise RegistrationIndexError(f"{path}: no such registration index") from None
@@ -358,7 +361,7 @@ def register(
     pairs = within_view_ratio_matches(index, descriptors)
     views = index.view[pairs[:, 1]]
     votes = np.bincount(views, minlength=len(index.poses))
-    best, best_inliers = -1, None
+    best, H_live_to_reference, best_inliers = -1, np.eye(3), (np.zeros((0, 2)), np.zeros((0, 2)))
     for view in np.argsort(-votes, kind="stable")[:CANDIDATE_VIEWS]:
         if votes[view] < MIN_INLIERS:
             break
@@ -372,7 +375,9 @@ def register(
         return None
     reference_pose = index.poses[best]
     K_reference = intrinsics(camera, reference_pose[2])
-    centred = np.array([[1.0, 0.0, -camera.principal_point_px[0]], [0.0, 1.0, -camera.principal_point_px[1]], [0, 0, 1]])
+    centred = np.array(
+        [[1.0, 0.0, -camera.principal_point_px[0]], [0.0, 1.0, -camera.principal_point_px[1]], [0, 0, 1]]
+    )
     H_reference_to_live = centred @ np.linalg.inv(H_live_to_reference) @ np.linalg.inv(centred)
     focal_px = focal_from_homography(H_reference_to_live, K_reference[0, 0])
     K_live = np.diag([focal_px, focal_px, 1.0])
@@ -389,7 +394,9 @@ def register(
     pose = refine_pose(camera, reference_pose, reference_px[spread], live_px[spread], initial_pose)
     # The homography of a narrow view leaves its perspective part (and so eq. 2) poorly pinned; the
     # three-parameter camera is not, but the inliers must then fit it, as they fit a true rotation.
-    fitted = np.linalg.norm(apply_homography(rotation_homography(camera, reference_pose, pose), reference_px) - live_px, axis=1)
+    fitted = np.linalg.norm(
+        apply_homography(rotation_homography(camera, reference_pose, pose), reference_px) - live_px, axis=1
+    )
     if np.count_nonzero(fitted <= RANSAC_THRESHOLD_PX) < max(MIN_INLIERS, len(live_px) / 2):
         return None
     return Registration(pose, pose[2] * camera.f_min_px, best, int(np.count_nonzero(fitted <= RANSAC_THRESHOLD_PX)))

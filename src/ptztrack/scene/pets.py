@@ -126,7 +126,8 @@ def read_video(path: str | Path, expected_frames: int | None = None, expected_si
     if expected_frames is not None and len(video) != expected_frames:
         raise DatasetError(f"{path}: {len(video)} frames, expected {expected_frames}")
     if expected_size_px is not None and tuple(video.shape[2:0:-1]) != tuple(expected_size_px):
-        raise DatasetError(f"{path}: frames are {video.shape[2]}x{video.shape[1]} px, expected {expected_size_px[0]}x{expected_size_px[1]}")
+        width, height = expected_size_px
+        raise DatasetError(f"{path}: frames are {video.shape[2]}x{video.shape[1]} px, expected {width}x{height}")
     return video
 
 
@@ -188,11 +189,11 @@ class RecordedVideo:
     def _open(self) -> None:
         self._capture = cv2.VideoCapture(str(self.path))
         self._next = 0
-        self._last = None
+        self._last: np.ndarray | None = None
 
     def frame(self, index: int) -> np.ndarray:
         """Frame ``index`` (0-based) as (height, width, 3) uint8 BGR (do not modify it: it is kept)."""
-        if index == self._next - 1:
+        if index == self._next - 1 and self._last is not None:
             return self._last
         if index < self._next:
             self._capture.release()

@@ -122,8 +122,7 @@ class TrackletOracle:
                 or self._within_walk(last_m, heading, walk_m, self.centre_m(step, unit))
             }
             for unit in units
-            if unit not in self.unit_vertex
-            and any(self.graph.nodes[v]["targets"] & unit for v in self.lost)
+            if unit not in self.unit_vertex and any(self.graph.nodes[v]["targets"] & unit for v in self.lost)
         }
         events = []
         for unit, parents in candidates.items():
@@ -152,7 +151,9 @@ class TrackletOracle:
         block_m = self.road_spacing_m / np.sqrt(2)
         position_blocks = (np.asarray(start_m) @ heading) / block_m
         corner_m = (np.ceil(position_blocks - 1e-9) - position_blocks) * block_m
-        return corner_m <= walk_m and abs(along_m - corner_m) <= margin_m and abs(aside_m) <= walk_m - corner_m + margin_m
+        return (
+            corner_m <= walk_m and abs(along_m - corner_m) <= margin_m and abs(aside_m) <= walk_m - corner_m + margin_m
+        )
 
     def _start(self, step: int, events: list) -> None:
         created = msg.add_tracklets(self.graph, [(frozenset(unit), parents) for unit, parents in events], step)

@@ -139,7 +139,8 @@ def _road_ends(bound: float) -> tuple[np.ndarray, np.ndarray]:
 
     The area is 0 <= w1 + w2 <= bound and 0 <= w1 - w2 <= bound; roads that only touch a corner are left out.
     """
-    starts, directions = [], []
+    starts: list[tuple[float, float]] = []
+    directions: list[int] = []
     for k in range(-int(bound), int(bound) + 1):
         if abs(k) < bound / 2:  # road w2 = k runs over w1 in [|k|, bound - |k|]
             starts += [(abs(k), k), (bound - abs(k), k)]

@@ -46,4 +46,3 @@ def update(x, P, innovation, C, V) -> tuple[np.ndarray, np.ndarray]:
     I_KC = np.eye(x.shape[-1]) - K @ C
     P_plus = I_KC @ P @ np.swapaxes(I_KC, -1, -2) + K @ V @ np.swapaxes(K, -1, -2)
     return x_plus, P_plus
-

@@ -122,7 +122,9 @@ def refresh_templates(
     refreshed = {track_id: template for track_id, template in templates.items() if track_id in live}
     feet_px = np.asarray(feet_px, dtype=float).reshape(-1, 2)
     boxes_px = template_box_px(camera, pose, feet_px, person_height_m, person_width_m)
-    for track_id, box_px, seen in zip(np.asarray(track_ids).tolist(), boxes_px, inside_image(camera, feet_px)):
+    for track_id, box_px, seen in zip(
+        np.asarray(track_ids).tolist(), boxes_px, inside_image(camera, feet_px), strict=True
+    ):
         if seen and track_id in live:
             refreshed[track_id] = spatiogram(image_bgr, box_px)
     return refreshed
@@ -169,7 +171,7 @@ def template_measurements(
     searched = np.flatnonzero(in_front & inside_image(camera, predicted_px) & np.isin(tracks.ids, list(templates)))
     boxes_px = template_box_px(camera, pose, predicted_px[searched], person_height_m, person_width_m)
     found_px, track_ids, scores = [], [], []
-    for index, (_, _, width_px, height_px) in zip(searched, boxes_px):
+    for index, (_, _, width_px, height_px) in zip(searched, boxes_px, strict=True):
         template = templates[int(tracks.ids[index])]
         feet_px, score = search(image_bgr, template, predicted_px[index], height_px, width_px, radius_px[index])
         if score >= min_similarity:
@@ -229,7 +231,9 @@ class TemplateTracker:
         found = template_measurements(image, camera, pose, tracks, self.templates, V, height_m, width_m)
         noise = template_noise_covariance(camera, pose, found.feet_px, height_m, V)
         max_sigma_m = self.tracker.parameters.max_position_sigma_m
-        self.tracker.tracks = update_own_tracks(tracks, found.track_ids, found.feet_px, camera, pose, noise, max_sigma_m)
+        self.tracker.tracks = update_own_tracks(
+            tracks, found.track_ids, found.feet_px, camera, pose, noise, max_sigma_m
+        )
         height_px = template_box_px(camera, pose, found.feet_px, height_m, width_m)[:, 3]
         measurements = Detections(found.feet_px, height_px, np.full(len(found.feet_px), -1), found.similarity)
         alive = np.isin(found.track_ids, self.tracker.tracks.ids)

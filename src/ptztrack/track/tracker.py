@@ -187,7 +187,11 @@ def update_tracks(tracks: Tracks, feet_px, camera: PTZCamera, pose, V, parameter
             tracks.mean, tracks.covariance, innovation, distance2, gated, S, C, V, parameters.clutter_density_per_px2
         )
         paired = detected[track_index]
-        track_index, detection_index, updated_index = track_index[paired], detection_index[paired], np.flatnonzero(detected)
+        track_index, detection_index, updated_index = (
+            track_index[paired],
+            detection_index[paired],
+            np.flatnonzero(detected),
+        )
     else:
         mean, covariance = tracks.mean.copy(), tracks.covariance.copy()
         mean[track_index], covariance[track_index] = kalman.update(
@@ -222,7 +226,14 @@ def update_tracks(tracks: Tracks, feet_px, camera: PTZCamera, pose, V, parameter
 
 
 def _after_update(
-    tracks: Tracks, mean, covariance, track_index, predicted_px, in_front, camera: PTZCamera, parameters: TrackerParameters
+    tracks: Tracks,
+    mean,
+    covariance,
+    track_index,
+    predicted_px,
+    in_front,
+    camera: PTZCamera,
+    parameters: TrackerParameters,
 ):
     """The updated tracks' misses, hits and deletions (see :func:`update_tracks`); returns the survivors
     and which of the tracks survived (n,) bool."""
@@ -238,7 +249,9 @@ def _after_update(
     return updated.select(keep), keep
 
 
-def update_own_tracks(tracks: Tracks, track_ids, feet_px, camera: PTZCamera, pose, V, max_position_sigma_m: float) -> Tracks:
+def update_own_tracks(
+    tracks: Tracks, track_ids, feet_px, camera: PTZCamera, pose, V, max_position_sigma_m: float
+) -> Tracks:
     """Update each track with its own measurement: no association, no new tracks, no missed steps.
 
     track_ids : (K,) the track each measurement ``feet_px`` (K, 2) px belongs to (as template

@@ -1,0 +1,38 @@
+"""The promises about the code itself that a tool can check: layers, lint, types, the example."""
+
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+
+pytestmark = pytest.mark.slow
+
+
+@pytest.mark.parametrize(
+    "command",
+    [
+        ["lint-imports"],
+        ["ruff", "check", "src", "tests", "benchmarks", "examples"],
+        ["ruff", "format", "--check", "src", "tests", "benchmarks", "examples"],
+        ["mypy"],
+    ],
+    ids=["layers", "lint", "format", "types"],
+)
+def test_the_code_keeps_its_contracts(command):
+    """import-linter's contracts (pyproject.toml: layers, configuration at the edge, no cycles), ruff and mypy."""
+    executable = shutil.which(command[0], path=str(Path(sys.executable).parent))
+    assert executable is not None, f"{command[0]} is not installed: pip install '.[test]'"
+    result = subprocess.run([executable, *command[1:]], cwd=ROOT, capture_output=True, text=True)
+    assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
+
+
+def test_the_readme_example_runs_a_policy_defined_in_its_own_script(tmp_path):
+    result = subprocess.run(
+        [sys.executable, str(ROOT / "examples" / "custom_policy.py")], cwd=tmp_path, capture_output=True, text=True
+    )
+    assert result.returncode == 0, result.stderr
+    assert "follow_the_most_uncertain" in result.stdout and "one episode: MOTA" in result.stdout
