@@ -14,7 +14,7 @@ import time
 import numpy as np
 
 from ptztrack import registry
-from ptztrack.build.episode import run_episode
+from ptztrack.builders.episode import run_episode
 from ptztrack.config import scenario_from_dict
 from ptztrack.evaluate.metrics import episode_metrics
 

@@ -31,8 +31,8 @@ from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
 
-from ptztrack.build.episode import make_policy, run_episode  # noqa: E402
-from ptztrack.build.world import action_grid, build_world  # noqa: E402
+from ptztrack.builders.episode import make_policy, run_episode  # noqa: E402
+from ptztrack.builders.world import action_grid, build_world  # noqa: E402
 from ptztrack.config import scenario_from_dict  # noqa: E402
 from ptztrack.types import Tracks  # noqa: E402
 

@@ -15,7 +15,7 @@ C = lambda (1 - P_D P_G) / P_D with P_G = 0.99, the value of
 import numpy as np
 from scipy.spatial.distance import cdist
 
-from ptztrack.build.world import build_world
+from ptztrack.builders.world import build_world
 from ptztrack.config import pets_scenario
 
 

@@ -15,8 +15,8 @@ import time
 import cv2
 import numpy as np
 
-from ptztrack.build.registration import reference_index, registration_camera
-from ptztrack.build.world import action_grid
+from ptztrack.builders.registration import reference_index, registration_camera
+from ptztrack.builders.world import action_grid
 from ptztrack.config import pets_scenario
 from ptztrack.geometry.registration import LIVE_FEATURES, register, sift_features, within_view_ratio_matches
 from ptztrack.scene.pets import RecordedVideo

@@ -49,8 +49,8 @@ from pathlib import Path  # noqa: E402
 import cv2  # noqa: E402
 import numpy as np  # noqa: E402
 
-from ptztrack.build.episode import make_policy, make_tracker  # noqa: E402
-from ptztrack.build.world import build_world  # noqa: E402
+from ptztrack.builders.episode import make_policy, make_tracker  # noqa: E402
+from ptztrack.builders.world import build_world  # noqa: E402
 from ptztrack.config import pets_scenario  # noqa: E402
 from ptztrack.detect.hog import HogPeopleDetector, feet_and_height_px  # noqa: E402
 from ptztrack.loop import episode_seeds  # noqa: E402

@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from ptztrack.build.world import action_grid
+from ptztrack.builders.world import action_grid
 from ptztrack.camera.actions import ActionGrid
 from ptztrack.config import Scenario
 

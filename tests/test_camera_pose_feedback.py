@@ -3,10 +3,10 @@
 import numpy as np
 import pytest
 
-from ptztrack.build.episode import run_episode
-from ptztrack.build.experiments import registration_views
-from ptztrack.build.registration import reference_index, registration_camera
-from ptztrack.build.world import action_grid, landing_error
+from ptztrack.builders.episode import run_episode
+from ptztrack.builders.experiments import registration_views
+from ptztrack.builders.registration import reference_index, registration_camera
+from ptztrack.builders.world import action_grid, landing_error
 from ptztrack.camera import pose_feedback
 from ptztrack.config import PoseError, ScenarioError, pets_scenario, scenario_from_dict
 from ptztrack.evaluate.metrics import episode_metrics

@@ -3,8 +3,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ptztrack.build.episode import run_episode
-from ptztrack.build.world import build_world
+from ptztrack.builders.episode import run_episode
+from ptztrack.builders.world import build_world
 from ptztrack.config import load_scenario, pets_scenario
 from ptztrack.evaluate.metrics import episode_metrics
 from ptztrack.geometry.ptz import apply_homography, ground_to_image

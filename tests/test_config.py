@@ -2,7 +2,7 @@ from pathlib import Path
 
 import pytest
 
-from ptztrack.build.world import action_grid
+from ptztrack.builders.world import action_grid
 from ptztrack.config import Scenario, ScenarioError, load_scenario
 
 EXAMPLE = Path(__file__).parent.parent / "examples" / "scenario.yaml"

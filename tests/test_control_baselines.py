@@ -1,7 +1,7 @@
 import numpy as np
 
-from ptztrack.build.episode import run_episode
-from ptztrack.build.world import action_grid, ptz_camera
+from ptztrack.builders.episode import run_episode
+from ptztrack.builders.world import action_grid, ptz_camera
 from ptztrack.config import Scenario
 from ptztrack.control.baselines import area_coverage, area_samples_m, patrol_route, widest_view_action
 from ptztrack.geometry.ptz import person_in_view, project_people

@@ -4,9 +4,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.stats import multivariate_normal
 
-from ptztrack.build.episode import make_policy
-from ptztrack.build.factories import recall_model
-from ptztrack.build.world import action_grid, build_world, ptz_camera
+from ptztrack.builders.episode import make_policy
+from ptztrack.builders.factories import recall_model
+from ptztrack.builders.world import action_grid, build_world, ptz_camera
 from ptztrack.config import Control, Scenario, scenario_from_dict
 from ptztrack.control.gaussian_rectangle import bivariate_normal_cdf, gaussian_rectangle_probability
 from ptztrack.control.information_gain import (

@@ -5,8 +5,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from ptztrack.build.factories import recall_model
-from ptztrack.build.world import ptz_camera
+from ptztrack.builders.factories import recall_model
+from ptztrack.builders.world import ptz_camera
 from ptztrack.config import Scenario
 from ptztrack.detect.simulated import RecallDetector, RecallModel, detection_probability
 from ptztrack.geometry.occlusion import occluded_fraction, occlusion_in_centred_views

@@ -5,7 +5,7 @@ import os
 import numpy as np
 import pytest
 
-from ptztrack.build.experiments import STRATEGIES, run_cell, synthetic_cells
+from ptztrack.builders.experiments import STRATEGIES, run_cell, synthetic_cells
 from ptztrack.cli import main
 from ptztrack.config import scenario_from_dict
 from ptztrack.evaluate.executors import run_cells

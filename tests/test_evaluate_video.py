@@ -4,7 +4,7 @@ import cv2
 import numpy as np
 import pytest
 
-from ptztrack.build.episode import episode_world, run_episode
+from ptztrack.builders.episode import episode_world, run_episode
 from ptztrack.cli import main
 from ptztrack.config import scenario_from_dict
 from ptztrack.evaluate.report import RUN_FILES

@@ -1,6 +1,6 @@
 import numpy as np
 
-from ptztrack.build.episode import run_episode
+from ptztrack.builders.episode import run_episode
 from ptztrack.config import scenario_from_dict
 from ptztrack.evaluate.metrics import episode_metrics
 

@@ -12,8 +12,8 @@ import pytest
 
 import ptztrack
 from ptztrack import registry
-from ptztrack.build.episode import run_episode
-from ptztrack.build.experiments import run_cell, synthetic_cells
+from ptztrack.builders.episode import run_episode
+from ptztrack.builders.experiments import run_cell, synthetic_cells
 from ptztrack.cli import main
 from ptztrack.config import ScenarioError, scenario_from_dict
 from ptztrack.evaluate.executors import run_cells
@@ -131,7 +131,7 @@ def test_another_package_adds_a_policy_and_a_detector_through_entry_points(tmp_p
     (tmp_path / "other_package.py").write_text(
         textwrap.dedent(
             """
-            from ptztrack.build.factories import ideal_detector
+            from ptztrack.builders.factories import ideal_detector
 
             class Stay:
                 def choose(self, context):

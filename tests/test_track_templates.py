@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from ptztrack.build.episode import run_episode
+from ptztrack.builders.episode import run_episode
 from ptztrack.camera.virtual import virtual_ptz
 from ptztrack.config import pets_scenario
 from ptztrack.evaluate.metrics import episode_metrics

@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from ptztrack.build.factories import tracker_parameters
+from ptztrack.builders.factories import tracker_parameters
 from ptztrack.config import Tracker, scenario_from_dict
 from ptztrack.geometry.ptz import PTZCamera, apply_homography, feet_jacobian, ground_to_image, look_at
 from ptztrack.track import kalman

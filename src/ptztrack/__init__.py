@@ -45,14 +45,14 @@ _HOME = {
     "World": ".loop",
     "Episode": ".loop",
     "run_loop": ".loop",
-    "BuiltScene": ".build.world",
-    "build_world": ".build.world",
-    "episode_world": ".build.episode",
-    "run_episode": ".build.episode",
-    "Cell": ".build.experiments",
-    "synthetic_cells": ".build.experiments",
-    "recording_cells": ".build.experiments",
-    "run_cell": ".build.experiments",
+    "BuiltScene": ".builders.world",
+    "build_world": ".builders.world",
+    "episode_world": ".builders.episode",
+    "run_episode": ".builders.episode",
+    "Cell": ".builders.experiments",
+    "synthetic_cells": ".builders.experiments",
+    "recording_cells": ".builders.experiments",
+    "run_cell": ".builders.experiments",
     "run_cells": ".evaluate.executors",
     "summarise": ".evaluate.tables",
     "format_table": ".evaluate.tables",
@@ -64,9 +64,9 @@ _RENAMED = {"register": (".registry", "register"), "registered_names": (".regist
 __all__ = ["__version__", *_HOME, *_RENAMED]
 
 if TYPE_CHECKING:
-    from .build.episode import episode_world, run_episode
-    from .build.experiments import Cell, recording_cells, run_cell, synthetic_cells
-    from .build.world import BuiltScene, build_world
+    from .builders.episode import episode_world, run_episode
+    from .builders.experiments import Cell, recording_cells, run_cell, synthetic_cells
+    from .builders.world import BuiltScene, build_world
     from .camera.actions import ActionGrid
     from .config import Scenario, ScenarioError, load_scenario, pets_scenario, scenario_from_dict
     from .evaluate.executors import run_cells

@@ -11,8 +11,8 @@ from pathlib import Path
 import numpy as np
 
 from ptztrack import registry
-from ptztrack.build.episode import episode_world, run_episode
-from ptztrack.build.experiments import (
+from ptztrack.builders.episode import episode_world, run_episode
+from ptztrack.builders.experiments import (
     POSE_SOURCES,
     STRATEGIES,
     closed_loop_cells,
@@ -22,7 +22,7 @@ from ptztrack.build.experiments import (
     run_closed_loop_cell,
     synthetic_cells,
 )
-from ptztrack.build.registration import reference_index
+from ptztrack.builders.registration import reference_index
 from ptztrack.config import PoseError, Scenario, ScenarioError, load_scenario, pets_scenario, scenario_from_dict
 from ptztrack.control.msg_scheduler import CHOOSERS
 from ptztrack.evaluate.executors import EXECUTORS, print_progress, run_cells

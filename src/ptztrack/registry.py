@@ -2,12 +2,12 @@
 
 Four kinds: ``policies``, ``detectors``, ``cameras`` (camera backends) and
 ``trackers``. A name maps to a *factory*, called by the builders
-(:mod:`ptztrack.build`) with the validated scenario and what is built so far:
+(:mod:`ptztrack.builders`) with the validated scenario and what is built so far:
 
 * ``policies`` and ``trackers``: ``factory(scenario, world) -> Policy | Tracker``,
   ``world`` a :class:`ptztrack.loop.World`;
 * ``detectors`` and ``cameras``: ``factory(scenario, scene) -> Detector | CameraBackend``,
-  ``scene`` a :class:`ptztrack.build.world.BuiltScene`.
+  ``scene`` a :class:`ptztrack.builders.world.BuiltScene`.
 
 Names come from three places, in this order of precedence: ptztrack's own
 (imported only when used), the entry points of installed packages in the
@@ -32,7 +32,7 @@ KINDS = ("policies", "detectors", "cameras", "trackers")
 ENTRY_POINT_GROUPS = {kind: f"ptztrack.{kind}" for kind in KINDS}
 _SINGULAR = {"policies": "policy", "detectors": "detector", "cameras": "camera backend", "trackers": "tracker"}
 
-_FACTORIES = "ptztrack.build.factories"
+_FACTORIES = "ptztrack.builders.factories"
 _BUILT_IN: dict[str, dict[str, str]] = {
     "policies": {name: f"{_FACTORIES}:{name}_policy" for name in ("fix", "patrol", "random", "intg", "smpl")},
     "detectors": {name: f"{_FACTORIES}:{name}_detector" for name in ("ideal", "realistic", "hog")},

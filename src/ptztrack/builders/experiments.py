@@ -1,0 +1,174 @@
+"""The papers' experiments as data: cells of (scenario, strategy, seed), each a function of its inputs.
+
+The executors of :mod:`ptztrack.evaluate.executors` run the cells; the
+tables of :mod:`ptztrack.evaluate.tables` summarise their rows.
+"""
+
+import copy
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from ptztrack import registry
+from ptztrack.builders.episode import PolicySpec, run_episode
+from ptztrack.builders.registration import registration_camera
+from ptztrack.builders.world import CameraSpec, DetectorSpec, action_grid
+from ptztrack.config import PoseError, Scenario
+from ptztrack.evaluate.metrics import episode_metrics
+from ptztrack.evaluate.registration import registration_errors
+from ptztrack.geometry.registration import ReferenceIndex
+from ptztrack.scene.pets import RecordedVideo, load_mot_ground_truth
+
+STRATEGIES = ("fix", "patrol", "rnd", "intg", "smpl")
+# The paper's column names; 'rnd' is the 'random' policy.
+POLICY_OF_STRATEGY = {"rnd": "random"}
+INFORMATION_STRATEGIES = ("intg", "smpl")
+POSE_SOURCES = ("oracle", "commanded", "registered")
+# Live views come from frames after this one, so that people have moved since the reference frame.
+FIRST_LIVE_FRAME = 50
+GROUND_GRID_POINTS = 25
+
+
+def strategy_name(strategy: PolicySpec) -> str:
+    """A strategy's column name: itself for a name, else the object's ``name`` or its type's name."""
+    if isinstance(strategy, str):
+        return strategy
+    name = getattr(strategy, "name", None) or getattr(strategy, "__name__", None)
+    return str(name or type(strategy).__name__)
+
+
+@dataclass(frozen=True)
+class Cell:
+    """One episode of an experiment: a scenario run with one strategy and one sequence seed.
+
+    strategy : a table name (``STRATEGIES``, 'rnd' for the 'random' policy), a registered policy,
+        a policy object (each cell runs a fresh copy) or a policy factory.
+    label : the table column it belongs to (the strategy, with beta where the table has several).
+    camera, detector : in place of the scenario's (see :func:`ptztrack.builders.world.build_world`).
+    """
+
+    scenario: Scenario
+    strategy: PolicySpec
+    seed: int
+    label: str = ""
+    camera: CameraSpec | None = None
+    detector: DetectorSpec | None = None
+
+    @property
+    def column(self) -> str:
+        return self.label or strategy_name(self.strategy)
+
+
+def _check_strategies(strategies: Sequence[PolicySpec]) -> None:
+    known = set(STRATEGIES) | set(registry.names("policies"))
+    unknown = sorted(s for s in strategies if isinstance(s, str) and s not in known)
+    if unknown:
+        raise ValueError(f"unknown strategies {unknown}; expected some of {', '.join(sorted(known))}")
+
+
+def synthetic_cells(
+    scenario: Scenario,
+    sequences: int,
+    strategies: Sequence[PolicySpec] = STRATEGIES,
+    camera: CameraSpec | None = None,
+    detector: DetectorSpec | None = None,
+) -> list[Cell]:
+    """The paper's synthetic protocol: every strategy on the same ``sequences`` sequences (seeds 0..n-1)."""
+    _check_strategies(strategies)
+    return [
+        Cell(scenario, strategy, seed, camera=camera, detector=detector)
+        for strategy in strategies
+        for seed in range(sequences)
+    ]
+
+
+def recording_cells(
+    scenario: Scenario, betas: Sequence[float], strategies: Sequence[PolicySpec] = STRATEGIES
+) -> list[Cell]:
+    """The paper's realistic protocol (section 5.2): one run of each strategy over the recording,
+    the information-gain ones once per ``beta`` of the patrolling term."""
+    _check_strategies(strategies)
+    cells = [Cell(scenario, strategy, 0) for strategy in strategies if strategy not in INFORMATION_STRATEGIES]
+    for beta in betas:
+        with_beta = scenario.model_copy(update={"control": scenario.control.model_copy(update={"beta": beta})})
+        for strategy in strategies:
+            if strategy in INFORMATION_STRATEGIES:
+                cells.append(Cell(with_beta, strategy, 0, f"{strategy} b{beta:g}"))
+    return cells
+
+
+def cell_policy(cell: Cell) -> PolicySpec:
+    """The policy spec a cell runs: its registered name, or a fresh copy of its object."""
+    if isinstance(cell.strategy, str):
+        return POLICY_OF_STRATEGY.get(cell.strategy, cell.strategy)
+    return copy.deepcopy(cell.strategy)
+
+
+def run_cell(cell: Cell) -> dict:
+    """Run one cell; returns its metrics with ``strategy``, ``label``, ``beta`` (None for baselines) and ``seed``."""
+    episode = run_episode(cell.scenario, cell_policy(cell), cell.seed, camera=cell.camera, detector=cell.detector)
+    beta = cell.scenario.control.beta if cell.strategy in INFORMATION_STRATEGIES else None
+    name = strategy_name(cell.strategy)
+    return {"strategy": name, "label": cell.column, "beta": beta, "seed": cell.seed, **episode_metrics(episode)}
+
+
+def registration_views(
+    scenario: Scenario,
+    index: ReferenceIndex,
+    views: int,
+    seed: int = 0,
+    progress: Callable[[int, int], None] | None = None,
+) -> list[dict]:
+    """Register ``views`` live views of a recording scenario (see
+    :func:`ptztrack.evaluate.registration.registration_errors`).
+
+    The live views are at random reachable poses (pan and tilt uniform over the action grid's
+    range, zoom uniform from 1 to the grid's largest) of random frames after ``FIRST_LIVE_FRAME``;
+    the ground errors are measured over a grid over the annotated people's extent.
+    """
+    recording = scenario.required_recording("the registration experiment")
+    virtual, whole_frame_pose = registration_camera(scenario)
+    grid = action_grid(scenario)
+    annotations = load_mot_ground_truth(recording.ground_truth)
+    low, high = annotations.ground_m.min(axis=0), annotations.ground_m.max(axis=0)
+    x, y = np.meshgrid(*(np.linspace(low[k], high[k], GROUND_GRID_POINTS) for k in range(2)))
+    rng = np.random.default_rng(seed)
+    poses = np.c_[
+        whole_frame_pose[0] + rng.uniform(grid.pan_deg.min(), grid.pan_deg.max(), views),
+        whole_frame_pose[1] + rng.uniform(grid.tilt_deg.min(), grid.tilt_deg.max(), views),
+        rng.uniform(1.0, grid.zoom.max(), views),
+    ]
+    frames = np.sort(rng.integers(FIRST_LIVE_FRAME, annotations.frame.max() + 1, views))
+    video = RecordedVideo(scenario.required_video("the registration experiment"), recording.recorded_size_px)
+    return registration_errors(virtual, index, video, poses, frames, np.c_[x.ravel(), y.ravel()], progress)
+
+
+def closed_loop_cells(
+    scenario: Scenario, pose_error: PoseError, strategy: str = "smpl", sources: Sequence[str] = POSE_SOURCES
+) -> list[Cell]:
+    """One run of ``strategy`` per pose source, the camera landing off its commands by ``pose_error``."""
+    camera = scenario.camera.model_copy(update={"pose_error": pose_error})
+    cells = []
+    for source in sources:
+        feedback = scenario.pose_feedback.model_copy(update={"source": source})
+        with_source = scenario.model_copy(update={"camera": camera, "pose_feedback": feedback})
+        cells.append(Cell(with_source, strategy, 0, source))
+    return cells
+
+
+def run_closed_loop_cell(cell: Cell) -> dict:
+    """One closed-loop run: its metrics, with ``pose_source``, the median error of the tracker's pose
+    (``tracker_pan_err_deg``, ``tracker_tilt_err_deg``, ``tracker_zoom_err_pct``) and the fraction of
+    steps whose pose the source gave (``pose_known``)."""
+    episode = run_episode(cell.scenario, cell_policy(cell), cell.seed)
+    error = np.abs(episode.tracker_poses - episode.poses)
+    return {
+        "pose_source": cell.scenario.pose_feedback.source,
+        "strategy": cell.strategy,
+        **episode_metrics(episode),
+        "tracker_pan_err_deg": float(np.median(error[:, 0])),
+        "tracker_tilt_err_deg": float(np.median(error[:, 1])),
+        "tracker_zoom_err_pct": float(100 * np.median(error[:, 2] / episode.poses[:, 2])),
+        "pose_known": float(episode.pose_known.mean()),
+    }

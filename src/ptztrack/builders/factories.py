@@ -1,0 +1,145 @@
+"""ptztrack's own implementations of the roles, by name (:mod:`ptztrack.registry` points here).
+
+Policies and trackers are made from a scenario and its :class:`~ptztrack.loop.World`;
+camera backends and detectors from a scenario and its :class:`~ptztrack.builders.world.BuiltScene`.
+"""
+
+from typing import Literal
+
+from ptztrack.camera.recorded import RecordedPTZ
+from ptztrack.camera.simulated import SimulatedPTZ
+from ptztrack.config import Scenario
+from ptztrack.control.baselines import FixPolicy, PatrolPolicy, RandomPolicy, patrol_route, widest_view_action
+from ptztrack.control.exploration import exploration_map
+from ptztrack.control.information_policy import InformationGainPolicy
+from ptztrack.detect.hog import HogPeopleDetector
+from ptztrack.detect.simulated import AnnotationDetector, RecallDetector, RecallModel
+from ptztrack.loop import World
+from ptztrack.scene.pets import RecordedVideo
+from ptztrack.track.kalman import constant_velocity_model
+from ptztrack.track.templates import TemplateTracker
+from ptztrack.track.tracker import EkfTracker, TrackerParameters, pixel_noise_covariance
+
+TRACKER_FIELDS = (
+    "initial_speed_sigma_m_s",
+    "gate_probability",
+    "max_missed_steps",
+    "max_position_sigma_m",
+    "confirmation_hits",
+    "association",
+    "clutter_density_per_px2",
+)
+
+
+def recall_model(scenario: Scenario) -> RecallModel:
+    """The detector model the policies plan with: perfect for the ideal detector, else the scenario's
+    recall curve (HOG included)."""
+    detector = scenario.detector
+    return RecallModel(detector.recall_kd, detector.recall_r0_px, perfect=detector.kind == "ideal")
+
+
+def pixel_noise(scenario: Scenario):
+    """``V`` (2, 2) px^2 of the scenario's detector."""
+    return pixel_noise_covariance(scenario.detector.pixel_noise_px)
+
+
+def tracker_parameters(scenario: Scenario) -> TrackerParameters:
+    tracker = scenario.tracker
+    return TrackerParameters(**{name: getattr(tracker, name) for name in TRACKER_FIELDS})
+
+
+def fix_policy(scenario: Scenario, world: World) -> FixPolicy:
+    return FixPolicy(widest_view_action(world.camera, world.grid, world.area_bounds_m))
+
+
+def patrol_policy(scenario: Scenario, world: World) -> PatrolPolicy:
+    return PatrolPolicy(world.grid, patrol_route(world.camera, world.grid, world.area_bounds_m))
+
+
+def random_policy(scenario: Scenario, world: World) -> RandomPolicy:
+    return RandomPolicy()
+
+
+def _information_policy(scenario: Scenario, world: World, method: Literal["intg", "smpl"]) -> InformationGainPolicy:
+    control, recall = scenario.control, recall_model(scenario)
+    exploration = None
+    if control.beta > 0:
+        exploration = exploration_map(
+            world.camera,
+            world.grid.poses,
+            world.area_bounds_m,
+            recall,
+            control.person_height_m,
+            control.exploration_cell_m,
+            control.prior_occupancy,
+            control.arrival_rate_per_m2_s,
+            1.0 / scenario.frame_rate_hz,
+        )
+    return InformationGainPolicy(
+        world.camera,
+        world.grid,
+        recall,
+        pixel_noise(scenario),
+        control.person_height_m,
+        scenario.people.width_m,
+        method,
+        control.samples,
+        control.beta,
+        exploration,
+    )
+
+
+def intg_policy(scenario: Scenario, world: World) -> InformationGainPolicy:
+    return _information_policy(scenario, world, "intg")
+
+
+def smpl_policy(scenario: Scenario, world: World) -> InformationGainPolicy:
+    return _information_policy(scenario, world, "smpl")
+
+
+def _simulated_detector(scenario: Scenario, scene, recall: RecallModel):
+    detector = scenario.detector
+    size = (scene.camera.image_width_px, scene.camera.image_height_px)
+    return RecallDetector(recall, detector.pixel_noise_px, detector.false_positives_per_frame, size)
+
+
+def ideal_detector(scenario: Scenario, scene):
+    """The synthetic scene: recall 1, occluded people missed in proportion; a recording: the annotated
+    people wholly in view and hidden at most ``recording.occluded_above``."""
+    if scene.recording is not None:
+        occluded_above = scenario.required_recording("the ideal detector of a recording").occluded_above
+        return AnnotationDetector(scenario.detector.pixel_noise_px, occluded_above)
+    return _simulated_detector(scenario, scene, recall_model(scenario))
+
+
+def realistic_detector(scenario: Scenario, scene):
+    """The recall curve of the scenario (equation 13), occluded people missed in proportion."""
+    return _simulated_detector(scenario, scene, recall_model(scenario))
+
+
+def hog_detector(scenario: Scenario, scene) -> HogPeopleDetector:
+    detector = scenario.detector
+    return HogPeopleDetector(detector.hog_upsample, detector.hog_hit_threshold, detector.hog_nms_iou)
+
+
+def simulated_camera(scenario: Scenario, scene) -> SimulatedPTZ:
+    return SimulatedPTZ(scene.camera, scene.truth)
+
+
+def virtual_camera(scenario: Scenario, scene) -> RecordedPTZ:
+    """The virtual PTZ camera over the scenario's recording (images only if it names a video)."""
+    recording = scenario.required_recording("camera.backend 'virtual'")
+    video = None if recording.video is None else RecordedVideo(recording.video, recording.recorded_size_px)
+    return RecordedPTZ(scene.virtual, scene.recording, video)
+
+
+def ekf_tracker(scenario: Scenario, world: World) -> EkfTracker | TemplateTracker:
+    """One EKF per person on the ground (``tracker.association``), measured by the detector or, with
+    ``tracker.measurement_source`` 'spatiogram', by colour templates between detector steps."""
+    config = scenario.tracker
+    F, U = constant_velocity_model(1.0 / scenario.frame_rate_hz, config.acceleration_sigma_m_s2)
+    tracker = EkfTracker(world.camera, F, U, pixel_noise(scenario), tracker_parameters(scenario))
+    if config.measurement_source == "detector":
+        return tracker
+    height_m, width_m = scenario.control.person_height_m, scenario.people.width_m
+    return TemplateTracker(tracker, config.detector_every_steps, height_m, width_m)

@@ -1,0 +1,145 @@
+"""The scene, the camera backend, the detector and the pose source of a scenario: its :class:`~ptztrack.loop.World`."""
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ptztrack import registry
+from ptztrack.builders.registration import registered_pose_source
+from ptztrack.camera.actions import ActionGrid
+from ptztrack.camera.pose_feedback import LandingError, commanded_pose, true_pose
+from ptztrack.camera.virtual import VirtualPTZ, virtual_ptz
+from ptztrack.config import Scenario, ScenarioError
+from ptztrack.control.baselines import widest_view_action
+from ptztrack.geometry.calibration import load_calibration
+from ptztrack.geometry.ptz import PTZCamera
+from ptztrack.loop import World
+from ptztrack.roles import CameraBackend, Detector, PoseSource
+from ptztrack.scene.pets import RecordedScene, load_mot_ground_truth, recorded_scene
+from ptztrack.scene.synthetic import Crowd, walk_people
+from ptztrack.types import GroundTruth
+
+CameraSpec = str | CameraBackend | Callable[[Scenario, "BuiltScene"], CameraBackend]
+"""A camera backend: a registered name, an object, or a factory ``(scenario, scene) -> backend``."""
+DetectorSpec = str | Detector | Callable[[Scenario, "BuiltScene"], Detector]
+"""A detector: a registered name, an object, or a factory ``(scenario, scene) -> detector``."""
+
+
+@dataclass(frozen=True)
+class BuiltScene:
+    """A scenario's scene before its camera backend and detector: what their factories are given.
+
+    camera : the PTZ camera model; grid : its action grid; truth : the people;
+    area_bounds_m : [[x0, y0], [x1, y1]] where people can be.
+    recording, virtual : for a recording, its annotated people and the virtual PTZ camera over it.
+    """
+
+    camera: PTZCamera
+    grid: ActionGrid
+    truth: GroundTruth
+    area_bounds_m: np.ndarray
+    recording: RecordedScene | None = None
+    virtual: VirtualPTZ | None = None
+
+
+def ptz_camera(scenario: Scenario) -> PTZCamera:
+    """The synthetic scene's camera (a recording's comes from its calibration)."""
+    width_px, height_px = scenario.camera.image_size_px
+    return PTZCamera(scenario.camera.position_m, width_px, height_px, scenario.camera.f_min_px)
+
+
+def action_grid(scenario: Scenario) -> ActionGrid:
+    """The scenario's action grid (for a recording, pan and tilt are offsets from the whole-frame view)."""
+    actions = scenario.actions
+    return ActionGrid(
+        pan_deg=actions.pan_deg.values(),
+        tilt_deg=actions.tilt_deg.values(),
+        zoom=np.asarray(actions.zoom, dtype=float),
+        max_steps=actions.max_steps,
+    )
+
+
+def crowd(scenario: Scenario) -> Crowd:
+    return Crowd(**scenario.people.model_dump())
+
+
+def build_scene(scenario: Scenario, scene_rng: np.random.Generator) -> BuiltScene:
+    """The synthetic scene (walkers drawn from ``scene_rng``), or the recording seen by a virtual PTZ camera."""
+    if scenario.recording is None:
+        truth = walk_people(crowd(scenario), scenario.area_m, scenario.frames, scenario.frame_rate_hz, scene_rng)
+        return BuiltScene(ptz_camera(scenario), action_grid(scenario), truth, scenario.area_bounds_m)
+    recording = scenario.recording
+    calibration = load_calibration(recording.calibration, recording.view)
+    virtual, whole_frame_pose = virtual_ptz(calibration, recording.recorded_size_px, scenario.camera.image_size_px)
+    offsets = action_grid(scenario)
+    grid = ActionGrid(
+        offsets.pan_deg + whole_frame_pose[0], offsets.tilt_deg + whole_frame_pose[1], offsets.zoom, offsets.max_steps
+    )
+    scene = recorded_scene(
+        load_mot_ground_truth(recording.ground_truth),
+        recording.frame_step,
+        scenario.frames,
+        scenario.frame_rate_hz,
+        scenario.people.width_m,
+    )
+    margin_m = 1.0
+    ground_m = scene.annotations.ground_m
+    area_bounds_m = np.array([ground_m.min(axis=0) - margin_m, ground_m.max(axis=0) + margin_m])
+    return BuiltScene(virtual.camera, grid, scene.truth, area_bounds_m, scene, virtual)
+
+
+def resolve(kind: str, spec: Any, scenario: Scenario, built: Any, method: str) -> Any:
+    """An implementation of a role from its spec: a name registered under ``kind`` (its factory is
+    called with ``scenario`` and ``built``), an object that has ``method`` (used as it is), or a
+    factory called like a registered one."""
+    if isinstance(spec, str):
+        return registry.factory(kind, spec)(scenario, built)
+    if not isinstance(spec, type) and hasattr(spec, method):
+        return spec
+    if callable(spec):
+        return spec(scenario, built)
+    raise TypeError(f"a {kind} spec must be a registered name, an object with {method}(), or a factory; got {spec!r}")
+
+
+def pose_source(scenario: Scenario, scene: BuiltScene) -> PoseSource:
+    """The pose the tracker maps detections with: ``pose_feedback.source`` of the scenario."""
+    source = scenario.pose_feedback.source
+    if source == "registered":
+        if scene.recording is None:
+            raise ScenarioError("pose_feedback.source 'registered' needs a recording")
+        return registered_pose_source(scenario, scene.recording.video_frame)
+    return {"commanded": commanded_pose, "oracle": true_pose}[source]
+
+
+def landing_error(scenario: Scenario) -> LandingError:
+    return LandingError(**scenario.camera.pose_error.model_dump())
+
+
+def build_world(
+    scenario: Scenario,
+    scene_rng: np.random.Generator,
+    camera: CameraSpec | None = None,
+    detector: DetectorSpec | None = None,
+) -> World:
+    """The world of ``scenario``: its scene, camera backend, detector and pose source.
+
+    camera : the backend, by default ``camera.backend`` of the scenario ('simulated' for the
+    synthetic scene, 'virtual' for a recording); detector : by default ``detector.kind``.
+    """
+    scene = build_scene(scenario, scene_rng)
+    default_backend = "virtual" if scenario.recording is not None else "simulated"
+    backend = resolve("cameras", camera or scenario.camera.backend or default_backend, scenario, scene, "people")
+    found_by = resolve("detectors", detector or scenario.detector.kind, scenario, scene, "detect")
+    return World(
+        camera=scene.camera,
+        grid=scene.grid,
+        truth=scene.truth,
+        backend=backend,
+        detector=found_by,
+        area_bounds_m=scene.area_bounds_m,
+        start_action=widest_view_action(scene.camera, scene.grid, scene.area_bounds_m),
+        pose_source=pose_source(scenario, scene),
+        landing_error=landing_error(scenario),
+    )
