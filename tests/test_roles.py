@@ -216,3 +216,26 @@ def test_a_run_can_be_rescored_from_its_files_with_motmetrics_alone(tmp_path):
     detections = np.genfromtxt(tmp_path / "detections.csv", delimiter=",", names=True)
     assert len(detections) == expected["detections"]
     assert detections["height_px"].mean() == pytest.approx(expected["height_px"], abs=1e-3)
+
+
+class Sweep:
+    """Commands the camera continuously: half a degree of pan more every step, off the action grid."""
+
+    def choose(self, context):
+        return context.current_pose + [0.5, 0.0, 0.0]
+
+
+def test_a_policy_may_command_poses_off_the_grid():
+    episode = run_episode(SCENARIO, Sweep(), 0)
+    assert np.all(episode.actions == -1)
+    np.testing.assert_allclose(np.diff(episode.commanded[:, 0]), 0.5)
+    np.testing.assert_array_equal(episode.poses, episode.commanded)
+
+
+def test_a_pose_that_is_not_a_pose_is_refused():
+    class Broken:
+        def choose(self, context):
+            return [1.0, np.nan, 1.0]
+
+    with pytest.raises(ValueError, match="expected \\(pan_deg, tilt_deg, zoom\\), all finite"):
+        run_episode(SCENARIO, Broken(), 0)

@@ -53,8 +53,8 @@ class Episode:
 
     truth : the people.
     camera : the PTZ camera that looked; area_bounds_m : [[x0, y0], [x1, y1]] where people can be.
-    actions : (T,) flat action index taken at each step; commanded poses are ``grid.poses[actions]``.
-    commanded : (T, 3) the poses of the actions.
+    actions : (T,) flat action index taken at each step (-1 where the policy commanded a pose off the grid).
+    commanded : (T, 3) the poses the camera was sent to.
     poses : (T, 3) the poses the camera took, as (pan_deg, tilt_deg, zoom): the actions' poses
         unless the camera lands off them.
     tracker_poses : (T, 3) the poses the tracker mapped detections with.
@@ -81,6 +81,17 @@ class Episode:
 PER_STEP = ("actions", "commanded", "poses", "tracker_poses", "pose_known", "decision_s", "tracks", "detections")
 
 
+def command(grid: ActionGrid, choice: int | np.ndarray) -> tuple[int, np.ndarray]:
+    """A policy's choice as (flat action index, or -1 for a pose off the grid; the (3,) commanded pose)."""
+    if np.ndim(choice) == 0:
+        action = int(choice)
+        return action, grid.poses[action]
+    pose = np.asarray(choice, dtype=float)
+    if pose.shape != (3,) or not np.all(np.isfinite(pose)):
+        raise ValueError(f"a policy chose the pose {pose!r}; expected (pan_deg, tilt_deg, zoom), all finite")
+    return -1, pose
+
+
 def episode_seeds(seed: int) -> list[np.random.SeedSequence]:
     """The independent streams of an episode: scene, detector, policy, the camera's landing errors."""
     return np.random.SeedSequence(seed).spawn(4)
@@ -94,16 +105,18 @@ def run_loop(world: World, policy: Policy, tracker: Tracker, seed: int) -> Episo
     policy_rng = np.random.default_rng(policy_seed)
     landing_rng = np.random.default_rng(landing_seed)
 
-    action = world.start_action
+    grid = world.grid
+    nearest, commanded = world.start_action, grid.poses[world.start_action]
     per_step: dict[str, list] = {name: [] for name in PER_STEP}
     for step in range(steps):
         predicted = tracker.predict()
-        context = DecisionContext(step, action, world.grid.reachable(action), predicted, policy_rng)
-        previous_action, started = action, time.perf_counter()
-        action = int(policy.choose(context))
+        context = DecisionContext(step, nearest, grid.reachable(nearest), predicted, policy_rng, commanded)
+        previous, started = commanded, time.perf_counter()
+        choice = policy.choose(context)
         decision_s = time.perf_counter() - started
-        commanded = world.grid.poses[action]
-        if step == 0 or action != previous_action:
+        action, commanded = command(grid, choice)
+        nearest = action if action >= 0 else grid.nearest(commanded)
+        if step == 0 or not np.array_equal(commanded, previous):
             pose = landed_pose(commanded, world.landing_error, landing_rng)
         believed = world.pose_source(step, commanded, pose)
         tracker_pose = commanded if believed is None else believed

@@ -64,8 +64,9 @@ class Tracker(Protocol):
 
 
 class Policy(Protocol):
-    """Chooses the next action; may keep state across the steps of one episode."""
+    """Chooses where the camera looks next; may keep state across the steps of one episode."""
 
-    def choose(self, context: DecisionContext) -> int:
-        """The flat index of the next action, one of ``context.reachable``."""
+    def choose(self, context: DecisionContext) -> int | np.ndarray:
+        """The flat index of the next grid action, one of ``context.reachable``; or, for a policy that
+        commands the camera continuously (and keeps to its mechanics itself), a (3,) pose."""
         ...

@@ -154,10 +154,12 @@ class DecisionContext:
     """What a policy knows when it picks the next pose.
 
     step : time step being decided (0-based).
-    current_action : flat index of the pose the camera is at now.
+    current_action : flat index of the grid action the camera was sent to last (the nearest one
+        when it was last sent to a pose off the grid).
     reachable : flat indices of the actions the mechanics allow next.
     tracks : the tracks predicted to this step (``x-``, ``P-``), before observing.
     rng : the run's random generator; policies draw only from it.
+    current_pose : (3,) the pose the camera was last sent to (pan_deg, tilt_deg, zoom).
     """
 
     step: int
@@ -165,3 +167,4 @@ class DecisionContext:
     reachable: np.ndarray
     tracks: Tracks
     rng: np.random.Generator
+    current_pose: np.ndarray = field(default_factory=lambda: np.full(3, np.nan))

@@ -61,6 +61,15 @@ class ActionGrid:
         """Flat indices of the actions reachable in one step from ``current``."""
         return np.flatnonzero(self.reachable_mask(current))
 
+    def nearest(self, pose) -> int:
+        """The flat index of the grid action nearest to ``pose`` (3,), axis by axis."""
+        indices = [int(np.argmin(np.abs(values - value))) for values, value in zip(self.axes, pose, strict=True)]
+        return int(self.index(*indices))
+
+    @property
+    def axes(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        return self.pan_deg, self.tilt_deg, self.zoom
+
     def step_towards(self, current: int, target: int) -> int:
         """The reachable action closest (in grid steps) to ``target``."""
         here = self.axis_indices[current]
