@@ -4,10 +4,11 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.stats import multivariate_normal
 
+from overhead import overhead_scenario
 from ptztrack.builders.episode import make_policy
 from ptztrack.builders.factories import recall_model
 from ptztrack.builders.world import action_grid, build_world, ptz_camera
-from ptztrack.config import Control, Scenario, scenario_from_dict
+from ptztrack.config import Control
 from ptztrack.control.gaussian_rectangle import bivariate_normal_cdf, gaussian_rectangle_probability
 from ptztrack.control.information_gain import (
     action_geometry,
@@ -28,12 +29,12 @@ from ptztrack.geometry.ptz import (
 from ptztrack.track import kalman
 from ptztrack.types import DecisionContext, Tracks
 
-SCENARIO = Scenario()
+SCENARIO = overhead_scenario()
 
 
 def detector_model(kind="realistic"):
     """The recall model the policies plan with for the scenario's detector of ``kind``."""
-    return recall_model(scenario_from_dict({"detector": {"kind": kind}}))
+    return recall_model(overhead_scenario({"detector": {"kind": kind}}))
 
 
 def policy_for(name, scenario):
@@ -149,7 +150,7 @@ def single_track(mean_xy, sigma_m):
         ids=np.array([0]),
         mean=np.array([[*mean_xy, 0.0, 0.0]]),
         covariance=np.diag([sigma_m**2, sigma_m**2, 0.1, 0.1])[None],
-        missed_steps=np.array([0]),
+        existence=np.array([0.99]),
         hits=np.array([1]),
         next_id=1,
     )
@@ -159,7 +160,7 @@ def single_track(mean_xy, sigma_m):
 def test_with_one_person_and_no_occluders_smpl_and_intg_choose_the_same_action(kind):
     """Same action, up to ties: where both choices are worth the same to intg (within 0.1 %),
     the sampled estimate may pick either."""
-    scenario = scenario_from_dict({"detector": {"kind": kind}, "control": {"beta": 0.0}})
+    scenario = overhead_scenario({"detector": {"kind": kind}, "control": {"beta": 0.0}})
     rng = np.random.default_rng(11)
     agreements = 0
     for trial in range(12):
@@ -229,7 +230,7 @@ def test_zoom_leaves_occluded_fractions_exactly_unchanged():
 
 
 def test_patrolling_term_grows_while_unobserved_and_clears_where_the_camera_looks():
-    scenario = scenario_from_dict({"detector": {"kind": "ideal"}, "control": {"beta": 1.0}})
+    scenario = overhead_scenario({"detector": {"kind": "ideal"}, "control": {"beta": 1.0}})
     policy = policy_for("intg", scenario)
     exploration = policy.exploration
     wide = int(np.argmax(exploration.detection_probability.sum(axis=1)))
@@ -252,12 +253,13 @@ def test_without_tracks_the_patrolling_term_moves_the_camera_and_without_it_the_
     empty = Tracks.empty()
     start = int(GRID.index(3, 4, 1))
     context = DecisionContext(0, start, GRID.reachable(start), empty, np.random.default_rng(0))
-    assert policy_for("intg", scenario_from_dict({"control": {"beta": 0.0}})).choose(context) == start
-    explorer = policy_for("intg", scenario_from_dict({"control": {"beta": 1.0}}))
+    assert policy_for("intg", overhead_scenario({"control": {"beta": 0.0}})).choose(context) == start
+    explorer = policy_for("intg", overhead_scenario({"control": {"beta": 1.0}}))
     moves = [explorer.choose(context) for _ in range(3)]
     assert any(move != start for move in moves)
 
 
-def test_control_defaults_are_documented():
+def test_control_defaults_are_the_papers_synthetic_protocol():
+    """M = 100 samples, and no patrolling term: in section 5.1 "the targets are always in the scene"."""
     assert Control().samples == 100
-    assert Control().beta == 1.0
+    assert Control().beta == 0.0

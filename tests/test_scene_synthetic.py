@@ -3,13 +3,16 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from ptztrack.config import People
-from ptztrack.scene.synthetic import walk_people
+from ptztrack.scene.synthetic import Crowd, walk_people
 
 AREA = (15.0, 15.0)
 
 
 def walk(seed, frames=200, **people):
-    return walk_people(People(**people), AREA, frames, 5.0, np.random.default_rng(seed))
+    """Walkers alone unless ``pairs`` is given."""
+    people = People(**{"paired_fraction": 0.0, **people})
+    crowd = Crowd(**people.model_dump(exclude={"paired_fraction"}), pairs=people.pairs)
+    return walk_people(crowd, AREA, frames, 5.0, np.random.default_rng(seed))
 
 
 @settings(deadline=None, max_examples=25)
@@ -47,3 +50,32 @@ def test_people_entering_and_leaving_do_so_once_through_the_border():
             assert np.min(np.abs(np.concatenate([last, 15.0 - last]))) < 0.5, "leaves near the border"
     assert not present[0].all(), "entries are spread over time"
     assert not present[-1].all(), "some have left by the end"
+
+
+@settings(deadline=None, max_examples=25)
+@given(seed=st.integers(0, 2**32 - 1), enter_leave=st.booleans())
+def test_a_pair_walks_side_by_side_the_second_on_the_left_of_the_first(seed, enter_leave):
+    truth = walk(seed, frames=150, count=7, paired_fraction=0.85, enter_leave=enter_leave, stay_s=(5.0, 10.0))
+    for leader in (0, 2, 4):
+        mate = leader + 1
+        np.testing.assert_array_equal(truth.present[:, leader], truth.present[:, mate])
+        both = np.flatnonzero(truth.present[:, leader])[1:]
+        offset = truth.positions_m[both, mate] - truth.positions_m[both, leader]
+        # The leader's walk into its position: the direction the pair faces there.
+        heading = truth.positions_m[both, leader] - truth.positions_m[both - 1, leader]
+        inside = np.all((truth.positions_m[both, mate] > 0) & (truth.positions_m[both, mate] < 15.0), axis=-1)
+        # Steps of the leader's full stride (not stopped or clipped at the border).
+        stride = np.linalg.norm(heading, axis=-1)
+        moving = np.abs(stride - np.median(stride)) < 1e-9
+        # 0.75 m apart, at a right angle to the leader's walk, to its left (positive cross product)
+        np.testing.assert_allclose(np.linalg.norm(offset[inside], axis=-1), 0.75)
+        cross = heading[:, 0] * offset[:, 1] - heading[:, 1] * offset[:, 0]
+        dot = np.sum(heading * offset, axis=-1)
+        assert np.all(cross[inside & moving] > 0)
+        np.testing.assert_allclose(dot[inside & moving], 0.0, atol=1e-9)
+    assert truth.present[:, 6].any()
+
+
+def test_the_paired_fraction_makes_whole_pairs():
+    assert [People(count=count, paired_fraction=0.85).pairs for count in (0, 1, 3, 7, 20)] == [0, 0, 1, 3, 8]
+    assert People(count=7, paired_fraction=1.0).pairs == 3

@@ -216,12 +216,13 @@ def test_a_lone_measurement_in_two_gates_keeps_only_the_likelier_track_alive_and
     tracks = start_tracks(
         feet_px([[7.0, 6.0], [7.3, 6.0]]), CAMERA, POSE, V, config.initial_speed_sigma_m_s, first_id=0
     )
-    # One measurement near both tracks, nearer track 0; another far from both.
+    # One measurement near both tracks, nearer track 0; another far from both. Track 1 counts as
+    # missed, where it was detectable with probability 1/2: 0.5 * 0.5 / (1 - 0.25) = 1/3.
     updated = update_tracks(
-        predict_tracks(tracks, F, U), feet_px([[7.1, 6.0], [12.0, 9.0]]), CAMERA, POSE, V, config
+        predict_tracks(tracks, F, U), feet_px([[7.1, 6.0], [12.0, 9.0]]), CAMERA, POSE, V, config, np.full(2, 0.5)
     ).tracks
     np.testing.assert_array_equal(updated.ids, [0, 1, 2])
-    np.testing.assert_array_equal(updated.missed_steps, [0, 1, 0])
+    np.testing.assert_allclose(updated.existence, [0.99, 1 / 3, 0.5])
     np.testing.assert_array_equal(updated.hits, [2, 1, 1])
     # Both tracks moved part of the way towards the shared measurement.
     assert 7.0 < updated.mean[0, 0] < 7.1 < updated.mean[1, 0] < 7.3
@@ -237,7 +238,7 @@ def test_two_people_each_detected_keep_both_tracks_alive_even_inside_each_others
         predict_tracks(tracks, F, U), feet_px([[7.0, 6.0], [7.3, 6.0]]), CAMERA, POSE, V, CJPDAF
     ).tracks
     np.testing.assert_array_equal(updated.ids, [0, 1])
-    np.testing.assert_array_equal(updated.missed_steps, [0, 0])
+    np.testing.assert_array_equal(updated.existence, [0.99, 0.99])
     np.testing.assert_array_equal(updated.hits, [2, 2])
 
 
@@ -257,20 +258,22 @@ def test_a_measurement_only_in_the_gate_of_a_track_that_dies_starts_a_new_one():
     np.testing.assert_allclose(updated.mean[0, :2], [7.7, 6.1], atol=1e-9)
 
 
-def test_missed_steps_count_only_in_view_and_a_track_dies_after_the_allowed_ones():
+def test_a_track_out_of_view_keeps_its_existence_and_one_missed_in_view_loses_it():
     F, U = constant_velocity_model(0.2, ACCELERATION_SIGMA_M_S2)
-    config = replace(CJPDAF, max_missed_steps=2, max_position_sigma_m=100.0)
-    tracks = start_tracks(feet_px([[7.5, 6.0]]), CAMERA, POSE, V, config.initial_speed_sigma_m_s, first_id=0)
+    tracks = start_tracks(feet_px([[7.5, 6.0]]), CAMERA, POSE, V, CJPDAF.initial_speed_sigma_m_s, first_id=0)
     looking_away = np.array([60.0, 40.0, 4.0])
     for _ in range(3):
-        tracks = update_tracks(predict_tracks(tracks, F, U), np.zeros((0, 2)), CAMERA, looking_away, V, config).tracks
-    assert len(tracks) == 1 and tracks.missed_steps[0] == 0
+        tracks = update_tracks(predict_tracks(tracks, F, U), np.zeros((0, 2)), CAMERA, looking_away, V, CJPDAF).tracks
+    assert len(tracks) == 1 and tracks.existence[0] == 0.5
     lengths = []
-    for _ in range(3):
-        tracks = update_tracks(predict_tracks(tracks, F, U), feet_px([[2.0, 12.0]]), CAMERA, POSE, V, config).tracks
+    for _ in range(4):
+        predicted = predict_tracks(tracks, F, U)
+        detectable = np.where(predicted.ids == 0, 0.5, 1.0)
+        tracks = update_tracks(predicted, feet_px([[2.0, 12.0]]), CAMERA, POSE, V, CJPDAF, detectable).tracks
         lengths.append(sorted(tracks.ids.tolist()))
-    # The far detection starts a track of its own each step (it is gated by none), then keeps it alive.
-    assert lengths == [[0, 1], [0, 1], [1]]
+    # Track 0, missed where it was detectable half the time: 0.5 -> 1/3 -> 1/5 -> 1/9 -> 1/17, deleted
+    # below 0.1. The far detection starts a track of its own (it is in nobody's gate), then keeps it alive.
+    assert lengths == [[0, 1], [0, 1], [0, 1], [1]]
 
 
 @pytest.mark.parametrize("association", ["cjpdaf", "hungarian"])

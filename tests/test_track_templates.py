@@ -115,7 +115,7 @@ def test_a_track_not_predicted_in_the_image_gives_no_measurement(ground_m, pose)
     image = draw_person(noise_image(0), [320.0, 300.0])
     templates = refresh_templates({}, [0], image, CAMERA, POSE, [0], [[320.0, 300.0]], HEIGHT_M, WIDTH_M)
     tracks = tracks_at([[320.0, 300.0]])
-    tracks = Tracks(tracks.ids, np.array([[*ground_m, 0.0, 0.0]]), tracks.covariance, tracks.missed_steps, tracks.hits)
+    tracks = Tracks(tracks.ids, np.array([[*ground_m, 0.0, 0.0]]), tracks.covariance, tracks.existence, tracks.hits)
     found = template_measurements(image, CAMERA, pose, tracks, templates, V, HEIGHT_M, WIDTH_M, min_similarity=0.0)
     assert len(found.feet_px) == len(found.track_ids) == 0
 
@@ -151,7 +151,7 @@ def test_each_detected_or_new_track_is_paired_with_its_detection(association):
     F, U = constant_velocity_model(0.2, ACCELERATION_SIGMA_M_S2)
     predicted = predict_tracks(start_tracks(feet_px, CAMERA, POSE, V, config.initial_speed_sigma_m_s, 3), F, U)
     detections_px = np.array([[560.0, 350.0], [202.0, 299.0]])  # somebody new, and track 3 moved
-    update = update_tracks(predicted, detections_px, CAMERA, POSE, V, config)
+    update = update_tracks(predicted, detections_px, CAMERA, POSE, V, config, np.full(2, 0.5))
     assert set(update.tracks.ids) == {3, 4, 5}
     np.testing.assert_array_equal(update.track_ids, [3, 5])
     np.testing.assert_array_equal(update.measurement_index, [1, 0])
@@ -163,7 +163,8 @@ def test_a_detection_the_cjpdaf_shares_between_tracks_is_paired_with_none(associ
     F, U = constant_velocity_model(0.2, ACCELERATION_SIGMA_M_S2)
     feet_px = np.array([[298.0, 300.0], [302.0, 302.0], [302.0, 298.0]])
     predicted = predict_tracks(start_tracks(feet_px, CAMERA, POSE, V, config.initial_speed_sigma_m_s, 0), F, U)
-    update = update_tracks(predicted, np.array([[301.0, 300.0]]), CAMERA, POSE, V, config)
+    # Nobody was surely detectable: the missed tracks live on, and the shared detection starts none.
+    update = update_tracks(predicted, np.array([[301.0, 300.0]]), CAMERA, POSE, V, config, np.full(3, 0.5))
     assert len(update.track_ids) == len(update.measurement_index) == paired
 
 

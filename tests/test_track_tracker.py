@@ -8,6 +8,7 @@ from ptztrack.track import kalman
 from ptztrack.track.kalman import constant_velocity_model
 from ptztrack.track.tracker import (
     TrackerParameters,
+    existence_after_miss,
     observation_matrix,
     predict_tracks,
     start_tracks,
@@ -22,9 +23,9 @@ V = 4.0 * np.eye(2)
 ACCELERATION_SIGMA_M_S2 = Tracker().acceleration_sigma_m_s2
 
 
-def parameters(**fields) -> TrackerParameters:
-    """The tracker's parameters of a scenario with these ``tracker`` fields."""
-    return tracker_parameters(scenario_from_dict({"tracker": fields}))
+def parameters(people: dict | None = None, **fields) -> TrackerParameters:
+    """The tracker's parameters of a synthetic scenario with these ``tracker`` fields (and ``people``)."""
+    return tracker_parameters(scenario_from_dict({"tracker": fields, "people": people or {}}))
 
 
 CONFIG = parameters()
@@ -88,36 +89,58 @@ def test_hungarian_assignment_ignores_detection_order_and_gates_outliers():
     updated = update_tracks(predict_tracks(tracks, F, U), detections, CAMERA, POSE, V, CONFIG).tracks
     np.testing.assert_array_equal(updated.ids, [0, 1, 2])
     np.testing.assert_allclose(updated.mean[:, :2], [[5.0, 5.0], [9.0, 7.0], [14.0, 1.0]], atol=1e-6)
-    np.testing.assert_array_equal(updated.missed_steps, 0)
+    # The two detected tracks are as alive as detection makes them; the new one is a coin toss.
+    np.testing.assert_array_equal(updated.existence, [0.99, 0.99, 0.5])
 
 
-def test_a_track_in_view_is_deleted_after_the_allowed_missed_steps_but_not_one_out_of_view():
+def test_a_miss_lowers_existence_by_bayes_rule_as_much_as_the_person_was_detectable():
+    # r (1 - q) / (1 - r q): 0.99 * 0.1 / (1 - 0.891) for q = 0.9; unchanged for q = 0; 0 for q = 1.
+    np.testing.assert_allclose(
+        existence_after_miss([0.99, 0.99, 0.5, 0.5], [0.9, 0.0, 1.0, 0.5]), [0.099 / 0.109, 0.99, 0.0, 0.25 / 0.75]
+    )
+
+
+def detected_track(config):
+    """One track at (7.5, 6) detected twice: existence ``existence_when_detected``."""
     F, U = constant_velocity_model(0.2, ACCELERATION_SIGMA_M_S2)
-    config = parameters(max_missed_steps=2, max_position_sigma_m=100.0)
-    tracks = start_tracks(feet_px([[7.5, 6.0]]), CAMERA, POSE, V, config.initial_speed_sigma_m_s, first_id=0)
+    tracks = start_tracks(feet_px([[7.5, 6.0]]), CAMERA, POSE, V, config.initial_speed_sigma_m_s, 0)
+    return update_tracks(predict_tracks(tracks, F, U), feet_px([[7.5, 6.0]]), CAMERA, POSE, V, config).tracks, F, U
+
+
+def test_a_person_out_of_view_is_never_forgotten_and_one_missed_in_view_soon_is():
+    """Where people never leave, a track the camera does not look at lives on however uncertain it
+    grows; missed where the detector would have found the person with probability 0.9, it goes at
+    the third miss (0.99 -> 0.908 -> 0.497 -> 0.090, below 0.1)."""
+    config = parameters()
+    tracks, F, U = detected_track(config)
     looking_away = np.array([60.0, 40.0, 4.0])
-    for _ in range(5):
+    for _ in range(50):
         tracks = update_tracks(predict_tracks(tracks, F, U), np.zeros((0, 2)), CAMERA, looking_away, V, config).tracks
-    assert len(tracks) == 1 and tracks.missed_steps[0] == 0
+    assert len(tracks) == 1 and tracks.existence[0] == 0.99 and tracks.position_sigma_m[0] > 5.0
+    tracks, F, U = detected_track(config)
     lengths = []
     for _ in range(3):
-        tracks = update_tracks(predict_tracks(tracks, F, U), np.zeros((0, 2)), CAMERA, POSE, V, config).tracks
+        predicted = predict_tracks(tracks, F, U)
+        tracks = update_tracks(predicted, np.zeros((0, 2)), CAMERA, POSE, V, config, np.array([0.9])).tracks
         lengths.append(len(tracks))
     assert lengths == [1, 1, 0]
 
 
-def test_a_track_is_deleted_when_its_uncertainty_grows_too_large():
-    F, U = constant_velocity_model(0.2, ACCELERATION_SIGMA_M_S2)
-    config = parameters(max_position_sigma_m=1.0, max_missed_steps=1000)
-    tracks = start_tracks(feet_px([[7.5, 6.0]]), CAMERA, POSE, V, config.initial_speed_sigma_m_s, first_id=0)
-    looking_away = np.array([60.0, 40.0, 4.0])
-    alive = 0
-    while len(tracks):
-        tracks = update_tracks(predict_tracks(tracks, F, U), np.zeros((0, 2)), CAMERA, looking_away, V, config).tracks
-        alive += 1
-        assert alive < 100
-    # position sd 0.9 m/s * t (initial velocity spread) passes 1 m between 1.0 s and 1.2 s
-    assert alive in (5, 6)
+def test_uncertainty_deletes_a_track_only_where_people_can_leave():
+    leaving, staying = parameters({"enter_leave": True}, max_position_sigma_m=1.0), parameters(max_position_sigma_m=1.0)
+    assert staying.max_position_sigma_m == np.inf
+    lifetimes = []
+    for config in (leaving, staying):
+        tracks, F, U = detected_track(config)
+        looking_away = np.array([60.0, 40.0, 4.0])
+        alive = 0
+        while len(tracks) and alive < 30:
+            predicted = predict_tracks(tracks, F, U)
+            tracks = update_tracks(predicted, np.zeros((0, 2)), CAMERA, looking_away, V, config).tracks
+            alive += len(tracks)
+        lifetimes.append(alive)
+    # position sd 0.9 m/s * t (the velocity's spread after two detections) passes 1 m after about a second
+    assert 3 <= lifetimes[0] <= 7 and lifetimes[1] == 30
 
 
 def test_with_confirmation_a_one_off_detection_is_never_reported_and_dies_at_its_first_miss():
@@ -130,8 +153,9 @@ def test_with_confirmation_a_one_off_detection_is_never_reported_and_dies_at_its
     np.testing.assert_array_equal(tracks.ids, [0])
     np.testing.assert_array_equal(tracks.hits, [2])
     np.testing.assert_array_equal(tracks.confirmed(config.confirmation_hits).ids, [0])
-    # Once confirmed, a track survives misses as before.
-    tracks = update_tracks(predict_tracks(tracks, F, U), np.zeros((0, 2)), CAMERA, POSE, V, config).tracks
+    # Once detected twice, a track survives a miss where the detector would have found it nine times in ten.
+    predicted = predict_tracks(tracks, F, U)
+    tracks = update_tracks(predicted, np.zeros((0, 2)), CAMERA, POSE, V, config, np.array([0.9])).tracks
     np.testing.assert_array_equal(tracks.confirmed(config.confirmation_hits).ids, [0])
 
 
@@ -139,12 +163,15 @@ def test_a_track_measured_by_its_own_template_is_updated_without_becoming_more_o
     tracks = start_tracks(
         feet_px(np.array([[7.0, 6.0], [9.0, 7.0]])), CAMERA, POSE, V, CONFIG.initial_speed_sigma_m_s, 0
     )
-    tracks = update_tracks(tracks, feet_px(np.array([[7.0, 6.0]])), CAMERA, POSE, V, CONFIG).tracks  # track 1 missed
+    # track 1 missed where the detector would have found it half the time
+    tracks = update_tracks(
+        tracks, feet_px(np.array([[7.0, 6.0]])), CAMERA, POSE, V, CONFIG, np.array([1.0, 0.5])
+    ).tracks
     moved = feet_px(np.array([[9.1, 7.0]]))
     updated = update_own_tracks(tracks, [1], moved, CAMERA, POSE, V, CONFIG.max_position_sigma_m)
     np.testing.assert_array_equal(updated.ids, tracks.ids)
     np.testing.assert_array_equal(updated.hits, tracks.hits)
-    np.testing.assert_array_equal(updated.missed_steps, tracks.missed_steps)
+    np.testing.assert_array_equal(updated.existence, tracks.existence)
     # Track 0 had no measurement; track 1 moved towards it, with the Kalman gain of its own covariance.
     np.testing.assert_array_equal(updated.mean[0], tracks.mean[0])
     C = observation_matrix(CAMERA, POSE, tracks.mean[1:])

@@ -38,7 +38,7 @@ from ptztrack.evaluate.msg import (
 )
 from ptztrack.evaluate.registration import summarise_registration
 from ptztrack.evaluate.report import RUN_FILES, write_atomically, write_figure, write_outputs
-from ptztrack.evaluate.tables import format_table, summarise
+from ptztrack.evaluate.tables import format_table, paired_difference, summarise
 from ptztrack.evaluate.video import view_renderer
 from ptztrack.geometry.calibration import CalibrationError
 from ptztrack.geometry.registration import RegistrationIndexError
@@ -217,6 +217,11 @@ def _run_table(args: argparse.Namespace, cells: list, title: str) -> int:
     print(f"{len(cells)} episodes, {args.executor} executor", file=sys.stderr)
     summary = summarise(run_cells(cells, run_cell, args.executor, args.workers, print_progress))
     print(format_table(summary, title))
+    labels = {row["label"] for row in summary}
+    if {"smpl", "intg"} <= labels and summary[0]["sequences"] > 1:
+        mean, error, count = paired_difference(summary, "smpl", "intg")
+        paired = f"paired over {count} sequences, standard error"
+        print(f"smpl - intg: {100 * mean:+.1f} +- {100 * error:.1f} MOTA points ({paired})")
     if args.json is not None:
         write_atomically(args.json, (json.dumps(summary, indent=2) + "\n").encode())
         print(f"wrote {args.json}")

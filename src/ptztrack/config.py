@@ -43,13 +43,19 @@ class _Strict(BaseModel):
 
 
 class People(_Strict):
+    """The synthetic crowd (:mod:`ptztrack.scene.synthetic`). paired_fraction : the share of the
+    ``count`` people who walk in pairs, side by side ``pair_spacing_m`` apart (pairs: the fraction
+    of count / 2, rounded)."""
+
     count: int = Field(7, ge=0)
     speed_m_s: tuple[PositiveFloat, PositiveFloat] = (1.0, 1.5)
     height_m: tuple[PositiveFloat, PositiveFloat] = (1.6, 1.9)
-    width_m: PositiveFloat = 0.5
+    width_m: PositiveFloat = 0.62
     turn_rate_sigma_deg_s: NonNegativeFloat = 40.0
     enter_leave: bool = False
     stay_s: tuple[PositiveFloat, PositiveFloat] = (8.0, 20.0)
+    paired_fraction: float = Field(0.85, ge=0, le=1)
+    pair_spacing_m: PositiveFloat = 0.75
 
     @model_validator(mode="after")
     def _intervals_ordered(self):
@@ -58,6 +64,11 @@ class People(_Strict):
             if high < low:
                 raise ValueError(f"{name} must be [low, high] with low <= high (got {[low, high]})")
         return self
+
+    @property
+    def pairs(self) -> int:
+        """How many pairs walk side by side (never more than there are people for)."""
+        return min(round(self.paired_fraction * self.count / 2), self.count // 2)
 
 
 class PoseError(_Strict):
@@ -79,9 +90,9 @@ class Camera(_Strict):
     """The PTZ camera. backend : a registered camera backend; by default 'simulated' for the
     synthetic scene and 'virtual' (the virtual PTZ camera) for a recording."""
 
-    position_m: tuple[float, float, PositiveFloat] = (7.5, -4.0, 7.0)
+    position_m: tuple[float, float, PositiveFloat] = (7.5, -6.0, 2.5)
     image_size_px: tuple[Annotated[int, Field(gt=0)], Annotated[int, Field(gt=0)]] = (640, 480)
-    f_min_px: PositiveFloat = 400.0
+    f_min_px: PositiveFloat = 325.0
     pose_error: PoseError = PoseError()
     backend: Annotated[str | None, _registered("cameras")] = None
     options: Options = Field(default_factory=dict)
@@ -122,7 +133,7 @@ class AxisRange(_Strict):
 
 class Actions(_Strict):
     pan_deg: AxisRange = AxisRange(start=-45.0, stop=45.0, count=7)
-    tilt_deg: AxisRange = AxisRange(start=15.0, stop=60.0, count=10)
+    tilt_deg: AxisRange = AxisRange(start=0.0, stop=24.0, count=10)
     zoom: tuple[Annotated[float, Field(ge=1)], ...] = (1.0, 2.0, 3.0, 4.0)
     max_steps: tuple[Annotated[int, Field(ge=0)], Annotated[int, Field(ge=0)], Annotated[int, Field(ge=0)]] = (
         2,
@@ -181,6 +192,11 @@ class Tracker(_Strict):
     its spatiogram around its prediction, at the scale the head/feet homology gives;
     :mod:`ptztrack.track.templates`). Needs a recording with a video.
     kind : a registered tracker (another package's, with ``options`` its parameters).
+    existence_at_birth, existence_when_detected, existence_to_delete : the track lifecycle, by the
+    probability that a track's person exists (:mod:`ptztrack.track.tracker`).
+    max_position_sigma_m : where people can leave the scene (a recording, or ``people.enter_leave``),
+    a track this uncertain is deleted; where they never leave, uncertainty deletes nobody.
+    report_position_sigma_m : a track more uncertain than this is kept but not reported.
     """
 
     kind: Annotated[str, _registered("trackers")] = "ekf"
@@ -188,9 +204,12 @@ class Tracker(_Strict):
     acceleration_sigma_m_s2: PositiveFloat = 1.5
     initial_speed_sigma_m_s: PositiveFloat = 0.9
     gate_probability: float = Field(0.99, gt=0, lt=1)
-    max_missed_steps: int = Field(5, ge=0)
+    existence_at_birth: float = Field(0.5, gt=0, lt=1)
+    existence_when_detected: float = Field(0.99, gt=0, lt=1)
+    existence_to_delete: float = Field(0.1, gt=0, lt=1)
     max_position_sigma_m: PositiveFloat = 2.0
     confirmation_hits: int = Field(1, ge=1)
+    report_position_sigma_m: PositiveFloat = 1.0
     association: Literal["hungarian", "cjpdaf"] = "hungarian"
     clutter_density_per_px2: NonNegativeFloat = 0.0
     measurement_source: Literal["detector", "spatiogram"] = "detector"
@@ -201,7 +220,7 @@ class Control(_Strict):
     """Parameters of the information-gain policies (paper sections 4 and 4.4)."""
 
     samples: int = Field(100, ge=1)
-    beta: NonNegativeFloat = 1.0
+    beta: NonNegativeFloat = 0.0
     person_height_m: PositiveFloat = 1.75
     exploration_cell_m: PositiveFloat = 1.0
     prior_occupancy: float = Field(0.05, ge=0, lt=1)
@@ -352,6 +371,8 @@ def pets_scenario(detector: str = "ideal", **overrides) -> Scenario:
             **(PETS_HOG_RECALL if detector == "hog" else {}),
         },
         "tracker": PETS_HOG_TRACKER if detector == "hog" else {},
+        # People come and go here (section 5.2): the patrolling term looks for them.
+        "control": {"beta": 1.0},
         "recording": recording,
     }
     return scenario_from_dict(data, "pets", **overrides)

@@ -87,7 +87,7 @@ class Tracks:
     ids : (n,) stable integer ids.
     mean : (n, 4) states [x_m, y_m, vx_m_s, vy_m_s].
     covariance : (n, 4, 4).
-    missed_steps : (n,) consecutive steps without an associated detection.
+    existence : (n,) probability that the track's person exists (is there to be seen).
     hits : (n,) steps with an associated detection, the one that started the track included.
     next_id : the id the next new track gets.
     """
@@ -95,7 +95,7 @@ class Tracks:
     ids: np.ndarray
     mean: np.ndarray
     covariance: np.ndarray
-    missed_steps: np.ndarray
+    existence: np.ndarray
     hits: np.ndarray
     next_id: int = 0
 
@@ -108,7 +108,7 @@ class Tracks:
             np.zeros(0, dtype=int),
             np.zeros((0, 4)),
             np.zeros((0, 4, 4)),
-            np.zeros(0, dtype=int),
+            np.zeros(0),
             np.zeros(0, dtype=int),
         )
 
@@ -118,7 +118,7 @@ class Tracks:
             ids=self.ids[keep],
             mean=self.mean[keep],
             covariance=self.covariance[keep],
-            missed_steps=self.missed_steps[keep],
+            existence=self.existence[keep],
             hits=self.hits[keep],
         )
 

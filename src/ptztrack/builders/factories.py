@@ -4,6 +4,8 @@ Policies and trackers are made from a scenario and its :class:`~ptztrack.loop.Wo
 camera backends and detectors from a scenario and its :class:`~ptztrack.builders.world.BuiltScene`.
 """
 
+import math
+from functools import partial
 from typing import Literal
 
 from ptztrack.camera.recorded import RecordedPTZ
@@ -11,6 +13,7 @@ from ptztrack.camera.simulated import SimulatedPTZ
 from ptztrack.config import Scenario
 from ptztrack.control.baselines import FixPolicy, PatrolPolicy, RandomPolicy, patrol_route, widest_view_action
 from ptztrack.control.exploration import exploration_map
+from ptztrack.control.information_gain import expected_detection_probability
 from ptztrack.control.information_policy import InformationGainPolicy
 from ptztrack.detect.hog import HogPeopleDetector
 from ptztrack.detect.simulated import AnnotationDetector, RecallDetector, RecallModel
@@ -18,14 +21,16 @@ from ptztrack.loop import World
 from ptztrack.scene.pets import RecordedVideo
 from ptztrack.track.kalman import constant_velocity_model
 from ptztrack.track.templates import TemplateTracker
-from ptztrack.track.tracker import EkfTracker, TrackerParameters, pixel_noise_covariance
+from ptztrack.track.tracker import DetectionModel, EkfTracker, TrackerParameters, pixel_noise_covariance
 
 TRACKER_FIELDS = (
     "initial_speed_sigma_m_s",
     "gate_probability",
-    "max_missed_steps",
-    "max_position_sigma_m",
+    "existence_at_birth",
+    "existence_when_detected",
+    "existence_to_delete",
     "confirmation_hits",
+    "report_position_sigma_m",
     "association",
     "clutter_density_per_px2",
 )
@@ -43,9 +48,30 @@ def pixel_noise(scenario: Scenario):
     return pixel_noise_covariance(scenario.detector.pixel_noise_px)
 
 
+def people_can_leave(scenario: Scenario) -> bool:
+    """A recording's people come and go; the synthetic scene's only with ``people.enter_leave``."""
+    return scenario.recording is not None or scenario.people.enter_leave
+
+
 def tracker_parameters(scenario: Scenario) -> TrackerParameters:
+    """The tracker's parameters; uncertainty deletes a track only where people can leave."""
     tracker = scenario.tracker
-    return TrackerParameters(**{name: getattr(tracker, name) for name in TRACKER_FIELDS})
+    max_position_sigma_m = tracker.max_position_sigma_m if people_can_leave(scenario) else math.inf
+    return TrackerParameters(
+        **{name: getattr(tracker, name) for name in TRACKER_FIELDS}, max_position_sigma_m=max_position_sigma_m
+    )
+
+
+def detection_model(scenario: Scenario, world: World) -> DetectionModel:
+    """What the tracker expects the detector to find: the policies' own model of it."""
+    return partial(
+        expected_detection_probability,
+        world.camera,
+        recall_model(scenario),
+        pixel_noise(scenario),
+        scenario.control.person_height_m,
+        scenario.people.width_m,
+    )
 
 
 def fix_policy(scenario: Scenario, world: World) -> FixPolicy:
@@ -138,7 +164,8 @@ def ekf_tracker(scenario: Scenario, world: World) -> EkfTracker | TemplateTracke
     ``tracker.measurement_source`` 'spatiogram', by colour templates between detector steps."""
     config = scenario.tracker
     F, U = constant_velocity_model(1.0 / scenario.frame_rate_hz, config.acceleration_sigma_m_s2)
-    tracker = EkfTracker(world.camera, F, U, pixel_noise(scenario), tracker_parameters(scenario))
+    parameters, model = tracker_parameters(scenario), detection_model(scenario, world)
+    tracker = EkfTracker(world.camera, F, U, pixel_noise(scenario), parameters, model)
     if config.measurement_source == "detector":
         return tracker
     height_m, width_m = scenario.control.person_height_m, scenario.people.width_m

@@ -62,7 +62,8 @@ def action_grid(scenario: Scenario) -> ActionGrid:
 
 
 def crowd(scenario: Scenario) -> Crowd:
-    return Crowd(**scenario.people.model_dump())
+    people = scenario.people.model_dump(exclude={"paired_fraction"})
+    return Crowd(**people, pairs=scenario.people.pairs)
 
 
 def build_scene(scenario: Scenario, scene_rng: np.random.Generator) -> BuiltScene:

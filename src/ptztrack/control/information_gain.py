@@ -32,6 +32,7 @@ from ptztrack.geometry.ptz import (
     PTZCamera,
     ground_to_image,
     head_from_feet_homology,
+    look_at,
     plane_homography,
     project_people,
 )
@@ -217,6 +218,33 @@ def _detection_weight_sampled(
                 p = realistic_recall(feet_v - head_v, kd, r0_px) if realistic else 1.0
                 alpha[action, track] += p * visible_fraction[sample, track]
     return alpha / M
+
+
+def expected_detection_probability(
+    camera: PTZCamera,
+    recall: RecallModel,
+    V,
+    person_height_m: float,
+    person_width_m: float,
+    mean_m,
+    position_cov_m2,
+    pose,
+) -> np.ndarray:
+    """The probability (n,) that the detector finds each predicted person at ``pose``, were it there.
+
+    ``alpha`` of equation 8 at the pose (feet and head in the image, recall at the person's size,
+    over the prediction's uncertainty), times the fraction of the person not hidden by the other
+    tracked people at their predicted positions (seen from the view centred on them, as 'smpl'
+    does). The tracker's existence update reads it (:mod:`ptztrack.track.tracker`).
+    mean_m : (n, 2); position_cov_m2 : (n, 2, 2); V : (2, 2) px^2.
+    """
+    mean_m = np.asarray(mean_m, dtype=float)
+    if len(mean_m) == 0:
+        return np.zeros(0)
+    geometry = action_geometry(camera, np.asarray(pose, dtype=float)[None], person_height_m)
+    alpha = detection_weight_integral(camera, geometry, recall, mean_m, position_cov_m2, V)[0]
+    centred = project_people(camera, look_at(camera, mean_m.mean(axis=0), 1.0), mean_m, person_height_m, person_width_m)
+    return alpha * (1.0 - occluded_fraction(centred.box_px, centred.range_m, centred.in_front))
 
 
 def detection_weight_sampled(

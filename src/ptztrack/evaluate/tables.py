@@ -12,20 +12,50 @@ SUMMARY_KEYS = ("mota", "motp_m", "height_px", "detections", "zoom")
 
 def summarise(rows: Sequence[dict]) -> list[dict]:
     """Per table column, in the order of first appearance, the mean over sequences of the paper's figures
-    (the paper averages per-sequence results)."""
+    (the paper averages per-sequence results), with ``instances`` (person-instances per sequence),
+    ``mota_per_sequence`` (in seed order, so that columns pair up sequence by sequence) and
+    ``mota_se`` (the standard error of the mean; 0 for one sequence)."""
     summary = []
     for label in dict.fromkeys(row["label"] for row in rows):
-        mine = [row for row in rows if row["label"] == label]
+        mine = sorted((row for row in rows if row["label"] == label), key=lambda row: row["seed"])
         means = {key: float(np.mean([row[key] for row in mine])) for key in SUMMARY_KEYS}
+        mota = [row["mota"] for row in mine]
         first = mine[0]
         summary.append(
-            {"strategy": first["strategy"], "label": label, "beta": first["beta"], "sequences": len(mine), **means}
+            {
+                "strategy": first["strategy"],
+                "label": label,
+                "beta": first["beta"],
+                "sequences": len(mine),
+                **means,
+                "mota_se": standard_error(mota),
+                "instances": float(np.mean([row["objects"] for row in mine])),
+                "mota_per_sequence": mota,
+            }
         )
     return summary
 
 
+def standard_error(values) -> float:
+    """The standard error of the mean of ``values`` (sample standard deviation / sqrt(n)); 0 for one value."""
+    values = np.asarray(values, dtype=float)
+    return float(values.std(ddof=1) / np.sqrt(len(values))) if len(values) > 1 else 0.0
+
+
+def paired_difference(summary: Sequence[dict], first: str, second: str) -> tuple[float, float, int]:
+    """The mean per-sequence MOTA difference of column ``first`` minus column ``second``, its
+    standard error and the number of sequences (the columns must share their sequences)."""
+    columns = {row["label"]: row for row in summary}
+    a, b = (np.asarray(columns[label]["mota_per_sequence"]) for label in (first, second))
+    if len(a) != len(b):
+        raise ValueError(f"{first} and {second} ran {len(a)} and {len(b)} sequences: they do not pair up")
+    difference = a - b
+    return float(difference.mean()), standard_error(difference), len(difference)
+
+
 def format_table(summary: Sequence[dict], title: str = "") -> str:
-    """The paper's layout: a row per figure, a column per strategy."""
+    """The paper's layout: a row per figure, a column per strategy; under MOTA its standard error
+    over the sequences (in points)."""
     width = max(len(DISPLAY[key][0]) for key in SUMMARY_KEYS)
     columns = [max(10, len(row["label"]) + 2) for row in summary]
     lines = [title] if title else []
@@ -36,4 +66,10 @@ def format_table(summary: Sequence[dict], title: str = "") -> str:
         label, fmt = DISPLAY[key]
         cells = (f"{fmt.format(row[key]):>{column}}" for row, column in zip(summary, columns, strict=True))
         lines.append(f"{label:<{width}}" + "".join(cells))
+        if key == "mota" and any(row["sequences"] > 1 for row in summary):
+            errors = (
+                f"+-{100 * row['mota_se']:.1f}"[:column].rjust(column)
+                for row, column in zip(summary, columns, strict=True)
+            )
+            lines.append(" " * width + "".join(errors))
     return "\n".join(lines)

@@ -209,10 +209,12 @@ def project_people(camera: PTZCamera, poses, ground_xy, height_m, width_m) -> Pr
         homogeneous = (P[..., :3] @ points_m[..., None] + P[..., 3:])[..., 0]
         return homogeneous[..., :2] / homogeneous[..., 2:], homogeneous[..., 2]
 
-    feet_px, feet_depth_m = project(feet_m)
-    head_px, head_depth_m = project(head_m)
-    focal_px = poses[..., ZOOM, None] * camera.f_min_px
-    half_width_px = 0.5 * focal_px * np.asarray(width_m, dtype=float) / (0.5 * (feet_depth_m + head_depth_m))
+    # A point in the camera's own plane (depth 0) projects to infinity; ``in_front`` flags it.
+    with np.errstate(divide="ignore", invalid="ignore"):
+        feet_px, feet_depth_m = project(feet_m)
+        head_px, head_depth_m = project(head_m)
+        focal_px = poses[..., ZOOM, None] * camera.f_min_px
+        half_width_px = 0.5 * focal_px * np.asarray(width_m, dtype=float) / (0.5 * (feet_depth_m + head_depth_m))
     middle_u_px = 0.5 * (feet_px[..., 0] + head_px[..., 0])
     box_px = np.stack(
         [

@@ -36,9 +36,13 @@ class Crowd:
     width_m : everybody's width; turn_rate_sigma_deg_s : stationary spread of the turn rate;
     enter_leave : people enter through the border and leave after ``stay_s`` [low, high] seconds;
     else they are there from the first frame to the last.
+    pairs : how many of them walk in pairs, side by side (persons 0 and 1, 2 and 3, ...): the
+    second of a pair keeps ``pair_spacing_m`` to the left of the first, who leads.
     """
 
     count: int
+    pairs: int
+    pair_spacing_m: float
     speed_m_s: tuple[float, float]
     height_m: tuple[float, float]
     width_m: float
@@ -84,12 +88,14 @@ def walk_people(
     turn_rate = rng.normal(0.0, np.deg2rad(people.turn_rate_sigma_deg_s), size=count)
 
     positions_m = np.full((frames, count, 2), np.nan)
+    headings = np.zeros((frames, count))
     gone = np.zeros(count, dtype=bool)
     centre = area / 2
     for frame in range(frames):
         entered = frame >= entry_frame
         present = entered & ~gone
         positions_m[frame, present] = position[present]
+        headings[frame] = heading
 
         staying = frame < entry_frame + stay_frames
         ahead = position + LOOKAHEAD_S * speed[:, None] * np.stack([np.cos(heading), np.sin(heading)], -1)
@@ -107,7 +113,16 @@ def walk_people(
         gone |= moving & ~staying & outside
         position = np.where((staying & moving)[:, None], np.clip(position, 0.0, area), position)
 
+    for leader in range(0, 2 * people.pairs, 2):
+        positions_m[:, leader + 1] = _beside(positions_m[:, leader], headings[:, leader], people.pair_spacing_m, area)
     return GroundTruth(positions_m=positions_m, heights_m=heights_m, widths_m=widths_m, frame_rate_hz=frame_rate_hz)
+
+
+def _beside(leader_m, heading_rad, spacing_m: float, area: np.ndarray) -> np.ndarray:
+    """Where somebody walking ``spacing_m`` to the left of a leader at ``leader_m`` (T, 2) is (T, 2),
+    kept inside the area; absent (NaN) where the leader is."""
+    left = np.stack([-np.sin(heading_rad), np.cos(heading_rad)], axis=-1)
+    return np.clip(leader_m + spacing_m * left, 0.0, area)
 
 
 def _border_points(area: np.ndarray, rng: np.random.Generator, count: int) -> np.ndarray:

@@ -5,8 +5,29 @@ is the ground-to-image homography of that pose, linearised at the predicted
 state (the paper's section 3.1). Detections are associated with tracks by
 the Hungarian assignment (default) or by the Cheap JPDAF of
 :mod:`ptztrack.track.jpdaf` (``TrackerParameters.association``).
+
+Track lifecycle. A PTZ camera looks at a few people at a time; a person it
+does not look at is still there, only more uncertain, and the information
+gain policies come back to exactly such people. So a track is not deleted
+because it is uncertain (except, where people can leave the scene, beyond
+``max_position_sigma_m``) but on evidence that its person is not there: each
+track carries the probability that its person exists, ``existence``, updated
+by Bayes' rule every step. Detected, it is ``existence_when_detected``. Not
+detected, while the detector would have found the person with probability
+``q`` (the detector model's prediction at the pose: the person's predicted
+feet and head in the image, recall at their size, and not hidden by other
+tracked people), it becomes ``r (1 - q) / (1 - r q)``: a miss where the
+detector could not have seen anybody changes nothing, a miss where it surely
+would have is strong evidence. Below ``existence_to_delete`` the track goes.
+A new track starts at ``existence_at_birth`` (one detection: a new person,
+a false positive or somebody already tracked). Every track is kept for the
+policy and for re-association; the tracker reports those detected at least
+``confirmation_hits`` times and localised to within ``report_position_sigma_m``
+(beyond that, a reported track is more often a false positive and a miss at
+once than a match).
 """
 
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from typing import Literal
 
@@ -43,19 +64,29 @@ class TrackerParameters:
 
     initial_speed_sigma_m_s : spread of a new track's velocity per axis.
     gate_probability : the chi-square gate (2 degrees of freedom) of the association.
-    max_missed_steps, max_position_sigma_m : when a track is deleted.
-    confirmation_hits : hits before a track is reported (until then it dies at its first miss).
+    existence_at_birth, existence_when_detected, existence_to_delete : the existence probability
+        of a new track, of a track just detected, and below which a track is deleted.
+    max_position_sigma_m : a track more uncertain than this is deleted (inf where people never leave).
+    confirmation_hits, report_position_sigma_m : what the tracker reports (see the module's docstring).
     association : 'hungarian' or 'cjpdaf' (:mod:`ptztrack.track.jpdaf`).
     clutter_density_per_px2 : the CJPDAF's C.
     """
 
     initial_speed_sigma_m_s: float
     gate_probability: float
-    max_missed_steps: int
+    existence_at_birth: float
+    existence_when_detected: float
+    existence_to_delete: float
     max_position_sigma_m: float
     confirmation_hits: int
+    report_position_sigma_m: float
     association: Literal["hungarian", "cjpdaf"]
     clutter_density_per_px2: float
+
+
+DetectionModel = Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray]
+"""``model(mean_m (n, 2), position_cov_m2 (n, 2, 2), pose (3,)) -> (n,)``: the probability that the
+detector finds each predicted person at the pose, were the person there."""
 
 
 def observation_matrix(camera: PTZCamera, pose, mean) -> np.ndarray:
@@ -125,11 +156,13 @@ def ground_points(feet_px, camera: PTZCamera, pose) -> tuple[np.ndarray, np.ndar
         return homogeneous[:, :2] / homogeneous[:, 2:], ok
 
 
-def start_tracks(feet_px, camera: PTZCamera, pose, V, initial_speed_sigma_m_s: float, first_id: int) -> Tracks:
+def start_tracks(
+    feet_px, camera: PTZCamera, pose, V, initial_speed_sigma_m_s: float, first_id: int, existence: float = 0.5
+) -> Tracks:
     """New tracks at the ground points of detections, with the pixel noise carried to the ground.
 
-    Velocity starts at 0 with spread ``initial_speed_sigma_m_s`` per axis.
-    Detections at or above the horizon cannot start a track and are dropped.
+    Velocity starts at 0 with spread ``initial_speed_sigma_m_s`` per axis; the existence probability
+    at ``existence``. Detections at or above the horizon cannot start a track and are dropped.
     """
     ground_xy, ok = ground_points(feet_px, camera, pose)
     ground_xy = ground_xy[ok]
@@ -142,16 +175,20 @@ def start_tracks(feet_px, camera: PTZCamera, pose, V, initial_speed_sigma_m_s: f
         ids=first_id + np.arange(count),
         mean=np.concatenate([ground_xy, np.zeros((count, 2))], axis=-1),
         covariance=covariance,
-        missed_steps=np.zeros(count, dtype=int),
+        existence=np.full(count, existence),
         hits=np.ones(count, dtype=int),
         next_id=first_id + count,
     )
 
 
-def update_tracks(tracks: Tracks, feet_px, camera: PTZCamera, pose, V, parameters: TrackerParameters) -> TrackUpdate:
+def update_tracks(
+    tracks: Tracks, feet_px, camera: PTZCamera, pose, V, parameters: TrackerParameters, detectable=None
+) -> TrackUpdate:
     """Associate, update, start and delete: the tracker's step after prediction.
 
-    feet_px : (K, 2) detections taken at ``pose``. ``parameters.association``
+    feet_px : (K, 2) detections taken at ``pose``; detectable : (n,) the probability that the
+    detector would have found each track's person at ``pose`` (see :data:`DetectionModel`); by
+    default 1 for a track predicted in the image and 0 otherwise. ``parameters.association``
     chooses the association: 'hungarian' updates a track with at most one
     detection, and a detection assigned to no track starts one; 'cjpdaf'
     updates every track with all detections in its gate (see
@@ -160,14 +197,9 @@ def update_tracks(tracks: Tracks, feet_px, camera: PTZCamera, pose, V, parameter
     and a detection in the gate of no surviving track starts one (a
     detection shared by tracks is not a new person).
 
-    A step counts as missed for a track not detected only if the track was
-    predicted inside the image: a PTZ camera that looks elsewhere has not
-    missed anybody. A track is deleted after more than ``max_missed_steps``
-    missed steps, or when its position standard deviation exceeds
-    ``max_position_sigma_m`` (which is what ends a track the camera no
-    longer looks at). A track not yet confirmed (fewer than
-    ``confirmation_hits`` hits) is deleted at its first missed step: a
-    detector's false positive rarely repeats at the same ground point.
+    Each track's existence follows the module's docstring: not detected where it was detectable,
+    it loses existence; a PTZ camera that looks elsewhere has missed nobody. A track is deleted
+    below ``existence_to_delete`` or beyond ``max_position_sigma_m``.
 
     The update's ``track_ids`` and ``measurement_index`` pair each surviving detected track with
     its detection (under the CJPDAF, with the detection the Hungarian assignment would give it;
@@ -202,21 +234,31 @@ def update_tracks(tracks: Tracks, feet_px, camera: PTZCamera, pose, V, parameter
             V,
         )
         updated_index = track_index
-    survivors, keep = _after_update(tracks, mean, covariance, updated_index, predicted_px, in_front, camera, parameters)
+    if detectable is None:
+        detectable = (in_front & inside_image(camera, predicted_px)).astype(float)
+    survivors, keep = _after_update(tracks, mean, covariance, updated_index, detectable, parameters)
     if parameters.association == "cjpdaf":
         unmatched = np.flatnonzero(~gated[keep].any(axis=0))
     else:
         unmatched = np.setdiff1d(np.arange(len(feet_px)), detection_index)
     _, on_ground = ground_points(feet_px[unmatched], camera, pose)
     starting = unmatched[on_ground]
-    born = start_tracks(feet_px[starting], camera, pose, V, parameters.initial_speed_sigma_m_s, tracks.next_id)
+    born = start_tracks(
+        feet_px[starting],
+        camera,
+        pose,
+        V,
+        parameters.initial_speed_sigma_m_s,
+        tracks.next_id,
+        parameters.existence_at_birth,
+    )
     alive = keep[track_index]
     return TrackUpdate(
         tracks=Tracks(
             ids=np.concatenate([survivors.ids, born.ids]),
             mean=np.concatenate([survivors.mean, born.mean]),
             covariance=np.concatenate([survivors.covariance, born.covariance]),
-            missed_steps=np.concatenate([survivors.missed_steps, born.missed_steps]),
+            existence=np.concatenate([survivors.existence, born.existence]),
             hits=np.concatenate([survivors.hits, born.hits]),
             next_id=born.next_id,
         ),
@@ -225,38 +267,33 @@ def update_tracks(tracks: Tracks, feet_px, camera: PTZCamera, pose, V, parameter
     )
 
 
-def _after_update(
-    tracks: Tracks,
-    mean,
-    covariance,
-    track_index,
-    predicted_px,
-    in_front,
-    camera: PTZCamera,
-    parameters: TrackerParameters,
-):
-    """The updated tracks' misses, hits and deletions (see :func:`update_tracks`); returns the survivors
-    and which of the tracks survived (n,) bool."""
-    missed = tracks.missed_steps + (in_front & inside_image(camera, predicted_px))
-    missed[track_index] = 0
+def existence_after_miss(existence, detectable) -> np.ndarray:
+    """Bayes' rule for a track not detected: ``r (1 - q) / (1 - r q)`` for existence ``r`` and the
+    probability ``q`` that the detector would have found the person were it there (both (n,))."""
+    existence, detectable = np.asarray(existence, dtype=float), np.asarray(detectable, dtype=float)
+    return existence * (1.0 - detectable) / (1.0 - existence * detectable)
+
+
+def _after_update(tracks: Tracks, mean, covariance, track_index, detectable, parameters: TrackerParameters):
+    """The updated tracks' existence, hits and deletions (see :func:`update_tracks`); returns the
+    survivors and which of the tracks survived (n,) bool."""
+    existence = existence_after_miss(tracks.existence, detectable)
+    existence[track_index] = parameters.existence_when_detected
     hits = tracks.hits.copy()
     hits[track_index] += 1
-    updated = replace(tracks, mean=mean, covariance=covariance, missed_steps=missed, hits=hits)
-    allowed_missed_steps = np.where(hits >= parameters.confirmation_hits, parameters.max_missed_steps, 0)
-    keep = (updated.missed_steps <= allowed_missed_steps) & (
-        updated.position_sigma_m <= parameters.max_position_sigma_m
-    )
+    updated = replace(tracks, mean=mean, covariance=covariance, existence=existence, hits=hits)
+    keep = (existence >= parameters.existence_to_delete) & (updated.position_sigma_m <= parameters.max_position_sigma_m)
     return updated.select(keep), keep
 
 
 def update_own_tracks(
     tracks: Tracks, track_ids, feet_px, camera: PTZCamera, pose, V, max_position_sigma_m: float
 ) -> Tracks:
-    """Update each track with its own measurement: no association, no new tracks, no missed steps.
+    """Update each track with its own measurement: no association, no new tracks, no change of existence.
 
     track_ids : (K,) the track each measurement ``feet_px`` (K, 2) px belongs to (as template
     matching finds them); V : (2, 2) or (K, 2, 2) px^2 their noise. Such measurements neither count
-    as hits nor clear missed steps: a template can settle on the background and keep matching it,
+    as hits nor raise existence: a template can settle on the background and keep matching it,
     so only the detector confirms a track or keeps it alive. Tracks more uncertain than
     ``max_position_sigma_m`` are deleted as in :func:`update_tracks`.
     """
@@ -281,7 +318,8 @@ class EkfTracker:
     """The ground-plane tracker as a role of the loop (:class:`ptztrack.roles.Tracker`).
 
     camera : the camera model; F, U : the motion model (:func:`ptztrack.track.kalman.constant_velocity_model`);
-    V : (2, 2) px^2 the detections' noise; parameters : see :func:`update_tracks`.
+    V : (2, 2) px^2 the detections' noise; parameters : see :func:`update_tracks`;
+    detection_model : what the detector would find (see :data:`DetectionModel`).
     """
 
     camera: PTZCamera
@@ -289,6 +327,7 @@ class EkfTracker:
     U: np.ndarray
     V: np.ndarray
     parameters: TrackerParameters
+    detection_model: DetectionModel
     tracks: Tracks = field(default_factory=Tracks.empty)
 
     def predict(self) -> Tracks:
@@ -300,9 +339,13 @@ class EkfTracker:
 
     def update(self, detections: Detections | None, pose, view: ImageSource) -> TrackUpdate:
         detections = Detections.empty() if detections is None else detections
-        update = update_tracks(self.tracks, detections.feet_px, self.camera, pose, self.V, self.parameters)
+        tracks, pose = self.tracks, np.asarray(pose, dtype=float)
+        detectable = self.detection_model(tracks.mean[:, :2], tracks.covariance[:, :2, :2], pose)
+        update = update_tracks(tracks, detections.feet_px, self.camera, pose, self.V, self.parameters, detectable)
         self.tracks = update.tracks
         return update
 
     def reported(self) -> Tracks:
-        return self.tracks.confirmed(self.parameters.confirmation_hits)
+        """The tracks detected ``confirmation_hits`` times or more and localised within ``report_position_sigma_m``."""
+        confirmed = self.tracks.confirmed(self.parameters.confirmation_hits)
+        return confirmed.select(confirmed.position_sigma_m <= self.parameters.report_position_sigma_m)
