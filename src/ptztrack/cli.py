@@ -22,6 +22,7 @@ from ptztrack.builders.experiments import (
     run_closed_loop_cell,
     synthetic_cells,
 )
+from ptztrack.builders.pets import PROTOCOLS, protocol_folds
 from ptztrack.builders.registration import reference_index
 from ptztrack.config import PoseError, Scenario, ScenarioError, load_scenario, pets_scenario, scenario_from_dict
 from ptztrack.control.msg_scheduler import CHOOSERS
@@ -208,15 +209,32 @@ def pets_experiment_command(args: argparse.Namespace) -> int:
     scenario = build_scenario(
         "pets", args.detector, args.frames, recording_paths(args), args.association, args.measurement_source
     )
-    cells = recording_cells(scenario, args.beta or [9.0, 1.0], args.strategies)
-    title = f"PETS 2009 S2.L1 View_001, {scenario.detector.kind} detector, every 2nd frame"
-    return _run_table(args, cells, title)
+    folds = protocol_folds(scenario, args.protocol)
+    for fold in folds:
+        if fold.fitted:
+            fitted = ", ".join(f"{name} {value:.4g}" for name, value in fold.fitted.items())
+            print(f"fold {fold.index}: fitted on the other half's frames: {fitted}", file=sys.stderr)
+    betas = args.beta or [9.0, 1.0]
+    cells = [
+        cell
+        for fold in folds
+        for cell in recording_cells(fold.scenario, betas, args.strategies, args.seeds, fold.index)
+    ]
+    title = (
+        f"PETS 2009 S2.L1 View_001, {scenario.detector.kind} detector, every 2nd frame, protocol {args.protocol}, "
+        f"{args.seeds} seeds where a run depends on its seed (MOTA +- standard deviation over seeds and folds)"
+    )
+    extra = {"protocol": args.protocol, "fitted": [fold.fitted for fold in folds]}
+    return _run_table(args, cells, title, "mota_sd", extra)
 
 
-def _run_table(args: argparse.Namespace, cells: list, title: str) -> int:
+def _run_table(
+    args: argparse.Namespace, cells: list, title: str, spread: str = "mota_se", extra: dict | None = None
+) -> int:
     print(f"{len(cells)} episodes, {args.executor} executor", file=sys.stderr)
     summary = summarise(run_cells(cells, run_cell, args.executor, args.workers, print_progress))
-    print(format_table(summary, title))
+    summary = [{**row, **(extra or {})} for row in summary]
+    print(format_table(summary, title, spread))
     labels = {row["label"] for row in summary}
     if {"smpl", "intg"} <= labels and summary[0]["sequences"] > 1:
         mean, error, count = paired_difference(summary, "smpl", "intg")
@@ -275,6 +293,14 @@ def parser() -> argparse.ArgumentParser:
     )
     pets.add_argument("--strategies", nargs="+", choices=_strategies(policies), default=list(STRATEGIES))
     pets.add_argument("--frames", type=_positive_int, help="overrides the scenario's number of steps")
+    pets.add_argument(
+        "--protocol",
+        choices=PROTOCOLS,
+        default="a-priori",
+        help="a-priori: every parameter fixed before looking at S2.L1; two-fold: the detector's model fitted on "
+        "one half of the frames, the table scored on the other, both ways",
+    )
+    pets.add_argument("--seeds", type=_positive_int, default=5, help="runs of a strategy whose run depends on its seed")
     _add_tracker_arguments(pets)
     _add_executor_arguments(pets, "one row per strategy and beta")
     _add_recording_arguments(pets)

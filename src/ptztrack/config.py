@@ -234,6 +234,9 @@ class Recording(_Strict):
     calibration (``camera.image_size_px`` sets the virtual view), and the
     action grid's pan and tilt are offsets from the pose that shows the whole
     recorded frame. Relative paths in a scenario file are relative to it.
+    frame_range : [first, stop) video frames (0-based) to run on; default all.
+    area_m : the walkable area, a polygon of [x, y] points in metres; default the ground the
+    recorded view shows (see :func:`ptztrack.builders.world.visible_ground_m`).
     """
 
     ground_truth: str
@@ -243,6 +246,16 @@ class Recording(_Strict):
     recorded_size_px: tuple[Annotated[int, Field(gt=0)], Annotated[int, Field(gt=0)]] = (768, 576)
     frame_step: int = Field(2, ge=1)
     occluded_above: float = Field(0.25, ge=0, le=1)
+    frame_range: tuple[Annotated[int, Field(ge=0)], Annotated[int, Field(ge=0)]] | None = None
+    area_m: tuple[tuple[float, float], ...] | None = None
+
+    @model_validator(mode="after")
+    def _range_and_area(self):
+        if self.frame_range is not None and self.frame_range[1] <= self.frame_range[0]:
+            raise ValueError(f"frame_range must be [first, stop) with first < stop (got {list(self.frame_range)})")
+        if self.area_m is not None and len(self.area_m) < 3:
+            raise ValueError(f"area_m must be a polygon of at least 3 [x, y] points (got {len(self.area_m)})")
+        return self
 
 
 class Scenario(_Strict):
@@ -270,11 +283,6 @@ class Scenario(_Strict):
         if self.tracker.measurement_source == "spatiogram" and not has_video:
             raise ValueError("tracker.measurement_source 'spatiogram' needs a recording with a video (recording.video)")
         return self
-
-    @property
-    def area_bounds_m(self) -> np.ndarray:
-        """[[x0, y0], [x1, y1]] of the synthetic area, whose corner is the origin."""
-        return np.array([[0.0, 0.0], list(self.area_m)])
 
     def required_recording(self, purpose: str) -> Recording:
         """The scenario's recording; a :class:`ScenarioError` saying that ``purpose`` needs one if it has none."""
@@ -321,34 +329,14 @@ def scenario_from_dict(data: dict, source: str = "scenario", **overrides) -> Sce
         raise ScenarioError(_first_error_line(error, source)) from None
 
 
-# Pixel noise of the feet in the 160 x 120 virtual view: the annotations lie
-# about 2 px from the calibrated feet in the 768 px frame (0.5 px here); HOG's
-# feet lie a median 1.6 px from them, which a 2-D Gaussian of 1.4 px gives.
-PETS_PIXEL_NOISE_PX = {"ideal": 0.5, "hog": 1.5}
-# The recall curve the policies plan with for HOG on these views, fitted by
-# benchmarks/fit_hog_recall.py (maximum likelihood over 2210 annotated people
-# in views of every 20th step at zoom 1-4): HOG on a 6x upsampled view finds
-# 84 % of the people 15-21 px tall, where the paper's Caltech curve
-# (Kd 0.0098, r0 21.29) predicts none.
-PETS_HOG_RECALL = {"recall_kd": 0.0795, "recall_r0_px": 1.83}
-# HOG reports false positives (fix: 599 against 1809 matches), which rarely
-# repeat at the same ground point: with HOG a track is reported from its
-# second detection on, and dies at its first miss until then. The simulated
-# detectors report none, and there confirmation only loses tracks of people
-# seen rarely (synthetic realistic table, fix: 63.2 % -> 32.3 % MOTA).
-# The CJPDAF's clutter density: HOG's boxes whose feet lie more than 5 px x
-# zoom from every annotated person's are 0.04 per view at zoom 1 and 0.2 at
-# zoom 2, at a recall of 0.69 and 0.91 (benchmarks/hog_clutter.py), which
-# makes lambda (1 - P_D P_G) / P_D 0.9e-6 and 1.2e-6 per px^2.
-PETS_HOG_TRACKER = {"confirmation_hits": 2, "clutter_density_per_px2": 1e-6}
-
-
 def pets_scenario(detector: str = "ideal", **overrides) -> Scenario:
-    """The built-in PETS 2009 S2.L1 scenario: the paper's realistic experiment (section 5.2).
+    """The built-in PETS 2009 S2.L1 scenario: the paper's realistic experiment (section 5.2), with every
+    parameter fixed a priori (the defaults; :mod:`ptztrack.builders.pets` fits the detector's model on
+    frames a table does not score).
 
     detector : 'ideal' (annotated boxes) or 'hog' (OpenCV's people detector on the view).
     """
-    if detector not in PETS_PIXEL_NOISE_PX:
+    if detector not in ("ideal", "hog"):
         raise ScenarioError(f"pets: detector {detector!r} is not available; expected ideal or hog")
     data_dir = resources.files("ptztrack.data") / "pets2009_s2l1"
     recording = {
@@ -365,12 +353,11 @@ def pets_scenario(detector: str = "ideal", **overrides) -> Scenario:
             "tilt_deg": {"start": -10.0, "stop": 10.0, "count": 5},
             "zoom": (1.0, 2.0, 3.0, 4.0),
         },
-        "detector": {
-            "kind": detector,
-            "pixel_noise_px": PETS_PIXEL_NOISE_PX[detector],
-            **(PETS_HOG_RECALL if detector == "hog" else {}),
-        },
-        "tracker": PETS_HOG_TRACKER if detector == "hog" else {},
+        "detector": {"kind": detector},
+        # A person's box as the policies see it: the Caltech benchmark's standardised pedestrian aspect
+        # ratio, width = 0.41 x height (Dollar et al., "Pedestrian detection: an evaluation of the state
+        # of the art", 2012), at the policies' 1.75 m.
+        "people": {"width_m": 0.41 * 1.75},
         # People come and go here (section 5.2): the patrolling term looks for them.
         "control": {"beta": 1.0},
         "recording": recording,

@@ -30,7 +30,7 @@ class World:
     camera, grid : the PTZ camera model and its action grid.
     truth : the people, for the metrics.
     backend : what the camera shows; detector : what finds people in it.
-    area_bounds_m : [[x0, y0], [x1, y1]], where people can be.
+    area_polygon_m : (K, 2) the walkable area, a polygon on the ground.
     start_action : the flat action the camera is at before the first step.
     pose_source : the pose the tracker maps detections with (:mod:`ptztrack.camera.pose_feedback`).
     landing_error : where the camera lands when sent to a pose.
@@ -41,7 +41,7 @@ class World:
     truth: GroundTruth
     backend: CameraBackend
     detector: Detector
-    area_bounds_m: np.ndarray
+    area_polygon_m: np.ndarray
     start_action: int
     pose_source: PoseSource
     landing_error: LandingError
@@ -52,7 +52,7 @@ class Episode:
     """What happened in one run.
 
     truth : the people.
-    camera : the PTZ camera that looked; area_bounds_m : [[x0, y0], [x1, y1]] where people can be.
+    camera : the PTZ camera that looked; area_polygon_m : (K, 2) the walkable area, a polygon on the ground.
     actions : (T,) flat action index taken at each step (-1 where the policy commanded a pose off the grid).
     commanded : (T, 3) the poses the camera was sent to.
     poses : (T, 3) the poses the camera took, as (pan_deg, tilt_deg, zoom): the actions' poses
@@ -66,7 +66,7 @@ class Episode:
 
     truth: GroundTruth
     camera: PTZCamera
-    area_bounds_m: np.ndarray
+    area_polygon_m: np.ndarray
     actions: np.ndarray
     commanded: np.ndarray
     poses: np.ndarray
@@ -141,7 +141,7 @@ def run_loop(world: World, policy: Policy, tracker: Tracker, seed: int) -> Episo
     return Episode(
         world.truth,
         world.camera,
-        world.area_bounds_m,
+        world.area_polygon_m,
         tracks=per_step["tracks"],
         detections=per_step["detections"],
         **arrays,

@@ -25,6 +25,8 @@ STRATEGIES = ("fix", "patrol", "rnd", "intg", "smpl")
 # The paper's column names; 'rnd' is the 'random' policy.
 POLICY_OF_STRATEGY = {"rnd": "random"}
 INFORMATION_STRATEGIES = ("intg", "smpl")
+# The strategies that draw from their random stream (the others are deterministic given the detections).
+RANDOM_STRATEGIES = ("rnd", "smpl")
 POSE_SOURCES = ("oracle", "commanded", "registered")
 # Live views come from frames after this one, so that people have moved since the reference frame.
 FIRST_LIVE_FRAME = 50
@@ -47,6 +49,7 @@ class Cell:
         a policy object (each cell runs a fresh copy) or a policy factory.
     label : the table column it belongs to (the strategy, with beta where the table has several).
     camera, detector : in place of the scenario's (see :func:`ptztrack.builders.world.build_world`).
+    fold : which scoring of a table under a protocol with several (:mod:`ptztrack.builders.pets`).
     """
 
     scenario: Scenario
@@ -55,6 +58,7 @@ class Cell:
     label: str = ""
     camera: CameraSpec | None = None
     detector: DetectorSpec | None = None
+    fold: int | None = None
 
     @property
     def column(self) -> str:
@@ -84,19 +88,32 @@ def synthetic_cells(
     ]
 
 
+def seed_matters(scenario: Scenario, strategy: PolicySpec) -> bool:
+    """Whether a run of ``strategy`` depends on its seed: a strategy that draws, or a detector that does
+    (every one but OpenCV's HOG, which finds the same people in the same image)."""
+    return strategy in RANDOM_STRATEGIES or scenario.detector.kind != "hog"
+
+
 def recording_cells(
-    scenario: Scenario, betas: Sequence[float], strategies: Sequence[PolicySpec] = STRATEGIES
+    scenario: Scenario,
+    betas: Sequence[float],
+    strategies: Sequence[PolicySpec] = STRATEGIES,
+    seeds: int = 1,
+    fold: int | None = None,
 ) -> list[Cell]:
-    """The paper's realistic protocol (section 5.2): one run of each strategy over the recording,
-    the information-gain ones once per ``beta`` of the patrolling term."""
+    """The paper's realistic protocol (section 5.2): each strategy over the recording, the
+    information-gain ones once per ``beta`` of the patrolling term; with seeds 0..``seeds``-1 where the
+    run depends on its seed (:func:`seed_matters`), else once."""
     _check_strategies(strategies)
-    cells = [Cell(scenario, strategy, 0) for strategy in strategies if strategy not in INFORMATION_STRATEGIES]
+    columns = [(scenario, strategy, "") for strategy in strategies if strategy not in INFORMATION_STRATEGIES]
     for beta in betas:
         with_beta = scenario.model_copy(update={"control": scenario.control.model_copy(update={"beta": beta})})
-        for strategy in strategies:
-            if strategy in INFORMATION_STRATEGIES:
-                cells.append(Cell(with_beta, strategy, 0, f"{strategy} b{beta:g}"))
-    return cells
+        columns += [(with_beta, s, f"{s} b{beta:g}") for s in strategies if s in INFORMATION_STRATEGIES]
+    return [
+        Cell(column_scenario, strategy, seed, label, fold=fold)
+        for column_scenario, strategy, label in columns
+        for seed in range(seeds if seed_matters(column_scenario, strategy) else 1)
+    ]
 
 
 def cell_policy(cell: Cell) -> PolicySpec:
@@ -111,7 +128,8 @@ def run_cell(cell: Cell) -> dict:
     episode = run_episode(cell.scenario, cell_policy(cell), cell.seed, camera=cell.camera, detector=cell.detector)
     beta = cell.scenario.control.beta if cell.strategy in INFORMATION_STRATEGIES else None
     name = strategy_name(cell.strategy)
-    return {"strategy": name, "label": cell.column, "beta": beta, "seed": cell.seed, **episode_metrics(episode)}
+    fold = {} if cell.fold is None else {"fold": cell.fold}
+    return {"strategy": name, "label": cell.column, "beta": beta, "seed": cell.seed, **fold, **episode_metrics(episode)}
 
 
 def scene_statistics(scenario: Scenario, sequences: int) -> dict:

@@ -75,11 +75,11 @@ def detection_model(scenario: Scenario, world: World) -> DetectionModel:
 
 
 def fix_policy(scenario: Scenario, world: World) -> FixPolicy:
-    return FixPolicy(widest_view_action(world.camera, world.grid, world.area_bounds_m))
+    return FixPolicy(widest_view_action(world.camera, world.grid, world.area_polygon_m))
 
 
 def patrol_policy(scenario: Scenario, world: World) -> PatrolPolicy:
-    return PatrolPolicy(world.grid, patrol_route(world.camera, world.grid, world.area_bounds_m))
+    return PatrolPolicy(world.grid, patrol_route(world.camera, world.grid, world.area_polygon_m))
 
 
 def random_policy(scenario: Scenario, world: World) -> RandomPolicy:
@@ -93,7 +93,7 @@ def _information_policy(scenario: Scenario, world: World, method: Literal["intg"
         exploration = exploration_map(
             world.camera,
             world.grid.poses,
-            world.area_bounds_m,
+            world.area_polygon_m,
             recall,
             control.person_height_m,
             control.exploration_cell_m,

@@ -13,8 +13,9 @@ from ptztrack.camera.pose_feedback import LandingError, commanded_pose, true_pos
 from ptztrack.camera.virtual import VirtualPTZ, virtual_ptz
 from ptztrack.config import Scenario, ScenarioError
 from ptztrack.control.baselines import widest_view_action
+from ptztrack.geometry.area import rectangle_m
 from ptztrack.geometry.calibration import load_calibration
-from ptztrack.geometry.ptz import PTZCamera
+from ptztrack.geometry.ptz import PTZCamera, ground_footprint
 from ptztrack.loop import World
 from ptztrack.roles import CameraBackend, Detector, PoseSource
 from ptztrack.scene.pets import RecordedScene, load_mot_ground_truth, recorded_scene
@@ -32,14 +33,14 @@ class BuiltScene:
     """A scenario's scene before its camera backend and detector: what their factories are given.
 
     camera : the PTZ camera model; grid : its action grid; truth : the people;
-    area_bounds_m : [[x0, y0], [x1, y1]] where people can be.
+    area_polygon_m : (K, 2) the walkable area, a polygon on the ground.
     recording, virtual : for a recording, its annotated people and the virtual PTZ camera over it.
     """
 
     camera: PTZCamera
     grid: ActionGrid
     truth: GroundTruth
-    area_bounds_m: np.ndarray
+    area_polygon_m: np.ndarray
     recording: RecordedScene | None = None
     virtual: VirtualPTZ | None = None
 
@@ -70,7 +71,7 @@ def build_scene(scenario: Scenario, scene_rng: np.random.Generator) -> BuiltScen
     """The synthetic scene (walkers drawn from ``scene_rng``), or the recording seen by a virtual PTZ camera."""
     if scenario.recording is None:
         truth = walk_people(crowd(scenario), scenario.area_m, scenario.frames, scenario.frame_rate_hz, scene_rng)
-        return BuiltScene(ptz_camera(scenario), action_grid(scenario), truth, scenario.area_bounds_m)
+        return BuiltScene(ptz_camera(scenario), action_grid(scenario), truth, rectangle_m(*scenario.area_m))
     recording = scenario.recording
     calibration = load_calibration(recording.calibration, recording.view)
     virtual, whole_frame_pose = virtual_ptz(calibration, recording.recorded_size_px, scenario.camera.image_size_px)
@@ -84,11 +85,23 @@ def build_scene(scenario: Scenario, scene_rng: np.random.Generator) -> BuiltScen
         scenario.frames,
         scenario.frame_rate_hz,
         scenario.people.width_m,
+        recording.frame_range,
     )
-    margin_m = 1.0
-    ground_m = scene.annotations.ground_m
-    area_bounds_m = np.array([ground_m.min(axis=0) - margin_m, ground_m.max(axis=0) + margin_m])
-    return BuiltScene(virtual.camera, grid, scene.truth, area_bounds_m, scene, virtual)
+    if recording.area_m is not None:
+        area_polygon_m = np.asarray(recording.area_m, dtype=float)
+    else:
+        area_polygon_m = visible_ground_m(scenario, virtual.camera, whole_frame_pose, grid)
+    return BuiltScene(virtual.camera, grid, scene.truth, area_polygon_m, scene, virtual)
+
+
+def visible_ground_m(scenario: Scenario, camera: PTZCamera, whole_frame_pose, grid: ActionGrid) -> np.ndarray:
+    """The walkable area of a recording, from the scene alone: the ground the recorded view shows (the
+    virtual camera's view of the whole frame), out to where a standing person of
+    ``control.person_height_m`` would look smaller than ``detector.recall_r0_px`` even at the grid's
+    largest zoom (no detector model finds anybody beyond); a polygon (K, 2)."""
+    focal_px = camera.f_min_px * grid.zoom.max()
+    max_range_m = focal_px * scenario.control.person_height_m / scenario.detector.recall_r0_px
+    return ground_footprint(camera, whole_frame_pose, max_range_m=max_range_m)
 
 
 def resolve(kind: str, spec: Any, scenario: Scenario, built: Any, method: str) -> Any:
@@ -139,8 +152,8 @@ def build_world(
         truth=scene.truth,
         backend=backend,
         detector=found_by,
-        area_bounds_m=scene.area_bounds_m,
-        start_action=widest_view_action(scene.camera, scene.grid, scene.area_bounds_m),
+        area_polygon_m=scene.area_polygon_m,
+        start_action=widest_view_action(scene.camera, scene.grid, scene.area_polygon_m),
         pose_source=pose_source(scenario, scene),
         landing_error=landing_error(scenario),
     )

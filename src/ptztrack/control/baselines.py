@@ -5,30 +5,31 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ptztrack.camera.actions import ActionGrid
+from ptztrack.geometry.area import bounds_m, grid_inside
 from ptztrack.geometry.ptz import PTZCamera, person_in_view, project_people
 from ptztrack.types import DecisionContext
 
 REFERENCE_PERSON_HEIGHT_M = 1.75
 
 
-def area_samples_m(area_bounds_m, per_axis: int = 30) -> np.ndarray:
-    """(per_axis**2, 2) cell centres of a regular grid over the area ``[[x0, y0], [x1, y1]]``."""
-    (x0, y0), (x1, y1) = np.asarray(area_bounds_m, dtype=float)
+def area_samples_m(area_polygon_m, per_axis: int = 30) -> np.ndarray:
+    """(M, 2) the cell centres of a per_axis x per_axis grid over the area's bounding box that lie in the area."""
+    (x0, y0), (x1, y1) = bounds_m(area_polygon_m)
     xs = x0 + (np.arange(per_axis) + 0.5) / per_axis * (x1 - x0)
     ys = y0 + (np.arange(per_axis) + 0.5) / per_axis * (y1 - y0)
-    return np.stack(np.meshgrid(xs, ys), axis=-1).reshape(-1, 2)
+    return grid_inside(area_polygon_m, xs, ys)
 
 
-def area_coverage(camera: PTZCamera, poses, area_bounds_m) -> np.ndarray:
+def area_coverage(camera: PTZCamera, poses, area_polygon_m) -> np.ndarray:
     """Fraction of the area where a standing person has head and feet in the image; (*P,)."""
-    people = project_people(camera, poses, area_samples_m(area_bounds_m), REFERENCE_PERSON_HEIGHT_M, 0.0)
+    people = project_people(camera, poses, area_samples_m(area_polygon_m), REFERENCE_PERSON_HEIGHT_M, 0.0)
     return person_in_view(camera, people).mean(axis=-1)
 
 
-def widest_view_action(camera: PTZCamera, grid: ActionGrid, area_bounds_m) -> int:
+def widest_view_action(camera: PTZCamera, grid: ActionGrid, area_polygon_m) -> int:
     """The zoom-1 action that sees most of the area: where 'fix' looks, and where every run starts."""
     widest = np.flatnonzero(grid.axis_indices[:, 2] == 0)
-    return int(widest[np.argmax(area_coverage(camera, grid.poses[widest], area_bounds_m))])
+    return int(widest[np.argmax(area_coverage(camera, grid.poses[widest], area_polygon_m))])
 
 
 @dataclass
@@ -71,7 +72,7 @@ class PatrolPolicy:
         return self.grid.step_towards(context.current_action, int(self.waypoints[self._next]))
 
 
-def patrol_route(camera: PTZCamera, grid: ActionGrid, area_bounds_m, zoom_index: int | None = None) -> np.ndarray:
+def patrol_route(camera: PTZCamera, grid: ActionGrid, area_polygon_m, zoom_index: int | None = None) -> np.ndarray:
     """A boustrophedon over the pan x tilt grid at one zoom, covering the area.
 
     Along pan and tilt the waypoints are spread evenly from the first to the
@@ -96,7 +97,7 @@ def patrol_route(camera: PTZCamera, grid: ActionGrid, area_bounds_m, zoom_index:
             for pan in (pans if row % 2 == 0 else pans[::-1])
         ]
     )
-    sees_area = area_coverage(camera, grid.poses[route], area_bounds_m) > 0
+    sees_area = area_coverage(camera, grid.poses[route], area_polygon_m) > 0
     return route[sees_area]
 
 

@@ -39,6 +39,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ptztrack.detect.simulated import RecallModel
+from ptztrack.geometry.area import bounds_m, grid_inside
 from ptztrack.geometry.ptz import PTZCamera, person_in_view, project_people
 
 
@@ -82,7 +83,7 @@ class ExplorationMap:
 def exploration_map(
     camera: PTZCamera,
     poses,
-    area_bounds_m,
+    area_polygon_m,
     recall: RecallModel,
     person_height_m: float,
     cell_m: float,
@@ -90,12 +91,12 @@ def exploration_map(
     arrival_rate_per_m2_s: float,
     dt_s: float,
 ) -> ExplorationMap:
-    """A fresh map over the area ``[[x0, y0], [x1, y1]]`` with square cells ``cell_m`` wide, every cell
+    """A fresh map over the area (a polygon (K, 2)) with square cells ``cell_m`` wide, every cell
     believed occupied with ``prior_occupancy``, people arriving at ``arrival_rate_per_m2_s``, steps of ``dt_s``."""
-    (x0, y0), (x1, y1) = np.asarray(area_bounds_m, dtype=float)
-    xs = np.arange(x0 + cell_m / 2, x1, cell_m)
-    ys = np.arange(y0 + cell_m / 2, y1, cell_m)
-    centres = np.stack(np.meshgrid(xs, ys), axis=-1).reshape(-1, 2)
+    (x0, y0), (x1, y1) = bounds_m(area_polygon_m)
+    centres = grid_inside(
+        area_polygon_m, np.arange(x0 + cell_m / 2, x1, cell_m), np.arange(y0 + cell_m / 2, y1, cell_m)
+    )
     arrival = -np.expm1(-arrival_rate_per_m2_s * cell_m**2 * dt_s)
     return ExplorationMap(
         detection_probability=cell_detection_probability(camera, poses, centres, recall, person_height_m),

@@ -9,14 +9,20 @@ by maximum likelihood from people of known height that were or were not
 detected, and :func:`detection_trials` collects such people from a
 simulated camera (a recording seen by the virtual camera, say): it runs a
 detector on the views at given poses and marks each unoccluded person in
-view as detected when a detection's feet fall near the person's.
+view as detected when a detection's feet fall near the person's, and
+measures how far from the person's true ground point the feet fall (the
+detector's pixel noise).
 """
+
+from dataclasses import dataclass
 
 import numpy as np
 from scipy.optimize import minimize
 
 from ptztrack.detect.simulated import realistic_recall
+from ptztrack.geometry.ptz import PTZCamera, apply_homography, ground_to_image
 from ptztrack.roles import CameraBackend, Detector
+from ptztrack.types import GroundTruth
 
 # Beyond this share of its height, a box's feet are not this person's.
 MATCH_FRACTION_OF_HEIGHT = 0.3
@@ -47,26 +53,64 @@ def fit_recall(height_px, detected) -> tuple[float, float]:
     return float(np.exp(best.x[0])), float(best.x[1])
 
 
+@dataclass(frozen=True)
+class DetectionTrials:
+    """People in view, whether a detector found each, and where it put their feet.
+
+    height_px : (K,) their pixel heights; detected : (K,) bool;
+    feet_error_px : (M, 2) for each found person, the detected feet minus the pixel of the person's
+    true ground position (the error the tracker maps to the ground).
+    """
+
+    height_px: np.ndarray
+    detected: np.ndarray
+    feet_error_px: np.ndarray
+
+    @property
+    def pixel_noise_px(self) -> float:
+        """The root mean square of the feet errors per axis: the detector's pixel noise, 1 sigma."""
+        return float(np.sqrt(np.mean(self.feet_error_px**2))) if len(self.feet_error_px) else float("nan")
+
+
 def detection_trials(
-    camera: CameraBackend, detector: Detector, poses, steps, max_hidden: float
-) -> tuple[np.ndarray, np.ndarray]:
-    """Heights (K,) and detected flags (K,) of the people wholly in view and hidden at most
-    ``max_hidden``, in the views at ``poses`` of ``steps``, as ``camera.people`` knows them."""
-    heights, detected = [], []
+    camera: CameraBackend,
+    detector: Detector,
+    model: PTZCamera,
+    truth: GroundTruth,
+    poses,
+    steps,
+    max_hidden: float,
+) -> DetectionTrials:
+    """The people wholly in view and hidden at most ``max_hidden``, in the views at ``poses`` of
+    ``steps``, as ``camera.people`` knows them, and the detections near them.
+
+    A person counts as found when a detection's feet lie within ``MATCH_FRACTION_OF_HEIGHT`` of its
+    height from the person's feet; the feet error is taken against the pixel of the person's true
+    ground position (``truth``, through the camera ``model``'s homography at the pose).
+    """
+    heights, found, errors = [], [], []
     rng = np.random.default_rng(0)
     for step in steps:
         for pose in poses:
             people = camera.people(step, pose)
             if people is None:
-                raise RuntimeError("fitting a recall curve needs a camera that knows who is in view (a simulation)")
+                raise RuntimeError("fitting a detector model needs a camera that knows who is in view (a simulation)")
             visible = people.in_view & (people.hidden <= max_hidden)
             if not visible.any():
                 continue
             feet_px = detector.detect(camera, step, pose, rng).feet_px
+            distance = np.full((visible.sum(), max(len(feet_px), 1)), np.inf)
             if len(feet_px):
-                distance = np.linalg.norm(people.feet_px[visible, None] - feet_px[None], axis=-1).min(axis=1)
-            else:
-                distance = np.full(visible.sum(), np.inf)
+                distance = np.linalg.norm(people.feet_px[visible, None] - feet_px[None], axis=-1)
+            nearest = distance.argmin(axis=1)
+            hit = distance[np.arange(len(nearest)), nearest] <= MATCH_FRACTION_OF_HEIGHT * people.height_px[visible]
+            true_px = apply_homography(
+                ground_to_image(model, pose), truth.positions_m[step, people.person_index[visible]]
+            )
             heights.append(people.height_px[visible])
-            detected.append(distance <= MATCH_FRACTION_OF_HEIGHT * people.height_px[visible])
-    return np.concatenate(heights), np.concatenate(detected)
+            found.append(hit)
+            if len(feet_px):
+                errors.append(feet_px[nearest[hit]] - true_px[hit])
+    return DetectionTrials(
+        np.concatenate(heights), np.concatenate(found), np.concatenate(errors) if errors else np.zeros((0, 2))
+    )

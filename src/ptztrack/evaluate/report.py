@@ -19,10 +19,11 @@ from pathlib import Path
 import matplotlib
 import numpy as np
 from matplotlib.figure import Figure
-from matplotlib.patches import Rectangle
+from matplotlib.patches import Polygon
 
 from ptztrack.evaluate.video import RenderView, write_episode_video
 from ptztrack.files import write_atomically
+from ptztrack.geometry.area import bounds_m
 from ptztrack.geometry.ptz import ground_footprint
 from ptztrack.loop import Episode
 from ptztrack.track.tracker import ground_points
@@ -163,12 +164,11 @@ def episode_figure(episode: Episode, title: str = "") -> Figure:
     figure = Figure(figsize=(7, 7))
     axes = figure.add_subplot()
     camera = episode.camera
-    (x0, y0), (x1, y1) = episode.area_bounds_m
     footprints = ground_footprint(camera, episode.poses, max_range_m=40.0)
     for footprint in footprints:
         axes.fill(*footprint.T, facecolor="none", edgecolor="tab:blue", alpha=0.25, lw=0.8)
     axes.fill(*footprints[-1].T, color="tab:blue", alpha=0.08, lw=0)
-    axes.add_patch(Rectangle((x0, y0), x1 - x0, y1 - y0, fill=False, ls="--", color="black", lw=1))
+    axes.add_patch(Polygon(episode.area_polygon_m, closed=True, fill=False, ls="--", color="black", lw=1))
     for path in np.swapaxes(episode.truth.positions_m, 0, 1):
         axes.plot(*path.T, color="0.55", lw=3, alpha=0.6, solid_capstyle="round")
     colours = matplotlib.colormaps["tab20"]
@@ -185,8 +185,9 @@ def episode_figure(episode: Episode, title: str = "") -> Figure:
         "camera", (camera.centre_m[0], camera.centre_m[1]), xytext=(6, -3), textcoords="offset points", fontsize=8
     )
     margin_m = 2.0
-    axes.set_xlim(min(x0, camera.centre_m[0]) - margin_m, max(x1, camera.centre_m[0]) + margin_m)
-    axes.set_ylim(min(y0, camera.centre_m[1]) - margin_m, max(y1, camera.centre_m[1]) + margin_m)
+    low_m, high_m = bounds_m(np.vstack([episode.area_polygon_m, camera.centre_m[:2]]))
+    axes.set_xlim(low_m[0] - margin_m, high_m[0] + margin_m)
+    axes.set_ylim(low_m[1] - margin_m, high_m[1] + margin_m)
     axes.set_aspect("equal")
     axes.set_xlabel("x [m]")
     axes.set_ylabel("y [m]")

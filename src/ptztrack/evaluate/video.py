@@ -114,7 +114,7 @@ class MapTransform:
 
 def map_transform(episode: Episode) -> MapTransform:
     """The largest scale that shows the area and the camera with a margin, centred in the map panel."""
-    corners_m = np.vstack([episode.area_bounds_m, episode.camera.centre_m[:2]])
+    corners_m = np.vstack([episode.area_polygon_m, episode.camera.centre_m[:2]])
     low_m, high_m = corners_m.min(axis=0) - MAP_MARGIN_M, corners_m.max(axis=0) + MAP_MARGIN_M
     scale = float(np.min(np.asarray(PANEL_SIZE_PX) / (high_m - low_m)))
     return MapTransform(scale, (low_m + high_m) / 2, np.asarray(PANEL_SIZE_PX) / 2)
@@ -219,8 +219,7 @@ def map_background(episode: Episode, transform: MapTransform) -> np.ndarray:
                 where = (position_px + 3, PANEL_SIZE_PX[1] - 5) if axis == 0 else (3, position_px - 3)
                 font = cv2.FONT_HERSHEY_SIMPLEX
                 cv2.putText(panel, f"{value_m:g}", where, font, 0.35, GRID_LABEL_BGR, 1, cv2.LINE_AA)
-    corners = _int_px(transform.to_px(episode.area_bounds_m))
-    cv2.rectangle(panel, corners[0], corners[1], BLACK, 1)
+    cv2.polylines(panel, [_int_px(transform.to_px(episode.area_polygon_m))], True, BLACK, 1)
     camera = _int_px(transform.to_px(episode.camera.centre_m[:2]))
     triangle = np.array([camera + [0, -8], camera + [-7, 5], camera + [7, 5]], np.int32)
     cv2.fillPoly(panel, [triangle], BLACK, cv2.LINE_AA)

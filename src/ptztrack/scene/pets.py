@@ -148,14 +148,21 @@ class RecordedScene:
 
 
 def recorded_scene(
-    annotations: Annotations, frame_step: int, steps: int, frame_rate_hz: float, width_m: float = 0.5
+    annotations: Annotations,
+    frame_step: int,
+    steps: int,
+    frame_rate_hz: float,
+    width_m: float = 0.5,
+    frame_range: tuple[int, int] | None = None,
 ) -> RecordedScene:
-    """Every ``frame_step``-th annotated frame, from the first, for ``steps`` steps (fewer if the recording ends).
+    """Every ``frame_step``-th frame of ``frame_range`` [first, stop) (default: from frame 0 to the last
+    annotated one), for ``steps`` steps at most.
 
     The people's heights are not annotated; ``GroundTruth.heights_m`` holds
     NaN, which nothing on this path reads (detections come from the boxes).
     """
-    video_frame = np.arange(0, annotations.frame.max() + 1, frame_step)[:steps]
+    first, stop = frame_range if frame_range is not None else (0, annotations.frame.max() + 1)
+    video_frame = np.arange(first, stop, frame_step)[:steps]
     kept = annotations.select(np.isin(annotations.frame, video_frame))
     person_id = np.unique(kept.person_id)
     positions_m = np.full((len(video_frame), len(person_id), 2), np.nan)
