@@ -60,8 +60,14 @@ def grow(graph, active: dict, rng: np.random.Generator, next_target: list) -> No
     elif event == "label":
         solos = [v for v in vertices if len(active[v]) == 1 and not graph.nodes[v]["labeled"]]
         if solos:
-            msg.label(graph, solos[rng.integers(len(solos))], untangling=False)
-    created = msg.add_tracklets(graph, events, step)
+            v = solos[rng.integers(len(solos))]
+            (face,) = active[v]
+            msg.label(graph, v, face, untangling=False)
+    # One blob per tracklet: the benchmark never scores, so the blob id only has to be fresh.
+    tracklets = [
+        (len(targets), [graph.graph["next_vertex"] + i], parents) for i, (targets, parents) in enumerate(events)
+    ]
+    created = msg.add_tracklets(graph, tracklets, step)
     for (targets, parents), v in zip(events, created, strict=True):
         for p in parents:
             active.pop(p, None)

@@ -109,9 +109,11 @@ def test_msg_experiment_prints_the_table_and_writes_rows_plot_and_trails(tmp_pat
         str(paths["trails.png"]),
     ]
     assert main(arguments) == 0
-    assert "N_j/s" in capsys.readouterr().out
+    out = capsys.readouterr().out
+    assert "N_j/s" in out and "msg - leave-first" in out and "msg - msg-no-join" in out
     rows = json.loads(paths["rows.json"].read_text())
-    assert len(rows) == 9 and {row["scheduler"] for row in rows} == {"msg", "msg-no-untangling", "naive"}
+    schedulers = {"msg", "msg-no-untangling", "naive", "msg-no-join", "leave-first"}
+    assert len(rows) == 15 and {row["scheduler"] for row in rows} == schedulers
     assert all({"scheduler", "nj_s", "m"} <= set(row) and 0 <= row["m"] <= 1 for row in rows)
     for name in ("figure7.png", "trails.png"):
         assert paths[name].read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"

@@ -1,101 +1,132 @@
-"""The face-capture experiment: the tracker layer's graph, the score M, and the paper's qualitative results."""
+"""The face-capture experiment: no decision reads the future, the score M, and the paper's qualitative results."""
 
 from dataclasses import replace
 
+import networkx as nx
 import numpy as np
 import pytest
 
+from ptztrack.control.msg_scheduler import SCHEDULERS
 from ptztrack.evaluate.executors import run_cells
 from ptztrack.evaluate.msg import (
     EXPERIMENT_SCENE,
     labelled_fraction,
     msg_cells,
+    paired_difference_m,
     run_msg,
     run_msg_cell,
     summarise_by_ambiguity,
 )
-from ptztrack.scene.road_tracklets import TrackletOracle, TrackletOracleConfig
-from ptztrack.scene.roads import walk_roads
+from ptztrack.scene.road_camera import Blob
+from ptztrack.scene.roads import RoadScene, walk_roads
 from ptztrack.track import msg
+from ptztrack.track.tracklets import TrackletTrackerConfig
 
-SPACING_M = 10.0
-
-
-def straight_walks(starts_m, headings, steps: int, speed_m_s: float = 1.0, rate_hz: float = 5.0):
-    """Walkers on straight roads from ``starts_m`` (N, 2) along unit ``headings`` (N, 2)."""
-    time_s = np.arange(steps)[:, None, None] / rate_hz
-    positions_m = np.asarray(starts_m, float)[None] + np.asarray(headings, float)[None] * speed_m_s * time_s
-    heading = np.broadcast_to(np.asarray(headings, float), positions_m.shape).copy()
-    return positions_m, heading
+BUSY = replace(EXPERIMENT_SCENE, people=15, join_probability=0.7)
 
 
-def tracker_for(positions_m, group_id, heading, zoom_steps=5):
-    return TrackletOracle(
-        positions_m, group_id, heading, 40.0, 5.0, 1.0, SPACING_M, TrackletOracleConfig(zoom_steps=zoom_steps)
-    )
+class TruthUpTo(np.ndarray):
+    """A (T, ...) array of simulated truth that refuses to give out any step after ``last_step``."""
+
+    last_step: int
+
+    @classmethod
+    def of(cls, array: np.ndarray, last_step: int) -> "TruthUpTo":
+        guarded = array.view(cls)
+        guarded.last_step = last_step
+        return guarded
+
+    def __getitem__(self, index):
+        try:
+            steps = np.arange(self.shape[0])[index[0] if isinstance(index, tuple) else index]
+        except IndexError:  # a mask over more than the steps: it reads them all
+            steps = np.arange(self.shape[0])
+        if np.max(steps, initial=-1) > self.last_step:
+            raise AssertionError(f"read the truth of step {np.max(steps)} with only up to {self.last_step} known")
+        return np.asarray(self)[index]
 
 
-def test_a_join_and_a_split_become_a_compound_vertex_between_solo_ones():
-    diagonal = np.array([1.0, 1.0]) / np.sqrt(2)
-    positions_m, heading = straight_walks([[5.0, 5.0], [5.0, 5.0]], [diagonal, diagonal], 30)
-    group_id = np.full((30, 2), -1)
-    group_id[10:20] = 0  # walking together for steps 10-19
-    tracker = tracker_for(positions_m, group_id, heading)
-    for step in range(30):
-        tracker.observe(step)
-    graph = tracker.graph
-    compound = [v for v in graph if graph.nodes[v]["count"] == 2]
-    assert len(compound) == 1
-    (c,) = compound
-    assert graph.in_degree(c) == 2 and graph.out_degree(c) == 2
-    assert graph.nodes[c]["length"] == 10
-    # Every observed person-step is in exactly one tracklet.
-    assert sum(node["count"] * node["length"] for _, node in graph.nodes(data=True)) == 60
+def with_truth_replaced_after(scene: RoadScene, step: int, continuation: str) -> RoadScene:
+    """``scene`` with every person's truth after ``step`` replaced, by nothing (absent) or by another walk,
+    and unreadable."""
+    positions_m, group_id, heading = scene.positions_m.copy(), scene.group_id.copy(), scene.heading.copy()
+    if continuation == "nothing":
+        positions_m[step + 1 :], heading[step + 1 :], group_id[step + 1 :] = np.nan, np.nan, -1
+    else:
+        other = walk_roads(BUSY, np.random.default_rng(99))
+        positions_m[step + 1 :], heading[step + 1 :] = other.positions_m[step + 1 :], other.heading[step + 1 :]
+        group_id[step + 1 :] = np.where(other.group_id[step + 1 :] >= 0, other.group_id[step + 1 :] + 1000, -1)
+    truth = {"positions_m": positions_m, "group_id": group_id, "heading": heading}
+    return replace(scene, **{name: TruthUpTo.of(array, step) for name, array in truth.items()})
 
 
-def test_a_blind_gap_makes_x_ambiguities_only_between_walkers_who_could_have_swapped():
-    along = np.array([1.0, 1.0]) / np.sqrt(2)
-    # Two walkers half a metre apart on one road, a third far away.
-    positions_m, heading = straight_walks([[5.0, 5.0], [5.35, 5.35], [30.0, 10.0]], [along, along, along], 40)
-    tracker = tracker_for(positions_m, np.full((40, 3), -1), heading)
-    for step in range(10):
-        tracker.observe(step)
-    zoomed = frozenset({2})
-    for step in range(10, 16):
-        tracker.observe(step, zoomed)
-    tracker.observe(16)
-    graph = tracker.graph
-    near = [tracker.unit_vertex[frozenset({0})], tracker.unit_vertex[frozenset({1})]]
-    for v in near:
-        assert graph.in_degree(v) == 2  # either of the two lost tracklets could be this one
-    far = tracker.unit_vertex[zoomed]
-    assert graph.nodes[far]["length"] == 17 and graph.in_degree(far) == 0
+def test_the_guarded_truth_refuses_the_steps_after_its_last():
+    truth = TruthUpTo.of(np.zeros((10, 3, 2)), 4)
+    assert truth[4, 1].shape == (2,) and truth[:5].shape == (5, 3, 2)
+    for index in (5, (7, 0), slice(3, 6), (Ellipsis, 0), np.zeros((10, 3), dtype=bool)):
+        with pytest.raises(AssertionError, match="read the truth of step"):
+            truth[index]
 
 
-def test_m_counts_labelled_length_per_target_with_labelling_chains():
+@pytest.mark.parametrize("scheduler", list(SCHEDULERS))
+def test_no_decision_reads_the_future_cutting_the_truth_after_a_step_changes_nothing_up_to_it(scheduler):
+    scene = walk_roads(BUSY, np.random.default_rng(3))
+    full = run_msg(scene, scheduler, seed=3)
+    # Cut where a zoom is decided, where its face is captured, and anywhere.
+    decided = next(step for step, _ in full.zooms if step >= 150)
+    for step in (decided, decided + TrackletTrackerConfig().zoom_steps, 300):
+        original = run_msg(scene, scheduler, seed=3, steps=step + 1)
+        assert original.zooms == [zoom for zoom in full.zooms if zoom[0] <= step]
+        for continuation in ("nothing", "another walk"):
+            cut = run_msg(with_truth_replaced_after(scene, step, continuation), scheduler, seed=3, steps=step + 1)
+            assert cut.zooms == original.zooms and cut.captures == original.captures
+            assert nx.utils.graphs_equal(cut.graph, original.graph)
+            assert cut.blobs == original.blobs
+
+
+def test_m_counts_the_labelled_person_steps_along_labelling_chains_on_the_blobs_that_held_the_face():
     graph = msg.new_graph()
-    a, b = msg.add_tracklets(graph, [({0}, []), ({1}, [])], 0)
-    msg.extend(graph, a, 9, 10)
-    msg.extend(graph, b, 9, 10)
-    (group,) = msg.add_tracklets(graph, [({0, 1}, [a, b])], 10)
-    msg.extend(graph, group, 14, 5)
-    a2, b2 = msg.add_tracklets(graph, [({0}, [group]), ({1}, [group])], 15)
-    msg.extend(graph, a2, 24, 10)
-    msg.extend(graph, b2, 24, 10)
+    a, b = msg.add_tracklets(graph, [(1, [0], []), (1, [1], [])], 0)
+    (group,) = msg.add_tracklets(graph, [(2, [2], [a, b])], 10)
+    a2, b2 = msg.add_tracklets(graph, [(1, [3], [group]), (1, [4], [group])], 15)
+    blobs = {
+        0: Blob(frozenset({0}), 0, 9),
+        1: Blob(frozenset({1}), 0, 9),
+        2: Blob(frozenset({0, 1}), 10, 14),
+        3: Blob(frozenset({0}), 15, 24),
+        4: Blob(frozenset({1}), 15, 24),
+    }
     total = 10 + 10 + 2 * 5 + 10 + 10
-    assert labelled_fraction(graph) == 0.0
-    graph.nodes[a]["labeled"] = True
-    # a's only child is the group: the label reaches it (forward chain), for target 0 only.
-    assert labelled_fraction(graph) == pytest.approx((10 + 5) / total)
-    graph.nodes[b2]["labeled"] = True
-    # b2's only parent is the group (backward chain), which holds target 1 too.
-    assert labelled_fraction(graph) == pytest.approx((10 + 5 + 10 + 5) / total)
+    assert labelled_fraction(graph, blobs) == 0.0
+    graph.nodes[a].update(labeled=True, face=0)
+    # a's only child is the group: the label reaches it (forward chain), for person 0 only.
+    assert labelled_fraction(graph, blobs) == pytest.approx((10 + 5) / total)
+    graph.nodes[b2].update(labeled=True, face=1)
+    # b2's only parent is the group (backward chain), which held person 1 too.
+    assert labelled_fraction(graph, blobs) == pytest.approx((10 + 5 + 10 + 5) / total)
+    # A label on a tracklet of somebody else (a wrong association) earns nothing.
+    graph.nodes[a2].update(labeled=True, face=1)
+    assert labelled_fraction(graph, blobs) == pytest.approx((10 + 5 + 10 + 5) / total)
+
+
+def test_differences_pair_up_run_by_run():
+    rows = [
+        {"scheduler": name, "seed": seed, "nj_s": nj_s, "m": m}
+        for name, seed, nj_s, m in [
+            ("a", 0, 14, 0.9), ("b", 0, 14, 0.7),
+            ("a", 1, 16, 0.8), ("b", 1, 16, 0.7),
+            ("a", 2, 3, 0.5), ("b", 2, 3, 0.8),
+        ]
+    ]  # fmt: skip
+    mean, se, runs = paired_difference_m(rows, "a", "b", nj_s=15)
+    assert (mean, runs) == (pytest.approx(0.15), 2) and se == pytest.approx(0.05)
+    assert paired_difference_m(rows, "a", "b")[::2] == (pytest.approx(0.0), 3)
 
 
 def test_a_run_is_reproducible_and_every_scheduler_captures_faces():
     scene = walk_roads(replace(EXPERIMENT_SCENE, people=12, join_probability=0.7), np.random.default_rng(3))
-    for scheduler in ("msg", "msg-no-untangling", "naive"):
-        first, second = run_msg(scene, scheduler), run_msg(scene, scheduler)
+    for scheduler in SCHEDULERS:
+        first, second = run_msg(scene, scheduler, seed=1), run_msg(scene, scheduler, seed=1)
         assert first.m == second.m and first.captures == second.captures
         assert len(first.captures) > 0 and 0 < first.m <= 1
     with pytest.raises(ValueError, match="unknown scheduler"):

@@ -25,12 +25,13 @@ from ptztrack.builders.experiments import (
 from ptztrack.builders.pets import PROTOCOLS, protocol_folds
 from ptztrack.builders.registration import reference_index
 from ptztrack.config import PoseError, Scenario, ScenarioError, load_scenario, pets_scenario, scenario_from_dict
-from ptztrack.control.msg_scheduler import CHOOSERS
+from ptztrack.control.msg_scheduler import SCHEDULERS
 from ptztrack.evaluate.executors import EXECUTORS, print_progress, run_cells
 from ptztrack.evaluate.metrics import DISPLAY, episode_metrics
 from ptztrack.evaluate.msg import (
     ambiguity_figure,
     format_ambiguity_table,
+    format_paired_differences,
     msg_cells,
     run_msg,
     run_msg_cell,
@@ -111,10 +112,11 @@ def run_command(args: argparse.Namespace) -> int:
 
 def msg_experiment_command(args: argparse.Namespace) -> int:
     cells = msg_cells(args.runs)
-    print(f"{len(cells)} simulations x {len(CHOOSERS)} schedulers, {args.executor} executor", file=sys.stderr)
+    print(f"{len(cells)} simulations x {len(SCHEDULERS)} schedulers, {args.executor} executor", file=sys.stderr)
     rows = [row for rows in run_cells(cells, run_msg_cell, args.executor, args.workers, print_progress) for row in rows]
     print("Face capture on the MSG: M by N_j/s bin, mean +- standard deviation (runs)")
     print(format_ambiguity_table(summarise_by_ambiguity(rows)))
+    print(format_paired_differences(rows))
     written = []
     if args.json is not None:
         write_atomically(args.json, (json.dumps(rows, indent=2) + "\n").encode())
@@ -125,8 +127,8 @@ def msg_experiment_command(args: argparse.Namespace) -> int:
     if args.trails is not None:
         cell = cells[0]
         scene = walk_roads(cell.scene, np.random.default_rng(cell.seed))
-        run = run_msg(scene, "msg", cell.tracklets, cell.zoom_out_score)
-        title = f"simulation {cell.seed}: {cell.scene.people} walkers, N_j/s {run.nj_s}, msg scheduler, M {run.m:.2f}"
+        run = run_msg(scene, "msg", cell.tracker, cell.zoom_out_score, cell.seed, cell.zoomed_half_width_m)
+        title = f"simulation {cell.seed}: {cell.scene.people} walkers, N_j/s {scene.nj_s}, msg scheduler, M {run.m:.2f}"
         write_figure(args.trails, trails_figure(scene, run, title))
         written.append(args.trails)
     if written:

@@ -1,18 +1,23 @@
 """The face-capture experiment (MSG paper, section 4): simulate, schedule, score M against N_j/s.
 
 One run: a road-grid scene (:mod:`ptztrack.scene.roads`) watched by one PTZ
-camera. Every zoomed-out step the scheduler either stays zoomed out or zooms
-in on one walker for ``zoom_steps`` to capture a face; the tracklet oracle
-(:mod:`ptztrack.scene.road_tracklets`) grows the tracklet graph meanwhile, and a
-captured face labels the walker's tracklet, matches it and (unless switched
-off) untangles the graph. The three schedulers of a run see the same scene.
+camera at the area's centre (:mod:`ptztrack.scene.road_camera`), whose
+observations alone feed the tracklet tracker (:mod:`ptztrack.track.tracklets`).
+Every zoomed-out step the scheduler (:mod:`ptztrack.control.msg_scheduler`)
+either stays zoomed out or zooms in on one walker for ``zoom_steps`` to
+capture a face, aimed where the tracker predicts the walker at the capture;
+a captured face labels the walker's tracklet, matches it and (for the
+schedulers that untangle) untangles the graph. Every scheduler of a run
+meets the same scene and the same capture draws.
 
-The score (eq. 1) is M = sum_z |tau_L(z)| / sum_z sum_i |tau_i(z)|: the part
-of every target's tracklets, counted once per target a tracklet holds, that
-is labelled with the target. A labelled tracklet's label also reaches along
-its forward and backward labelling chains (a vertex that is its parent's
-only child, a parent that is its child's only parent), as in the paper's
-experiments; only tracklets that really hold the target count.
+The score (eq. 1) is M = sum_z |tau_L(z)| / sum_z sum_i |tau_i(z)|, on each
+scheduler's own final graph with the same rules: the part of every observed
+person-step that lies in a tracklet labelled with that person. A label
+reaches the labelled vertex and its forward and backward labelling chains
+(a vertex that is its parent's only child, a parent that is its child's
+only parent; Appendix A), up to a vertex labelled otherwise; within them it
+counts only on the blobs (observed units) that held the person, so wrong
+associations earn nothing.
 """
 
 from dataclasses import dataclass, replace
@@ -22,93 +27,90 @@ import networkx as nx
 import numpy as np
 from matplotlib.figure import Figure
 
-from ptztrack.control.msg_scheduler import CHOOSERS
-from ptztrack.scene.road_tracklets import TrackletOracle, TrackletOracleConfig
-from ptztrack.scene.roads import RoadScene, RoadSceneConfig, joins_and_splits, walk_roads
-from ptztrack.track.msg import label
+from ptztrack.control.msg_scheduler import SCHEDULERS
+from ptztrack.evaluate.tables import standard_error
+from ptztrack.scene.road_camera import ZOOMED_HALF_WIDTH_M, Blob, RoadCamera, Zoom
+from ptztrack.scene.roads import RoadScene, RoadSceneConfig, walk_roads
+from ptztrack.track.tracklets import TrackletTracker, TrackletTrackerConfig
 
 DEFAULT_ZOOM_OUT_SCORE = 5.0
 
 
 @dataclass(frozen=True)
 class MsgRun:
-    """What a run left: the final graph, the captures (step, person) and the score."""
+    """What a run left: the final graph, the camera's blobs, the zooms (decision step, vertex zoomed on),
+    the captured faces (step, person) and the score."""
 
     graph: nx.DiGraph
+    blobs: dict[int, Blob]
+    zooms: list[tuple[int, int]]
     captures: list[tuple[int, int]]
     m: float
-    nj_s: int
 
 
 def run_msg(
     scene: RoadScene,
     scheduler: str,
-    config: TrackletOracleConfig | None = None,
+    config: TrackletTrackerConfig | None = None,
     zoom_out_score: float = DEFAULT_ZOOM_OUT_SCORE,
+    seed: int = 0,
+    zoomed_half_width_m: float = ZOOMED_HALF_WIDTH_M,
+    steps: int | None = None,
 ) -> MsgRun:
-    """Run one scheduler ('msg', 'msg-no-untangling' or 'naive') over a scene (``config``: the
-    oracle's, by default :class:`TrackletOracleConfig`'s defaults)."""
-    config = config or TrackletOracleConfig()
-    if scheduler not in CHOOSERS:
-        raise ValueError(f"unknown scheduler {scheduler!r}; expected one of {', '.join(CHOOSERS)}")
-    choose = CHOOSERS[scheduler]
-    untangling = scheduler == "msg"
-    oracle = TrackletOracle(
-        scene.positions_m,
-        scene.group_id,
-        scene.heading,
-        scene.area_m,
-        scene.frame_rate_hz,
-        float(np.max(scene.speed_m_s)),
-        scene.road_spacing_m,
-        config,
-    )
-    captures = []
-    zoomed, zoom_end = None, -1
-    for step in range(len(scene.positions_m)):
-        if zoomed is not None and step <= zoom_end:
-            oracle.observe(step, zoomed.unit)
+    """Run one scheduler (a name in :data:`SCHEDULERS`) over a scene: ``config`` the tracker's (by
+    default :class:`TrackletTrackerConfig`'s defaults), ``seed`` fixes the capture draws,
+    ``steps`` stops the run after that many steps (default: all). Only the camera reads the scene, one
+    step at a time."""
+    config = config or TrackletTrackerConfig()
+    if scheduler not in SCHEDULERS:
+        raise ValueError(f"unknown scheduler {scheduler!r}; expected one of {', '.join(SCHEDULERS)}")
+    chosen = SCHEDULERS[scheduler]
+    camera_m = (scene.area_m / 2, scene.area_m / 2)
+    camera = RoadCamera(scene, camera_m, np.random.default_rng([seed, 2]), zoomed_half_width_m)
+    tracker = TrackletTracker(scene.area_m, scene.frame_rate_hz, camera_m, config, chosen.untangling)
+    zooms, captures = [], []
+    zoom = None
+    for step in range(len(scene.positions_m) if steps is None else steps):
+        zoomed_in = zoom is not None and step <= zoom.capture_step
+        observation = camera.observe(step, zoom if zoomed_in else None)
+        tracker.update(observation)
+        if observation.capture is not None:
+            captures.append((step, observation.capture.face))
+        if zoomed_in:
             continue
-        if zoomed is not None:
-            vertex = oracle.unit_vertex[zoomed.unit]
-            oracle.relabel(label(oracle.graph, vertex, untangling))
-            captures.append((step - 1, next(iter(zoomed.unit))))
-            zoomed = None
-        oracle.observe(step)
-        zoomed = choose(oracle, step, zoom_out_score)
-        zoom_end = step + config.zoom_steps
-    m = labelled_fraction(oracle.graph, chains=scheduler != "naive")
-    return MsgRun(oracle.graph, captures, m, int(joins_and_splits(scene).sum()))
+        candidate = chosen.choose(tracker, step, zoom_out_score)
+        zoom = None if candidate is None else Zoom(candidate.blob, candidate.aim_m, step + config.zoom_steps)
+        if candidate is not None:
+            zooms.append((step, candidate.vertex))
+    return MsgRun(tracker.graph, camera.blobs, zooms, captures, labelled_fraction(tracker.graph, camera.blobs))
 
 
-def labelled_fraction(graph: nx.DiGraph, chains: bool = True) -> float:
-    """M of eq. 1 on a final graph; ``chains``: labels reach along labelling chains."""
-    total = sum(node["count"] * node["length"] for _, node in graph.nodes(data=True))
+def labelled_fraction(graph: nx.DiGraph, blobs: dict[int, Blob]) -> float:
+    """M of eq. 1 on a final graph: the labelled share of the person-steps of ``blobs`` (the camera's)."""
+    total = sum(len(blob.members) * blob.steps for blob in blobs.values())
     if total == 0:
         return float("nan")
-    labelled = 0.0
-    for target, vertices in _labelled_reach(graph, chains).items():
-        labelled += sum(graph.nodes[v]["length"] for v in vertices if target in graph.nodes[v]["targets"])
+    labelled = 0
+    for face, vertices in labelled_reach(graph).items():
+        reached = {b for v in vertices for b in graph.nodes[v]["blobs"]}
+        labelled += sum(blobs[b].steps for b in reached if face in blobs[b].members)
     return labelled / total
 
 
-def _labelled_reach(graph: nx.DiGraph, chains: bool = True) -> dict:
-    """{target: vertices its labels reach}: labelled vertices, and with ``chains`` their forward and
-    backward labelling chains."""
+def labelled_reach(graph: nx.DiGraph) -> dict:
+    """{face: vertices its labels reach}: the vertices labelled with it, and their forward and backward
+    labelling chains up to a vertex labelled with another face."""
     reach: dict = {}
     for v, node in graph.nodes(data=True):
         if not node["labeled"]:
             continue
-        (target,) = node["targets"]
-        vertices = reach.setdefault(target, set())
+        vertices = reach.setdefault(node["face"], set())
         vertices.add(v)
-        if not chains:
-            continue
         for step_to, degree in ((graph.succ, graph.out_degree), (graph.pred, graph.in_degree)):
             x = v
             while degree(x) == 1:
                 (x,) = step_to[x]
-                if target not in graph.nodes[x]["targets"] or x in vertices:
+                if graph.nodes[x]["labeled"] or x in vertices:
                     break
                 vertices.add(x)
     return reach
@@ -126,12 +128,13 @@ BIN_WIDTH = 5
 
 @dataclass(frozen=True)
 class MsgCell:
-    """One simulation of the experiment, run by every scheduler: its seed fixes the scene."""
+    """One simulation of the experiment, run by every scheduler: its seed fixes the scene and the capture draws."""
 
     seed: int
     scene: RoadSceneConfig
-    tracklets: TrackletOracleConfig = TrackletOracleConfig()
+    tracker: TrackletTrackerConfig = TrackletTrackerConfig()
     zoom_out_score: float = DEFAULT_ZOOM_OUT_SCORE
+    zoomed_half_width_m: float = ZOOMED_HALF_WIDTH_M
 
 
 def msg_cells(runs: int, base: RoadSceneConfig = EXPERIMENT_SCENE) -> list[MsgCell]:
@@ -146,17 +149,18 @@ def msg_cells(runs: int, base: RoadSceneConfig = EXPERIMENT_SCENE) -> list[MsgCe
 
 
 def run_msg_cell(cell: MsgCell) -> list[dict]:
-    """One row per scheduler: ``scheduler``, ``nj_s``, ``m``, ``captures``, ``seed``, ``people``,
-    ``join_probability``."""
+    """One row per scheduler: ``scheduler``, ``nj_s``, ``m``, ``zooms`` (captures tried), ``captures``
+    (faces captured), ``seed``, ``people``, ``join_probability``."""
     scene = walk_roads(cell.scene, np.random.default_rng(cell.seed))
     rows = []
-    for scheduler in CHOOSERS:
-        run = run_msg(scene, scheduler, cell.tracklets, cell.zoom_out_score)
+    for scheduler in SCHEDULERS:
+        run = run_msg(scene, scheduler, cell.tracker, cell.zoom_out_score, cell.seed, cell.zoomed_half_width_m)
         rows.append(
             {
                 "scheduler": scheduler,
-                "nj_s": run.nj_s,
+                "nj_s": scene.nj_s,
                 "m": run.m,
+                "zooms": len(run.zooms),
                 "captures": len(run.captures),
                 "seed": cell.seed,
                 "people": cell.scene.people,
@@ -186,6 +190,46 @@ def summarise_by_ambiguity(rows: list[dict], bin_width: int = BIN_WIDTH) -> list
                 }
             )
     return summary
+
+
+# The paper's key ambiguity level ("for moderate ambiguity of N_j/s = 15"): the bin centred there.
+KEY_NJ_S = 15
+
+
+def paired_difference_m(
+    rows: list[dict], first: str, second: str, nj_s: int | None = None, bin_width: int = BIN_WIDTH
+) -> tuple[float, float, int]:
+    """M of scheduler ``first`` minus M of ``second``, paired by run (seed): mean, its standard error and
+    the number of runs; over all runs, or those in the N_j/s bin centred on ``nj_s``."""
+    m = {(row["scheduler"], row["seed"]): row["m"] for row in rows}
+    nj_s_of = {row["seed"]: row["nj_s"] for row in rows}
+    seeds = sorted(seed for seed in nj_s_of if (first, seed) in m and (second, seed) in m)
+    if nj_s is not None:
+        seeds = [seed for seed in seeds if np.floor(nj_s_of[seed] / bin_width + 0.5) * bin_width == nj_s]
+    difference = np.array([m[first, seed] - m[second, seed] for seed in seeds])
+    if difference.size == 0:
+        return float("nan"), float("nan"), 0
+    return float(difference.mean()), standard_error(difference), int(difference.size)
+
+
+def format_paired_differences(rows: list[dict], first: str = "msg", nj_s: int = KEY_NJ_S) -> str:
+    """``first`` minus every other scheduler, paired by run: mean +- standard error, over all runs and in
+    the bin centred on ``nj_s``; then each scheduler's faces captured per capture tried."""
+    schedulers = [name for name in dict.fromkeys(row["scheduler"] for row in rows) if name != first]
+    lines = [f"{'paired by run':<28}{'all runs':>24}{f'N_j/s bin {nj_s}':>24}"]
+    for second in schedulers:
+        line = f"{first + ' - ' + second:<28}"
+        for centre in (None, nj_s):
+            mean, se, runs = paired_difference_m(rows, first, second, centre)
+            line += f"{mean:>+12.4f} +- {se:.4f} ({runs:>3})"
+        lines.append(line)
+    rates = []
+    for name in dict.fromkeys(row["scheduler"] for row in rows):
+        mine = [row for row in rows if row["scheduler"] == name]
+        tried = sum(row["zooms"] for row in mine)
+        rates.append(f"{name} {sum(row['captures'] for row in mine) / max(tried, 1):.3f}")
+    lines.append("faces captured per capture tried: " + ", ".join(rates))
+    return "\n".join(lines)
 
 
 def format_ambiguity_table(summary: list[dict]) -> str:
@@ -232,11 +276,10 @@ def trails_figure(scene: RoadScene, run: MsgRun, title: str = "") -> Figure:
     figure = Figure(figsize=(8, 7))
     axes = figure.add_subplot(projection="3d")
     labelled = np.zeros(scene.positions_m.shape[:2], dtype=bool)
-    for target, vertices in _labelled_reach(run.graph).items():
-        for v in vertices:
-            node = run.graph.nodes[v]
-            if target in node["targets"]:
-                labelled[node["first_step"] : node["last_step"] + 1, target] = True
+    for face, vertices in labelled_reach(run.graph).items():
+        for blob in (run.blobs[b] for v in vertices for b in run.graph.nodes[v]["blobs"]):
+            if face in blob.members:
+                labelled[blob.first_step : blob.last_step + 1, face] = True
     time_s = np.arange(len(scene.positions_m)) / scene.frame_rate_hz
     colours = matplotlib.colormaps["tab20"]
     for person in range(scene.positions_m.shape[1]):

@@ -4,11 +4,15 @@ A vertex is a tracklet: solo (one target, ``count`` 1) or compound (``count``
 targets walking together, indistinguishable). An edge parent -> child is a
 candidate association between consecutive tracklets. Node attributes:
 
-- ``count`` (int), ``length`` (steps observed), ``labeled`` (a face was
-  captured on it; solo only), ``active`` (the tracklet still grows),
-  ``first_step`` / ``last_step``;
-- ``targets``: the true target ids, for scoring and for the exact face
-  matcher only (the scheduler never reads them);
+- ``count`` (int, people in the tracklet), ``length`` (steps observed),
+  ``labeled`` (a face was captured on it or matched to it; solo only),
+  ``face`` (the identity of that face, None while unlabelled), ``active``
+  (the tracklet still grows), ``first_step`` / ``last_step``;
+- ``blobs``: the ids of the observations the tracklet is made of (the
+  sensor's units seen continuously with the same members); the graph never
+  reads them, the scoring maps them to the people they held. Tracklets the
+  tracker associated wrongly hold blobs of other people, and a label is
+  right only where its face is among a blob's people;
 - the auxiliary data, each computed from the vertex and its parents alone:
   ``n_o`` (eq. 8), ``n_notL`` (eq. 2), ``p_left`` (eq. 3), ``C`` (eq. 4),
   ``L_notdir`` (eq. 7), ``n_ret`` (eq. 11), ``dL_dir`` (eq. 12). "No vertex"
@@ -79,22 +83,22 @@ def refresh_descendants(graph: nx.DiGraph, vertices: Iterable) -> None:
         refresh(graph, v)
 
 
-def add_tracklets(graph: nx.DiGraph, tracklets: list[tuple[frozenset, Iterable]], step: int) -> list[int]:
-    """Start new tracklets at ``step``: one vertex per (targets, parents), all edges of the event at once.
+def add_tracklets(graph: nx.DiGraph, tracklets: list[tuple[int, Iterable, Iterable]], step: int) -> list[int]:
+    """Start new tracklets at ``step``: one vertex per (count, blobs, parents), all edges of the event at once.
 
     Adding every child of a parent in one event matters: a parent's number of
     children enters its children's ``n_ret`` (forward labelling chains).
     Parents stop being active, with their auxiliary data brought up to their
     final length. Returns the new vertex ids.
     """
-    for p in {p for _, parents in tracklets for p in parents}:
+    for p in {p for _, _, parents in tracklets for p in parents}:
         refresh(graph, p)
     created = []
-    for targets, parents in tracklets:
+    for count, blobs, parents in tracklets:
         v = graph.graph["next_vertex"]
         graph.graph["next_vertex"] += 1
         graph.add_node(
-            v, count=len(targets), targets=frozenset(targets), length=0, labeled=False, active=True,
+            v, count=count, blobs=frozenset(blobs), length=0, labeled=False, face=None, active=True,
             first_step=step, last_step=step,
         )  # fmt: skip
         for p in parents:
@@ -139,20 +143,20 @@ def path_cone(graph: nx.DiGraph, start, end) -> tuple[set, set]:
 
 def untangle(graph: nx.DiGraph, start, end) -> dict:
     """Untangle the graph between a labelled vertex ``start`` and ``end``, just labelled with the same
-    target (section 3.2). Returns {old vertex: vertex now holding its tracklet} for merged vertices.
+    face (section 3.2). Returns {old vertex: vertex now holding its tracklet} for merged vertices.
 
     The target z went from start to end along one of the unlabelled paths
     between them. A vertex on every such path holds z for sure: a solo one
     becomes labelled and keeps only edges within those paths (its one
     target came from and went into them); a compound one splits into a
     labelled solo vertex of z and a remainder of the other targets, which
-    takes the compound's edges outside the paths. Edges within the paths
+    takes the compound's edges outside the paths (both keep its blobs). Edges within the paths
     stay unless they would carry z into a vertex without it or the reverse.
     With a single path this is the paper's untangling, and the chain merges
     into one labelled vertex. Total tracklet length (count x length) is
-    conserved and no true association is lost.
+    conserved and, if the graph held every true association, none is lost.
     """
-    (target,) = graph.nodes[end]["targets"]
+    face = graph.nodes[end]["face"]
     cone, certain = path_cone(graph, start, end)
     # Whoever loses or gains an edge needs fresh auxiliary data, and may now be part of a chain.
     touched = {n for v in cone for n in (v, *graph.pred[v], *graph.succ[v])}
@@ -167,8 +171,8 @@ def untangle(graph: nx.DiGraph, start, end) -> dict:
             continue
         solo, remainder = graph.graph["next_vertex"], graph.graph["next_vertex"] + 1
         graph.graph["next_vertex"] += 2
-        graph.add_node(solo, **{**node, "count": 1, "targets": frozenset({target})})
-        graph.add_node(remainder, **{**node, "count": node["count"] - 1, "targets": node["targets"] - {target}})
+        graph.add_node(solo, **{**node, "count": 1})
+        graph.add_node(remainder, **{**node, "count": node["count"] - 1})
         graph.add_edges_from((p, remainder) for p in graph.pred[v] if p not in cone)
         graph.add_edges_from((remainder, c) for c in graph.succ[v] if c not in cone)
         parts[v] = [solo, remainder]
@@ -188,7 +192,7 @@ def untangle(graph: nx.DiGraph, start, end) -> dict:
             graph.remove_edges_from([(p, v) for p in list(graph.pred[v]) if p not in within])
         if v != end:
             graph.remove_edges_from([(v, c) for c in list(graph.succ[v]) if c not in within])
-        graph.nodes[v]["labeled"] = True
+        graph.nodes[v].update(labeled=True, face=face)
     touched = {v for v in touched | holds_z | without_z if v in graph}
     touched |= {n for v in touched for n in (*graph.pred[v], *graph.succ[v])}
     merged_into = merge_chains(graph, touched)
@@ -198,8 +202,8 @@ def untangle(graph: nx.DiGraph, start, end) -> dict:
 
 def merge_chains(graph: nx.DiGraph, vertices: Iterable) -> dict:
     """Merge every chain through ``vertices``: an edge a -> b where a has one child, b one parent and both
-    the same count is one tracklet. The later vertex keeps its id (active vertices keep theirs).
-    Returns {merged vertex: vertex now holding its tracklet}."""
+    the same count is one tracklet, unless the faces of two people label them. The later vertex keeps its
+    id (active vertices keep theirs). Returns {merged vertex: vertex now holding its tracklet}."""
     merged_into = {}
     pending = [v for v in vertices if v in graph]
     while pending:
@@ -207,12 +211,16 @@ def merge_chains(graph: nx.DiGraph, vertices: Iterable) -> dict:
         if b not in graph or graph.in_degree(b) != 1:
             continue
         (a,) = graph.pred[b]
-        if graph.out_degree(a) != 1 or graph.nodes[a]["count"] != graph.nodes[b]["count"]:
-            continue
         node_a, node_b = graph.nodes[a], graph.nodes[b]
+        if graph.out_degree(a) != 1 or node_a["count"] != node_b["count"]:
+            continue
+        if None not in (node_a["face"], node_b["face"]) and node_a["face"] != node_b["face"]:
+            continue
         node_b["length"] += node_a["length"]
         node_b["first_step"] = node_a["first_step"]
+        node_b["blobs"] = node_a["blobs"] | node_b["blobs"]
         node_b["labeled"] = node_b["labeled"] or node_a["labeled"]
+        node_b["face"] = node_b["face"] if node_b["face"] is not None else node_a["face"]
         graph.add_edges_from((p, b) for p in graph.pred[a])
         graph.remove_node(a)
         merged_into[a] = b
@@ -223,28 +231,28 @@ def merge_chains(graph: nx.DiGraph, vertices: Iterable) -> dict:
     return merged_into
 
 
-def label(graph: nx.DiGraph, v, untangling: bool = True) -> dict:
-    """A face was captured on the active solo vertex v: label it, match it and untangle.
+def label(graph: nx.DiGraph, v, face, untangling: bool = True) -> dict:
+    """The face ``face`` (an identity) was captured on the active solo vertex v: label it, match it and untangle.
 
-    Face matching is exact, and a labelled vertex's target is known (from
-    its face, or by untangling), so the direct match is the latest labelled
-    vertex of v's target: the target's labelled vertices lie on its own path
-    in time order, and older ones could reach v only along other targets'
-    paths. With no labelled vertex of the target, the indirect match by
+    Face matching is exact, and a labelled vertex's face is known (captured,
+    or given by untangling), so the direct match is the latest labelled
+    vertex with the same face: with a graph that holds every true
+    association, the target's labelled vertices lie on its own path in time
+    order, and older ones could reach v only along other targets' paths.
+    With no labelled vertex of that face, the indirect match by
     elimination is C(v) (Claim 1), read before v is labelled. With
     ``untangling``, the paths between the match and v are untangled
     (:func:`untangle`). Returns {old vertex: vertex now holding its
     tracklet} for merged vertices (v keeps its id).
     """
-    (target,) = graph.nodes[v]["targets"]
     indirect_candidate = graph.nodes[v]["C"]
-    same_target = [u for u, node in graph.nodes(data=True) if node["labeled"] and node["targets"] == {target}]
-    graph.nodes[v]["labeled"] = True
+    same_face = [u for u, node in graph.nodes(data=True) if node["labeled"] and node["face"] == face]
+    graph.nodes[v].update(labeled=True, face=face)
     refresh_descendants(graph, [v])
     if not untangling:
         return {}
-    if same_target:
-        start = max(same_target, key=lambda u: graph.nodes[u]["last_step"])
+    if same_face:
+        start = max(same_face, key=lambda u: graph.nodes[u]["last_step"])
     elif indirect_candidate not in (None, v):
         start = indirect_candidate
     else:
