@@ -71,6 +71,8 @@ def test_summary_is_the_mean_over_sequences_in_the_papers_layout():
         "zoom": pytest.approx(1.0),
         # the sample standard deviation 0.1414, over sqrt(2)
         "mota_se": pytest.approx(0.1),
+        "mota_sd": pytest.approx(0.1414, abs=1e-4),
+        "seeds": 2,
         "instances": 350.0,
         "mota_per_sequence": [0.5, 0.7],
     }

@@ -18,6 +18,7 @@ from ptztrack.evaluate.video import (
     view_renderer,
     write_episode_video,
 )
+from ptztrack.geometry.area import bounds_m
 from ptztrack.geometry.ptz import PTZCamera
 from test_camera_recorded import EXCERPT, excerpt_scenario
 
@@ -127,10 +128,10 @@ def test_a_camera_looking_straight_down_scales_the_ellipse_by_focal_length_over_
 def test_the_map_shows_area_and_camera_with_y_up():
     episode = run_episode(scenario_from_dict({"frames": 2}), "fix", 0)
     transform = map_transform(episode)
-    points_m = np.vstack([episode.area_bounds_m, episode.camera.centre_m[:2]])
+    points_m = np.vstack([episode.area_polygon_m, episode.camera.centre_m[:2]])
     points_px = transform.to_px(points_m)
     assert np.all((points_px > 0) & (points_px < PANEL_SIZE_PX))
-    (x0, y0), (x1, y1) = episode.area_bounds_m
+    (x0, y0), (x1, y1) = bounds_m(episode.area_polygon_m)
     low_px, high_px = transform.to_px([[x0, y0], [x1, y1]])
     assert high_px[0] > low_px[0] and high_px[1] < low_px[1]
     np.testing.assert_allclose(transform.to_m(points_px), points_m, atol=1e-9)
