@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from ptztrack.detect.recall_fit import fit_recall
+from ptztrack.detect.recall_fit import MIN_R0_PX, fit_recall
 from ptztrack.detect.simulated import realistic_recall
 
 
@@ -21,3 +21,12 @@ def test_the_curve_is_zero_below_r0_and_rises_towards_one():
     assert values[0] == 0 and values[1] == 0
     assert values[2] == pytest.approx(1 - np.exp(-0.0098 * (50 - 21.29)))
     assert values[3] > 0.98
+
+
+def test_r0_stays_at_a_pixel_or_more_when_even_the_smallest_people_are_found():
+    # A detector that finds 80 % of people at every height: the best curve would put r0 below zero,
+    # which would make the walkable area (where people look taller than r0) unbounded.
+    rng = np.random.default_rng(3)
+    height_px = rng.uniform(2.0, 60.0, 2000)
+    kd, r0 = fit_recall(height_px, rng.random(2000) < 0.8)
+    assert r0 >= MIN_R0_PX and kd > 0

@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ptztrack.builders.world import build_world
-from ptztrack.config import Scenario
+from ptztrack.config import Scenario, scenario_from_dict
 from ptztrack.detect.recall_fit import detection_trials, fit_recall
 from ptztrack.scene.pets import load_mot_ground_truth
 
@@ -59,17 +59,10 @@ PEOPLE_FIELDS = ("width_m",)
 
 
 def with_frames(scenario: Scenario, frame_range: tuple[int, int], fields: dict) -> Scenario:
-    """The scenario on the frames ``frame_range``, with ``fields`` of the detector and the people set."""
-    recording = scenario.required_recording("a fold").model_copy(update={"frame_range": frame_range})
-    people = {name: value for name, value in fields.items() if name in PEOPLE_FIELDS}
-    detector = {name: value for name, value in fields.items() if name not in PEOPLE_FIELDS}
-    return scenario.model_copy(
-        update={
-            "recording": recording,
-            "detector": scenario.detector.model_copy(update=detector),
-            "people": scenario.people.model_copy(update=people),
-        }
-    )
+    """The scenario on the frames ``frame_range``, with ``fields`` of the detector and the people set;
+    validated like a scenario file, so that a fitted value out of its field's range is refused."""
+    overrides = {f"{'people' if name in PEOPLE_FIELDS else 'detector'}.{name}": value for name, value in fields.items()}
+    return scenario_from_dict(scenario.model_dump(), "fold", **{"recording.frame_range": frame_range, **overrides})
 
 
 def fit_detector(scenario: Scenario, frame_range: tuple[int, int]) -> dict:

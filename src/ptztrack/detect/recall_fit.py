@@ -28,6 +28,7 @@ from ptztrack.types import GroundTruth
 MATCH_FRACTION_OF_HEIGHT = 0.3
 # Keeps the log-likelihood finite where the curve says 0 or 1.
 PROBABILITY_FLOOR = 1e-4
+MIN_R0_PX = 1.0
 
 
 def fit_recall(height_px, detected) -> tuple[float, float]:
@@ -44,10 +45,13 @@ def fit_recall(height_px, detected) -> tuple[float, float]:
         p = np.clip(realistic_recall(height_px, np.exp(log_kd), r0), PROBABILITY_FLOOR, 1 - PROBABILITY_FLOOR)
         return -np.sum(np.where(detected, np.log(p), np.log1p(-p)))
 
-    # The likelihood has several local optima in (Kd, r0): start from a grid.
+    # The likelihood has several local optima in (Kd, r0): start from a grid. r0 is at least
+    # MIN_R0_PX: the curve then says that nobody under a pixel is found, and the walkable area,
+    # which ends where people look smaller than r0, is finite.
     starts = [(np.log(kd), r0) for kd in (0.01, 0.05, 0.2, 0.5) for r0 in (5.0, 10.0, 15.0, 20.0)]
+    bounds = [(None, None), (MIN_R0_PX, None)]
     best = min(
-        (minimize(negative_log_likelihood, start, method="Nelder-Mead") for start in starts),
+        (minimize(negative_log_likelihood, start, method="Nelder-Mead", bounds=bounds) for start in starts),
         key=lambda result: result.fun,
     )
     return float(np.exp(best.x[0])), float(best.x[1])
