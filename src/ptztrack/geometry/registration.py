@@ -425,7 +425,8 @@ def refine_view(camera: PTZCamera, directions, live_px, initial) -> np.ndarray:
     """The live (pan_deg, tilt_deg, zoom, roll_deg, k1) that best projects world directions (M, 3)
     onto their live points (M, 2): 5 parameters instead of the homography's 8, so a few dozen
     correspondences pin the view far better than the homography they came from. Soft-L1 loss (1 px);
-    k1 under its prior (``CORNER_DISTORTION_SIGMA`` at the corner)."""
+    k1 under its prior (``CORNER_DISTORTION_SIGMA`` at the corner; Gaussian within one sigma, where
+    the loss leaves it quadratic)."""
 
     def residuals(view):
         lens = Lens(roll_deg=view[3], k1=view[4])
