@@ -79,7 +79,7 @@ def test_an_offset_principal_point_shifts_every_pixel_and_distortion_scales_the_
 def test_undistortion_inverts_the_distortion(k1, x, y):
     normalised = np.array([[x, y]])
     distorted = normalised * (1.0 + k1 * (x * x + y * y))
-    np.testing.assert_allclose(undistort_normalised(distorted, k1), normalised, atol=1e-12)
+    np.testing.assert_allclose(undistort_normalised(distorted, k1), normalised, atol=1e-9)
 
 
 def test_directions_behind_the_view_have_no_pixel():
@@ -102,7 +102,7 @@ def test_barrel_distortion_is_invertible_only_while_it_reaches_the_corner():
     assert distortion_invertible(0.9 * limit, radius2) and distortion_invertible(0.5, radius2)
     corner = np.array([[0.8, 0.0]])
     undistorted = undistort_normalised(corner, 0.9 * limit)
-    np.testing.assert_allclose(undistorted * (1 + 0.9 * limit * (undistorted**2).sum()), corner, atol=1e-12)
+    np.testing.assert_allclose(undistorted * (1 + 0.9 * limit * (undistorted**2).sum()), corner, atol=1e-10)
     # A little more barrel than the limit and no radius reaches the corner: r (1 + k1 r^2) peaks below 0.8.
     assert not distortion_invertible(1.05 * limit, radius2)
     radii = np.linspace(0.0, 3.0, 3001)
