@@ -4,11 +4,11 @@ import numpy as np
 import pytest
 
 from ptztrack.builders.episode import run_episode
-from ptztrack.builders.experiments import registration_views
-from ptztrack.builders.registration import reference_index, registration_camera
+from ptztrack.builders.experiments import live_view_settings, registration_views
+from ptztrack.builders.registration import live_view_model, reference_index, registration_camera
 from ptztrack.builders.world import action_grid, landing_error
 from ptztrack.camera import pose_feedback
-from ptztrack.config import PoseError, ScenarioError, pets_scenario, scenario_from_dict
+from ptztrack.config import LiveView, PoseError, ScenarioError, pets_scenario, scenario_from_dict
 from ptztrack.evaluate.metrics import episode_metrics
 from ptztrack.evaluate.registration import summarise_registration
 from ptztrack.geometry.registration import register
@@ -59,6 +59,13 @@ def test_a_registered_scenario_needs_a_video():
         scenario_from_dict({"pose_feedback": {"source": "registered"}})
 
 
+def test_a_lens_distortion_that_folds_the_image_corners_is_refused():
+    # PETS's zoom-1 corner is at normalised radius 0.42: barrel distortion beyond k1 -0.82 folds it back.
+    live_view_model(pets_scenario(camera={"live_view": {"k1_wide": -0.8}}))
+    with pytest.raises(ScenarioError, match="camera.live_view: k1 -0.9 at zoom 1.00 bends the image corners back"):
+        live_view_model(pets_scenario(camera={"live_view": {"k1_wide": -0.9}}))
+
+
 @pytest.fixture(scope="module")
 def small_registration(tmp_path_factory):
     """The PETS scenario with a small reference index, cached in a file, and the index."""
@@ -85,6 +92,24 @@ def test_pets_views_register_to_a_fraction_of_a_percent_and_centimetres(small_re
     assert summary["registered"] >= 6
     assert summary["focal_err_median_pct"] < 0.5
     assert summary["ground_err_median_m"] < 0.1
+
+
+def test_realistic_pets_views_register_within_a_percent_and_fifteen_centimetres(small_registration):
+    scenario, index = small_registration
+    realistic = scenario.model_copy(update={"camera": scenario.camera.model_copy(update={"live_view": LiveView()})})
+    rows = registration_views(realistic, index, views=8, seed=3)
+    summary = summarise_registration(rows)
+    assert summary["registered"] >= 7
+    assert summary["focal_err_median_pct"] < 1.0
+    assert summary["ground_err_median_m"] < 0.15
+    # The registration knows the view better than the tracker's pinhole model can say (its roll and
+    # distortion), and the registered pose places the view's own pixels better than the true pose,
+    # for it absorbs the principal point offset.
+    assert summary["lens_ground_err_median_m"] < summary["ground_err_median_m"] < summary["oracle_ground_err_median_m"]
+    # The reference views are of the odd frames 1-25 (13 views); the live views 300 frames later at least.
+    settings = live_view_settings(realistic)
+    assert settings["reference_frames"] == [1, 25] and settings["first_live_frame"] == 325
+    assert min(row["frame"] for row in rows) >= 325
 
 
 def test_the_bundle_recovers_the_reference_poses_from_rough_ones(small_registration):

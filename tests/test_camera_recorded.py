@@ -5,6 +5,7 @@ import numpy as np
 
 from ptztrack.builders.episode import run_episode
 from ptztrack.builders.world import build_world
+from ptztrack.camera.live_view import recorded_to_live, view_lens
 from ptztrack.config import load_scenario, pets_scenario
 from ptztrack.evaluate.metrics import episode_metrics
 from ptztrack.geometry.ptz import apply_homography, ground_to_image
@@ -62,3 +63,18 @@ def test_the_built_in_pets_scenario_runs_from_the_package_data():
     metrics = episode_metrics(run_episode(scenario, "fix", 0))
     assert metrics["mota"] > 0.6
     assert 10 < metrics["height_px"] < 30
+
+
+def test_a_camera_with_a_live_view_shows_the_annotated_people_through_its_lens(tmp_path):
+    scenario = excerpt_scenario(tmp_path, camera={"image_size_px": (160, 120), "live_view": {}})
+    world = build_world(scenario, np.random.default_rng(0))
+    backend = world.backend
+    pose = world.grid.poses[int(np.argmin(np.abs(world.grid.axis_indices - [3, 2, 0]).sum(axis=1)))]
+    lens = view_lens(backend.live, backend.virtual, pose)
+    # The principal point is 10 px off at most in the registered 640 px image: 2.5 px at 160 px.
+    assert 0 < np.hypot(*lens.principal_offset_px) <= 2.5 and lens.k1 == -0.15
+    annotated = backend.scene.annotations.select(backend.scene.annotations.frame == 0).feet_px
+    seen = backend.people(0, pose)
+    np.testing.assert_allclose(seen.feet_px, recorded_to_live(backend.virtual, annotated, pose, backend.live))
+    assert np.abs(seen.feet_px - backend.virtual.recorded_to_virtual(annotated, pose)).max() > 0.5
+    assert len(world.detector.detect(backend, 0, pose, np.random.default_rng(0))) >= 0.7 * seen.in_view.sum()

@@ -126,3 +126,19 @@ def test_a_bad_registration_index_exits_2_naming_the_file(tmp_path, capsys):
     error = capsys.readouterr().err
     assert f"{bad}: not a registration index" in error
     assert "Traceback" not in error
+
+
+@pytest.mark.slow
+def test_the_registration_experiment_uses_realistic_live_views_and_says_which(tmp_path, capsys):
+    document_path = tmp_path / "registration.json"
+    arguments = ["experiment", "registration", "--views", "3", "--pose-sources", "oracle", "--frames", "3"]
+    assert main([*arguments, "--detector", "ideal", "--executor", "serial", "--json", str(document_path)]) == 0
+    assert "live views rolled up to 2 deg, principal point up to 10 px off" in capsys.readouterr().out
+    document = json.loads(document_path.read_text())
+    model = document["live_view_model"]
+    assert model["exact"] is False and model["roll_max_deg"] == 2.0 and model["jpeg_quality"] == 75
+    assert model["reference_frames"] == [1, 89] and model["first_live_frame"] == 389
+    assert document["registered"] == 3 and document["focal_err_median_pct"] < 1.0
+    assert document["ground_err_median_m"] is not None and [row["pose_source"] for row in document["closed_loop"]] == [
+        "oracle"
+    ]

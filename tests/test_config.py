@@ -29,6 +29,8 @@ def test_the_default_grid_is_the_papers_280_actions():
         ("detector: {kind: perfect}\n", "detector.kind: expected one of ideal, realistic, hog (got 'perfect')"),
         ("people: {speed_m_s: [2.0, 1.0]}\n", "people: speed_m_s must be [low, high]"),
         ("actions: {zoom: [2, 1]}\n", "actions: zoom must be a non-empty increasing list"),
+        ("camera: {live_view: {gain: [1.3, 0.7]}}\n", "camera.live_view: gain must be [low, high]"),
+        ("camera: {live_view: {jpeg_quality: 0}}\n", "camera.live_view.jpeg_quality: Input should be greater than"),
         ("- 1\n- 2\n", "expected a mapping of scenario fields (got list)"),
         ("area_m: [1, 2\n", "not valid YAML at line"),
     ],

@@ -6,6 +6,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from ptztrack.geometry import registration
+from ptztrack.geometry.lens import Lens, pixel_directions
 from ptztrack.geometry.ptz import PTZCamera, rotation_world_to_camera
 
 CAMERA = PTZCamera((0.0, 0.0, 8.0), 640, 480, 500.0)
@@ -121,3 +122,25 @@ def test_views_overlap_when_one_sees_much_of_the_other():
 def test_only_views_tied_to_the_first_through_matched_pairs_are_kept():
     matches = [(0, 1, None, None), (1, 3, None, None), (2, 4, None, None)]
     np.testing.assert_array_equal(registration.tied_to_first(6, matches), [True, True, False, True, False, False])
+
+
+def test_the_refinement_recovers_a_rolled_distorted_view_from_its_correspondences():
+    rng = np.random.default_rng(2)
+    truth, lens = np.array([12.0, 22.0, 1.3]), Lens(roll_deg=1.7, k1=-0.12)
+    # Directions spread over the live view, seen through its lens, with SIFT-like noise.
+    pixels = rng.uniform([0, 0], [640, 480], size=(100, 2))
+    directions = pixel_directions(CAMERA, truth, lens, pixels)
+    live_px = pixels + rng.normal(0.0, 0.3, pixels.shape)
+    # From the homography's guess, which knows neither roll nor distortion.
+    initial = np.array([12.4, 21.7, 1.3 * 1.02, 0.0, 0.0])
+    refined = registration.refine_view(CAMERA, directions, live_px, initial)
+    np.testing.assert_allclose(refined[:2], truth[:2], atol=0.01)
+    assert refined[2] == pytest.approx(truth[2], rel=1e-3)
+    assert refined[3] == pytest.approx(1.7, abs=0.01)
+    assert refined[4] == pytest.approx(-0.12, abs=0.01)
+    # A narrow view's corners lie near its axis: its distortion is left to the prior (0), harmlessly.
+    narrow, narrow_lens = np.array([12.0, 22.0, 4.0]), Lens(roll_deg=-1.0, k1=-0.05)
+    directions = pixel_directions(CAMERA, narrow, narrow_lens, pixels)
+    refined = registration.refine_view(CAMERA, directions, live_px, np.array([12.1, 22.1, 4.04, 0.0, 0.0]))
+    assert abs(refined[4]) < 0.05
+    assert refined[2] == pytest.approx(4.0, rel=2e-3) and refined[3] == pytest.approx(-1.0, abs=0.02)

@@ -16,6 +16,7 @@ from ptztrack.builders.experiments import (
     POSE_SOURCES,
     STRATEGIES,
     closed_loop_cells,
+    live_view_settings,
     recording_cells,
     registration_views,
     run_cell,
@@ -24,7 +25,15 @@ from ptztrack.builders.experiments import (
 )
 from ptztrack.builders.pets import PROTOCOLS, protocol_folds
 from ptztrack.builders.registration import reference_index
-from ptztrack.config import PoseError, Scenario, ScenarioError, load_scenario, pets_scenario, scenario_from_dict
+from ptztrack.config import (
+    LiveView,
+    PoseError,
+    Scenario,
+    ScenarioError,
+    load_scenario,
+    pets_scenario,
+    scenario_from_dict,
+)
 from ptztrack.control.msg_scheduler import SCHEDULERS
 from ptztrack.evaluate.executors import EXECUTORS, print_progress, run_cells
 from ptztrack.evaluate.metrics import DISPLAY, episode_metrics
@@ -147,6 +156,9 @@ def registration_experiment_command(args: argparse.Namespace) -> int:
     )
     if scenario.recording is None or scenario.recording.video is None:
         raise ScenarioError(f"{args.scenario}: the registration experiment needs a recording with a video")
+    live_view = None if args.exact_views else scenario.camera.live_view or LiveView()
+    scenario = scenario.model_copy(update={"camera": scenario.camera.model_copy(update={"live_view": live_view})})
+    settings = live_view_settings(scenario)
     with tempfile.TemporaryDirectory() as scratch:
         index_path = args.index or Path(scratch) / "index.npz"
         feedback = scenario.pose_feedback.model_copy(update={"index": str(index_path)})
@@ -166,7 +178,13 @@ def registration_experiment_command(args: argparse.Namespace) -> int:
         f"Registration of {summary['views']} live views at random reachable poses, {size[0]} x {size[1]} px, "
         f"against {len(index.poses)} reference views: {summary['registered']} registered"
     )
-    for name, key, unit in (("focal length error", "focal_err", "pct"), ("ground error", "ground_err", "m")):
+    print(f"  {_describe_live_views(settings)}")
+    for name, key, unit in (
+        ("focal length error", "focal_err", "pct"),
+        ("ground error", "ground_err", "m"),
+        ("  with true pose", "oracle_ground_err", "m"),
+        ("  with lens", "lens_ground_err", "m"),
+    ):
         median, p90 = (_unless_failed(summary[f"{key}_{which}_{unit}"]) for which in ("median", "p90"))
         symbol = "%" if unit == "pct" else unit
         print(f"  {name:<19} median {median} {symbol}   p90 {p90} {symbol}")
@@ -184,10 +202,26 @@ def registration_experiment_command(args: argparse.Namespace) -> int:
             f"{row['tracker_zoom_err_pct']:.2f} %"
         )
     if args.json is not None:
-        document = {**summary, "closed_loop": closed_loop, "views_detail": views}
+        document = {**summary, "live_view_model": settings, "closed_loop": closed_loop, "views_detail": views}
         write_atomically(args.json, (json.dumps(document, indent=2) + "\n").encode())
         print(f"wrote {args.json}")
     return 0
+
+
+def _describe_live_views(settings: dict) -> str:
+    """One line on the registration experiment's live views (see ``live_view_settings``)."""
+    frames = (
+        f"reference views of frames {settings['reference_frames'][0]}-{settings['reference_frames'][1]}, "
+        f"live views of frames {settings['first_live_frame']} on"
+    )
+    if settings["exact"]:
+        return f"exact pinhole live views; {frames}"
+    k1 = f"k1 {settings['k1_wide']:g} at zoom 1 to {settings['k1_tele']:g} at zoom {settings['tele_zoom']:g}"
+    return (
+        f"live views rolled up to {settings['roll_max_deg']:g} deg, principal point up to "
+        f"{settings['principal_offset_max_px']:g} px off, {k1}, gain {settings['gain'][0]:g}-{settings['gain'][1]:g}, "
+        f"brightness +-{settings['brightness_max']:g}, JPEG quality {settings['jpeg_quality']}; {frames}"
+    )
 
 
 def _unless_failed(error: float | None) -> str:
@@ -325,6 +359,11 @@ def parser() -> argparse.ArgumentParser:
     )
     registration.add_argument(
         "--index", type=Path, help="reference index file: read if it exists, else built and written (default: built)"
+    )
+    registration.add_argument(
+        "--exact-views",
+        action="store_true",
+        help="exact pinhole views instead of the scenario's camera.live_view (default: the realistic model)",
     )
     registration.add_argument("--detector", choices=detectors, default="hog", help="closed-loop detector")
     registration.add_argument("--policy", choices=policies, default="smpl", help="closed-loop policy")

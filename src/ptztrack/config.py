@@ -86,14 +86,48 @@ class PoseError(_Strict):
     zoom_bias: PositiveFloat = 1.0
 
 
+class LiveView(_Strict):
+    """How a real PTZ camera's views depart from the pinhole model (:mod:`ptztrack.camera.live_view`);
+    the defaults are the realistic model of the registration experiment.
+
+    Each view is rolled by up to ``roll_max_deg`` (uniform), its principal point is off the centre
+    by up to ``principal_offset_max_px`` (uniform over the disc; pixels of the registered image,
+    ``pose_feedback.image_size_px``, scaled for other sizes), its lens distorts radially by k1
+    (normalised coordinates) from ``k1_wide`` at zoom 1 linearly to ``k1_tele`` at ``tele_zoom``,
+    its contrast is multiplied by a ``gain`` in [low, high] and its brightness moved by up to
+    ``brightness_max`` grey levels (uniform), and it is JPEG-compressed at ``jpeg_quality``. A
+    view's values are fixed by ``seed`` (the camera unit) and its pose.
+    """
+
+    roll_max_deg: NonNegativeFloat = 2.0
+    principal_offset_max_px: NonNegativeFloat = 10.0
+    # The PETS camera's own lens over the field of our zoom-1 view (its calibration's k1).
+    k1_wide: Annotated[float, Field(gt=-1, lt=1)] = -0.15
+    k1_tele: Annotated[float, Field(gt=-1, lt=1)] = 0.0
+    tele_zoom: Annotated[float, Field(gt=1)] = 4.0
+    gain: tuple[PositiveFloat, PositiveFloat] = (0.7, 1.3)
+    brightness_max: NonNegativeFloat = 20.0
+    jpeg_quality: int = Field(75, ge=1, le=100)
+    seed: int = Field(0, ge=0)
+
+    @model_validator(mode="after")
+    def _gain_ordered(self):
+        if self.gain[1] < self.gain[0]:
+            raise ValueError(f"gain must be [low, high] with low <= high (got {list(self.gain)})")
+        return self
+
+
 class Camera(_Strict):
     """The PTZ camera. backend : a registered camera backend; by default 'simulated' for the
-    synthetic scene and 'virtual' (the virtual PTZ camera) for a recording."""
+    synthetic scene and 'virtual' (the virtual PTZ camera) for a recording. live_view : how a
+    recording's views depart from the pinhole model (None: exact pinhole views); the detector, the
+    templates and registration all see the same views."""
 
     position_m: tuple[float, float, PositiveFloat] = (7.5, -6.0, 2.5)
     image_size_px: tuple[Annotated[int, Field(gt=0)], Annotated[int, Field(gt=0)]] = (640, 480)
     f_min_px: PositiveFloat = 325.0
     pose_error: PoseError = PoseError()
+    live_view: LiveView | None = None
     backend: Annotated[str | None, _registered("cameras")] = None
     options: Options = Field(default_factory=dict)
 

@@ -7,14 +7,21 @@ tables of :mod:`ptztrack.evaluate.tables` summarise their rows.
 import copy
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
 from ptztrack import registry
 from ptztrack.builders.episode import PolicySpec, run_episode
-from ptztrack.builders.registration import registration_camera
+from ptztrack.builders.registration import (
+    LIVE_GAP_FRAMES,
+    live_view_model,
+    reference_frames,
+    registration_camera,
+    scenario_reference_poses,
+)
 from ptztrack.builders.world import CameraSpec, DetectorSpec, action_grid, build_world
-from ptztrack.config import PoseError, Scenario
+from ptztrack.config import PoseError, Scenario, ScenarioError
 from ptztrack.evaluate.metrics import episode_metrics
 from ptztrack.evaluate.registration import registration_errors
 from ptztrack.geometry.registration import ReferenceIndex
@@ -28,8 +35,6 @@ INFORMATION_STRATEGIES = ("intg", "smpl")
 # The strategies that draw from their random stream (the others are deterministic given the detections).
 RANDOM_STRATEGIES = ("rnd", "smpl")
 POSE_SOURCES = ("oracle", "commanded", "registered")
-# Live views come from frames after this one, so that people have moved since the reference frame.
-FIRST_LIVE_FRAME = 50
 GROUND_GRID_POINTS = 25
 
 
@@ -173,12 +178,12 @@ def registration_views(
     seed: int = 0,
     progress: Callable[[int, int], None] | None = None,
 ) -> list[dict]:
-    """Register ``views`` live views of a recording scenario (see
-    :func:`ptztrack.evaluate.registration.registration_errors`).
+    """Register ``views`` live views of a recording scenario as its ``camera.live_view`` takes them
+    (see :func:`ptztrack.evaluate.registration.registration_errors`).
 
     The live views are at random reachable poses (pan and tilt uniform over the action grid's
-    range, zoom uniform from 1 to the grid's largest) of random frames after ``FIRST_LIVE_FRAME``;
-    the ground errors are measured over a grid over the annotated people's extent.
+    range, zoom uniform from 1 to the grid's largest) of random frames from :func:`first_live_frame`
+    on; the ground errors are measured over a grid over the annotated people's extent.
     """
     recording = scenario.required_recording("the registration experiment")
     virtual, whole_frame_pose = registration_camera(scenario)
@@ -192,9 +197,42 @@ def registration_views(
         whole_frame_pose[1] + rng.uniform(grid.tilt_deg.min(), grid.tilt_deg.max(), views),
         rng.uniform(1.0, grid.zoom.max(), views),
     ]
-    frames = np.sort(rng.integers(FIRST_LIVE_FRAME, annotations.frame.max() + 1, views))
+    first_frame = first_live_frame(scenario, whole_frame_pose)
+    last_frame = int(annotations.frame.max())
+    if first_frame > last_frame:
+        raise ScenarioError(
+            f"the recording ends at frame {last_frame}, before the first live frame {first_frame} "
+            f"({LIVE_GAP_FRAMES} frames after the last reference view's)"
+        )
+    frames = np.sort(rng.integers(first_frame, last_frame + 1, views))
     video = RecordedVideo(scenario.required_video("the registration experiment"), recording.recorded_size_px)
-    return registration_errors(virtual, index, video, poses, frames, np.c_[x.ravel(), y.ravel()], progress)
+    ground_m = np.c_[x.ravel(), y.ravel()]
+    return registration_errors(virtual, index, video, poses, frames, ground_m, live_view_model(scenario), progress)
+
+
+def live_view_settings(scenario: Scenario) -> dict:
+    """The registration experiment's live views, as its JSON records them: ``camera.live_view``'s
+    settings (the roll, principal point, distortion, light and compression; ``exact`` when there are
+    none), and the frames of the reference sweep and of the live views (the time gap)."""
+    _, whole_frame_pose = registration_camera(scenario)
+    live_view = scenario.camera.live_view
+    sweep = reference_frames(len(scenario_reference_poses(scenario, whole_frame_pose)))
+    camera: dict[str, Any] = {"exact": True} if live_view is None else {"exact": False, **live_view.model_dump()}
+    if live_view is not None:
+        camera["principal_offset_image_size_px"] = list(scenario.pose_feedback.image_size_px)
+    return {
+        **camera,
+        "reference_frames": [int(sweep[0]), int(sweep[-1])],
+        "reference_frame_step": int(sweep[1] - sweep[0]) if len(sweep) > 1 else None,
+        "min_gap_frames": LIVE_GAP_FRAMES,
+        "first_live_frame": first_live_frame(scenario, whole_frame_pose),
+    }
+
+
+def first_live_frame(scenario: Scenario, whole_frame_pose) -> int:
+    """The first frame a live view of the registration experiment may show: ``LIVE_GAP_FRAMES``
+    after the last reference view's frame."""
+    return int(reference_frames(len(scenario_reference_poses(scenario, whole_frame_pose)))[-1] + LIVE_GAP_FRAMES)
 
 
 def closed_loop_cells(

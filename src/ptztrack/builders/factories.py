@@ -8,6 +8,7 @@ import math
 from functools import partial
 from typing import Literal
 
+from ptztrack.builders.registration import live_view_model
 from ptztrack.camera.recorded import RecordedPTZ
 from ptztrack.camera.simulated import SimulatedPTZ
 from ptztrack.config import Scenario
@@ -156,7 +157,7 @@ def virtual_camera(scenario: Scenario, scene) -> RecordedPTZ:
     """The virtual PTZ camera over the scenario's recording (images only if it names a video)."""
     recording = scenario.required_recording("camera.backend 'virtual'")
     video = None if recording.video is None else RecordedVideo(recording.video, recording.recorded_size_px)
-    return RecordedPTZ(scene.virtual, scene.recording, video)
+    return RecordedPTZ(scene.virtual, scene.recording, video, live_view_model(scenario))
 
 
 def ekf_tracker(scenario: Scenario, world: World) -> EkfTracker | TemplateTracker:

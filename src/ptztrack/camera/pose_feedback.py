@@ -12,12 +12,13 @@ poses (pan_deg, tilt_deg, zoom) and returns the (3,) pose the tracker uses,
 or None when it cannot tell (the loop then uses the commanded pose).
 """
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from ptztrack.camera.live_view import LiveViewModel, render_view
 from ptztrack.camera.virtual import VirtualPTZ
 from ptztrack.geometry.registration import ReferenceIndex, build_index, load_index, register, save_index
 from ptztrack.scene.pets import RecordedVideo
@@ -74,20 +75,23 @@ def reference_poses(
 
 def build_reference_index(
     virtual: VirtualPTZ,
-    frame_bgr: np.ndarray,
+    frames_bgr: Sequence[np.ndarray],
     poses,
     pose_sigma_deg: float,
     zoom_spread: float,
     rng: np.random.Generator,
 ) -> ReferenceIndex:
-    """The reference index of a virtual camera: views of ``frame_bgr`` rendered at ``poses`` (L, 3),
-    bundle-adjusted from poses known only roughly (pan and tilt to ``pose_sigma_deg``, zoom within
-    ``zoom_spread``), as a real camera's reference views would be; the first exactly."""
+    """The reference index of a virtual camera: view l rendered from ``frames_bgr[l]`` at ``poses[l]``
+    ((L, 3); the camera sweeps its field of regard while people walk), bundle-adjusted from poses
+    known only roughly (pan and tilt to ``pose_sigma_deg``, zoom within ``zoom_spread``), as a real
+    camera's reference views would be; the first exactly. The reference views are exact pinhole
+    views: they stand for views undistorted with the camera's calibration, taken once."""
     poses = np.asarray(poses, dtype=float)
     rough = poses.copy()
     rough[1:, :2] += rng.normal(0.0, pose_sigma_deg, (len(poses) - 1, 2))
     rough[1:, 2] *= rng.uniform(1 - zoom_spread, 1 + zoom_spread, len(poses) - 1)
-    return build_index(virtual.camera, [virtual.render(frame_bgr, pose) for pose in poses], rough)
+    views = [virtual.render(frame, pose) for frame, pose in zip(frames_bgr, poses, strict=True)]
+    return build_index(virtual.camera, views, rough)
 
 
 def cached_reference_index(path: str | Path | None, build: Callable[[], ReferenceIndex]) -> ReferenceIndex:
@@ -105,13 +109,15 @@ class RegisteredPose:
     """The pose source that registers the camera's image of each step.
 
     virtual : the camera at the registration resolution; index : its reference views;
-    video : the recording; video_frame : (T,) the frame of each step.
+    video : the recording; video_frame : (T,) the frame of each step; live : how the camera's
+    views depart from the pinhole model (:mod:`ptztrack.camera.live_view`), None for exact views.
     """
 
     virtual: VirtualPTZ
     index: ReferenceIndex
     video: RecordedVideo
     video_frame: np.ndarray
+    live: LiveViewModel | None = None
 
     def __post_init__(self):
         size = (self.virtual.camera.image_width_px, self.virtual.camera.image_height_px)
@@ -122,6 +128,6 @@ class RegisteredPose:
             )
 
     def __call__(self, step: int, commanded, actual) -> np.ndarray | None:
-        image = self.virtual.render(self.video.frame(int(self.video_frame[step])), actual)
+        image = render_view(self.virtual, self.video.frame(int(self.video_frame[step])), actual, self.live)
         registration = register(self.virtual.camera, self.index, image)
         return None if registration is None else registration.pose

@@ -37,30 +37,49 @@ class VirtualPTZ:
     recording: PinholeCalibration
     recorded_size_px: tuple[int, int]
 
-    def sampling_maps(self, pose) -> tuple[np.ndarray, np.ndarray]:
-        """Where each virtual pixel (centre) reads the recorded frame: two (h, w) float32 maps for cv2.remap."""
+    def pixel_centres(self) -> np.ndarray:
+        """(h * w, 2) centres of the virtual pixels, row by row: pixel (row, col) at (col + 0.5, row + 0.5)."""
         width, height = self.camera.image_width_px, self.camera.image_height_px
         u, v = np.meshgrid(np.arange(width) + 0.5, np.arange(height) + 0.5)
-        pixels = np.stack([u.ravel(), v.ravel(), np.ones(u.size)], axis=-1)
+        return np.c_[u.ravel(), v.ravel()]
+
+    def sampling_maps(self, pose) -> tuple[np.ndarray, np.ndarray]:
+        """Where each virtual pixel (centre) reads the recorded frame: two (h, w) float32 maps for cv2.remap."""
+        pixels = np.c_[self.pixel_centres(), np.ones(self.camera.image_width_px * self.camera.image_height_px)]
         pose = np.asarray(pose, dtype=float)
         rays = pixels @ np.linalg.inv(intrinsics(self.camera, pose[2])).T @ rotation_world_to_camera(pose[0], pose[1])
-        recorded = _project_directions(self.recording, rays)
+        return self.maps_of_directions(rays)
+
+    def maps_of_directions(self, directions) -> tuple[np.ndarray, np.ndarray]:
+        """Sampling maps (two (h, w) float32) of the virtual pixels that look along world ``directions``
+        (h * w, 3), row by row."""
+        recorded = _project_directions(self.recording, directions)
         # The centre of recorded pixel (i, j) is at (i + 0.5, j + 0.5); remap indexes from 0.
-        maps = (recorded - 0.5).reshape(height, width, 2).astype(np.float32)
+        maps = (recorded - 0.5).reshape(self.camera.image_height_px, self.camera.image_width_px, 2).astype(np.float32)
         return maps[..., 0], maps[..., 1]
 
     def render(self, frame, pose) -> np.ndarray:
         """The virtual view (h, w, 3) of a recorded frame; black where the recording does not reach."""
-        map_u, map_v = self.sampling_maps(pose)
-        return cv2.remap(frame, map_u, map_v, cv2.INTER_AREA if pose[2] < 1 else cv2.INTER_LINEAR)
+        return resample(frame, self.sampling_maps(pose), pose[2])
+
+    def _recorded_normalised(self, recorded_px) -> np.ndarray:
+        """Normalised (undistorted) recording coordinates (N, 2) of recorded pixels (N, 2)."""
+        if len(recorded_px) == 0:
+            return np.zeros((0, 2))
+        return cv2.undistortPoints(
+            np.asarray(recorded_px, dtype=float).reshape(-1, 1, 2), self.recording.K, self.recording.dist
+        )[:, 0, :]
+
+    def recorded_directions(self, recorded_px) -> np.ndarray:
+        """World directions (N, 3) of recorded (distorted) pixels (N, 2), from the recording's centre."""
+        normalised = self._recorded_normalised(recorded_px)
+        R = self.recording.R
+        # (u, v, 1) R_rec, written out per point (see recorded_to_virtual).
+        return normalised[:, :1] * R[0] + normalised[:, 1:] * R[1] + R[2]
 
     def recorded_to_virtual(self, recorded_px, pose) -> np.ndarray:
         """Recorded (distorted) pixels (N, 2) to virtual pixels (N, 2) at ``pose``; NaN behind the virtual camera."""
-        if len(recorded_px) == 0:
-            return np.zeros((0, 2))
-        normalised = cv2.undistortPoints(
-            np.asarray(recorded_px, dtype=float).reshape(-1, 1, 2), self.recording.K, self.recording.dist
-        )[:, 0, :]
+        normalised = self._recorded_normalised(recorded_px)
         pose = np.asarray(pose, dtype=float)
         # (u, v, 1) R_rec R_v^T K^T, written out per point: a matrix product over all points at once
         # rounds each row differently depending on how many there are.
@@ -69,6 +88,12 @@ class VirtualPTZ:
         with np.errstate(divide="ignore", invalid="ignore"):
             pixels = homogeneous[:, :2] / homogeneous[:, 2:]
         return np.where(homogeneous[:, 2:] > 0, pixels, np.nan)
+
+
+def resample(frame, maps: tuple[np.ndarray, np.ndarray], zoom: float) -> np.ndarray:
+    """A recorded frame read through sampling maps: area-averaged when the view is wider than the
+    recording (zoom below 1), bilinear otherwise."""
+    return cv2.remap(frame, maps[0], maps[1], cv2.INTER_AREA if zoom < 1 else cv2.INTER_LINEAR)
 
 
 def _project_directions(recording: PinholeCalibration, directions) -> np.ndarray:

@@ -1,8 +1,18 @@
 """How well live PTZ views are registered (scale-invariant tracking paper): errors per view, and their summary.
 
-The errors are those of the registered pose against the true one: the focal
-length in %, and on the ground (m) the median over a grid of points of the
-walkable area that the view sees.
+The truth is the view's real pose (pan, tilt, zoom) and focal length, and,
+for live views as a real camera takes them (:mod:`ptztrack.camera.live_view`),
+its lens: a ground point appears in the view where the real camera puts it.
+The errors: the focal length in %, and on the ground (m), over a grid of
+points of the walkable area that the view sees (median over the points),
+how far the view's pixels of those points land from them when mapped back
+
+* through the registered pose in the tracker's pinhole model (``ground_err``,
+  what a tracker gets);
+* through the true pose in the same model (``oracle_ground_err``: the
+  lens's departures from the model alone);
+* through the registered pose with the registered roll and distortion
+  (``lens_ground_err``: what the registration knows of the view).
 """
 
 import time
@@ -10,10 +20,21 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
+from ptztrack.camera.live_view import LiveViewModel, render_view, view_lens
 from ptztrack.camera.virtual import VirtualPTZ
-from ptztrack.geometry.ptz import apply_homography, ground_to_image, image_to_ground, inside_image
+from ptztrack.geometry.lens import Lens, pixel_directions, project_directions
+from ptztrack.geometry.ptz import PTZCamera, apply_homography, image_to_ground, inside_image
 from ptztrack.geometry.registration import ReferenceIndex, register
 from ptztrack.scene.pets import RecordedVideo
+
+# The ground errors of a view, and whether each needs the view registered.
+GROUND_ERRORS = {"ground_err_m": True, "oracle_ground_err_m": False, "lens_ground_err_m": True}
+
+
+def ground_of_pixels(camera: PTZCamera, pose, lens: Lens, pixels) -> np.ndarray:
+    """Ground points (N, 2) m seen at pixels (N, 2) of the view at ``pose`` through ``lens``."""
+    directions = pixel_directions(camera, pose, lens, pixels)
+    return camera.centre_m[:2] - camera.centre_m[2] * directions[:, :2] / directions[:, 2:]
 
 
 def registration_errors(
@@ -23,37 +44,49 @@ def registration_errors(
     poses,
     frames,
     ground_points_m,
+    live: LiveViewModel | None = None,
     progress: Callable[[int, int], None] | None = None,
 ) -> list[dict]:
     """Register the live views of ``virtual`` at ``poses`` (V, 3) of the video's ``frames`` (V,)
-    (ascending, so that the video is read forwards once); ground errors over ``ground_points_m`` (P, 2).
+    (ascending, so that the video is read forwards once), as ``live`` takes them (None: exact
+    pinhole views); ground errors over ``ground_points_m`` (P, 2).
 
     One row per view: ``pose`` (pan_deg, tilt_deg, zoom), ``frame``, ``registered`` (bool),
-    ``focal_err_pct`` and ``ground_err_m`` (None when not registered, and the ground error also when
-    the view sees none of the walkable area), ``seconds`` (of registration).
+    ``focal_err_pct``, the ground errors of ``GROUND_ERRORS`` in m (None when not registered, except
+    the oracle's, and all of them when the view sees none of the walkable area), ``roll_err_deg``
+    (registered roll minus the true one; None when not registered), ``seconds`` (of registration).
     """
     camera, views = virtual.camera, len(poses)
+    ground_points_m = np.asarray(ground_points_m, dtype=float)
+    directions = np.c_[ground_points_m, np.zeros(len(ground_points_m))] - camera.centre_m
     rows = []
     for number, (pose, frame) in enumerate(zip(poses, frames, strict=True), start=1):
-        image = virtual.render(video.frame(int(frame)), pose)
+        image = render_view(virtual, video.frame(int(frame)), pose, live)
         start = time.perf_counter()
         result = register(camera, index, image)
         seconds = time.perf_counter() - start
-        focal_err_pct = ground_err_m = None
-        if result is not None:
-            focal_err_pct = 100.0 * abs(result.focal_px / (pose[2] * camera.f_min_px) - 1.0)
-            pixels = apply_homography(ground_to_image(camera, pose), ground_points_m)
-            seen = inside_image(camera, pixels) & np.all(np.isfinite(pixels), axis=1)
-            if seen.any():
-                estimated = apply_homography(image_to_ground(camera, result.pose), pixels[seen])
-                ground_err_m = float(np.median(np.linalg.norm(estimated - ground_points_m[seen], axis=1)))
+        lens = Lens() if live is None else view_lens(live, virtual, pose)
+        pixels = project_directions(camera, pose, lens, directions)
+        seen = inside_image(camera, pixels) & np.all(np.isfinite(pixels), axis=1)
+        errors: dict[str, float | None] = dict.fromkeys(GROUND_ERRORS)
+        if seen.any():
+            mapped = {"oracle_ground_err_m": apply_homography(image_to_ground(camera, pose), pixels[seen])}
+            if result is not None:
+                mapped["ground_err_m"] = apply_homography(image_to_ground(camera, result.pose), pixels[seen])
+                registered_lens = Lens(roll_deg=result.roll_deg, k1=result.k1)
+                mapped["lens_ground_err_m"] = ground_of_pixels(camera, result.pose, registered_lens, pixels[seen])
+            for key, estimated in mapped.items():
+                errors[key] = float(np.median(np.linalg.norm(estimated - ground_points_m[seen], axis=1)))
         rows.append(
             {
-                "pose": pose.tolist(),
+                "pose": np.asarray(pose).tolist(),
                 "frame": int(frame),
                 "registered": result is not None,
-                "focal_err_pct": focal_err_pct,
-                "ground_err_m": ground_err_m,
+                "focal_err_pct": None
+                if result is None
+                else 100.0 * abs(result.focal_px / (pose[2] * camera.f_min_px) - 1.0),
+                **errors,
+                "roll_err_deg": None if result is None else result.roll_deg - lens.roll_deg,
                 "seconds": seconds,
             }
         )
@@ -67,24 +100,24 @@ def summarise_registration(rows: Sequence[dict]) -> dict:
 
     A view that was not registered counts as an error larger than any, so it raises the percentiles
     rather than vanishing from them; percentiles are order statistics (no interpolation with such
-    views), None when they fall on such a view. A registered view that sees none of the walkable
-    area has no ground error and is left out of the ground error's statistics only.
+    views), None when they fall on such a view. A view that sees none of the walkable area has no
+    ground errors and is left out of their statistics only.
     """
     registered = np.array([row["registered"] for row in rows])
-    focal = np.array([row["focal_err_pct"] if row["registered"] else np.inf for row in rows], dtype=float)
-    ground = np.array([row["ground_err_m"] if row["registered"] else np.inf for row in rows], dtype=float)
-    ground = ground[~np.isnan(ground)]
 
     def percentile(values, q):
         value = float(np.percentile(values, q, method="inverted_cdf")) if len(values) else np.inf
         return value if np.isfinite(value) else None
 
-    return {
-        "views": len(rows),
-        "registered": int(registered.sum()),
-        "focal_err_median_pct": percentile(focal, 50),
-        "focal_err_p90_pct": percentile(focal, 90),
-        "ground_err_median_m": percentile(ground, 50),
-        "ground_err_p90_m": percentile(ground, 90),
-        "register_ms_median": float(1e3 * np.median([row["seconds"] for row in rows])),
-    }
+    summary: dict[str, float | None] = {"views": len(rows), "registered": int(registered.sum())}
+    for key, needs_registration in {"focal_err_pct": True, **GROUND_ERRORS}.items():
+        # None: a view that sees nothing (NaN, left out), or one not registered (inf, when that counts).
+        values = np.array([row[key] if row["registered"] or not needs_registration else np.inf for row in rows], float)
+        values = values[~np.isnan(values)]
+        name, unit = key.rsplit("_", 1)
+        summary[f"{name}_median_{unit}"] = percentile(values, 50)
+        summary[f"{name}_p90_{unit}"] = percentile(values, 90)
+    roll_err_deg = [abs(row["roll_err_deg"]) for row in rows if row["registered"]]
+    summary["roll_err_median_deg"] = float(np.median(roll_err_deg)) if roll_err_deg else None
+    summary["register_ms_median"] = float(1e3 * np.median([row["seconds"] for row in rows]))
+    return summary

@@ -25,6 +25,13 @@ is the composition of equation 1. The reading chosen:
 * The rotation then follows from K_t^-1 H K_m R_m (orthogonalised), and with
   it the live pose (pan, tilt, zoom) of the one camera model, whose
   homographies and head/feet homology the tracker uses unchanged.
+* A real camera's live view is rolled and radially distorted
+  (:mod:`ptztrack.geometry.lens`), so the pose is refined together with the
+  view's roll and distortion (k1) on the inliers; the tracker's model keeps
+  (pan, tilt, zoom). The principal point is not estimated: off the centre
+  by d pixels it shifts the view as a turn of d / f does, and a view a few
+  tens of degrees wide or narrower cannot tell the two apart, so the
+  registered pose absorbs it, which places the view's own pixels right.
 """
 
 import io
@@ -38,7 +45,8 @@ from scipy.optimize import least_squares
 from scipy.sparse import lil_matrix
 
 from ptztrack.files import write_atomically
-from ptztrack.geometry.ptz import PTZCamera, apply_homography, inside_image, intrinsics, rotation_world_to_camera
+from ptztrack.geometry.lens import Lens, corner_radius2, pixel_directions, project_directions
+from ptztrack.geometry.ptz import PTZCamera, inside_image, intrinsics, rotation_world_to_camera
 
 RATIO_TEST = 0.75
 RANSAC_THRESHOLD_PX = 3.0
@@ -75,6 +83,11 @@ REFINE_POINTS = 100
 FLANN_CHECKS = 16
 LIVE_FEATURES = 500
 REFERENCE_FEATURES = 1000
+# The live view's radial distortion is estimated with its pose under a zero-mean Gaussian prior on the
+# distortion at the image corner (k1 r_corner^2) of this standard deviation, fixed a priori: the wide
+# end of a PTZ lens distorts by a few percent at the corner (the PETS camera's own lens by 2.7 % over
+# the field of our zoom-1 view), and a narrow view, whose corners lie near its axis, leaves k1 to the prior.
+CORNER_DISTORTION_SIGMA = 0.03
 # Correspondences per pair of reference views that bundle adjustment uses (evenly spread over the
 # inliers): enough to pin three parameters per view many times over, few enough to stay fast.
 BUNDLE_POINTS_PER_PAIR = 40
@@ -304,7 +317,7 @@ def focal_from_homography(H_reference_to_live: np.ndarray, reference_focal_px: f
 
 
 def pose_from_rotation(R: np.ndarray) -> tuple[float, float]:
-    """(pan_deg, tilt_deg) of a world-to-camera rotation (its roll ignored: the mount is level)."""
+    """(pan_deg, tilt_deg) of a world-to-camera rotation: the direction of its optical axis, whatever its roll."""
     forward = R[2] / np.linalg.norm(R[2])
     return float(np.rad2deg(np.arctan2(forward[0], forward[1]))), float(np.rad2deg(np.arcsin(-forward[2])))
 
@@ -314,14 +327,17 @@ class Registration:
     """A registered live view: the pose of the camera model that explains it, and how well.
 
     pose : (pan_deg, tilt_deg, zoom), from equation 2 and the homography's rotation, refined on the
-    inliers; focal_px : its focal length; view : the reference view used;
-    inliers : RANSAC inliers of H_t.
+    inliers with the view's roll and distortion; focal_px : its focal length; view : the reference
+    view used; inliers : correspondences the refined camera fits; roll_deg, k1 : the view's roll and
+    radial distortion, which the tracker's model does not use.
     """
 
     pose: np.ndarray
     focal_px: float
     view: int
     inliers: int
+    roll_deg: float
+    k1: float
 
 
 def within_view_ratio_matches(index: ReferenceIndex, descriptors: np.ndarray, ratio: float = RATIO_TEST) -> np.ndarray:
@@ -388,28 +404,35 @@ def register(
         rotation = -rotation
     R_live = rotation @ rotation_world_to_camera(reference_pose[0], reference_pose[1])
     pan_deg, tilt_deg = pose_from_rotation(R_live)
+    rolled = R_live @ rotation_world_to_camera(pan_deg, tilt_deg).T
+    roll_deg = float(np.rad2deg(np.arctan2(rolled[1, 0], rolled[0, 0])))
     live_px, reference_px = best_inliers
+    directions = pixel_directions(camera, reference_pose, Lens(), reference_px)
     spread = np.linspace(0, len(live_px) - 1, min(len(live_px), REFINE_POINTS)).astype(int)
-    initial_pose = np.array([pan_deg, tilt_deg, focal_px / camera.f_min_px])
-    pose = refine_pose(camera, reference_pose, reference_px[spread], live_px[spread], initial_pose)
+    initial = np.array([pan_deg, tilt_deg, focal_px / camera.f_min_px, roll_deg, 0.0])
+    refined = refine_view(camera, directions[spread], live_px[spread], initial)
+    pose, lens = refined[:3], Lens(roll_deg=float(refined[3]), k1=float(refined[4]))
     # The homography of a narrow view leaves its perspective part (and so eq. 2) poorly pinned; the
-    # three-parameter camera is not, but the inliers must then fit it, as they fit a true rotation.
-    fitted = np.linalg.norm(
-        apply_homography(rotation_homography(camera, reference_pose, pose), reference_px) - live_px, axis=1
-    )
-    if np.count_nonzero(fitted <= RANSAC_THRESHOLD_PX) < max(MIN_INLIERS, len(live_px) / 2):
+    # five-parameter camera is not, but the inliers must then fit it, as they fit a true rotation.
+    fitted = np.linalg.norm(project_directions(camera, pose, lens, directions) - live_px, axis=1)
+    fitting = int(np.count_nonzero(fitted <= RANSAC_THRESHOLD_PX))
+    if fitting < max(MIN_INLIERS, len(live_px) / 2):
         return None
-    return Registration(pose, pose[2] * camera.f_min_px, best, int(np.count_nonzero(fitted <= RANSAC_THRESHOLD_PX)))
+    return Registration(pose, pose[2] * camera.f_min_px, best, fitting, lens.roll_deg, lens.k1)
 
 
-def refine_pose(camera: PTZCamera, reference_pose, reference_px, live_px, initial_pose) -> np.ndarray:
-    """The live (pan_deg, tilt_deg, zoom) that best maps reference points (M, 2) onto live points (M, 2)
-    through the rotating camera: 3 parameters instead of the homography's 8, so a few dozen
-    correspondences pin the pose far better than the homography they came from."""
+def refine_view(camera: PTZCamera, directions, live_px, initial) -> np.ndarray:
+    """The live (pan_deg, tilt_deg, zoom, roll_deg, k1) that best projects world directions (M, 3)
+    onto their live points (M, 2): 5 parameters instead of the homography's 8, so a few dozen
+    correspondences pin the view far better than the homography they came from. Soft-L1 loss (1 px);
+    k1 under its prior (``CORNER_DISTORTION_SIGMA`` at the corner; Gaussian within one sigma, where
+    the loss leaves it quadratic)."""
 
-    def residuals(pose):
-        H = rotation_homography(camera, reference_pose, pose)
-        projected = reference_px @ H[:, :2].T + H[:, 2]
-        return (projected[:, :2] / projected[:, 2:] - live_px).ravel()
+    def residuals(view):
+        lens = Lens(roll_deg=view[3], k1=view[4])
+        projected = project_directions(camera, view[:3], lens, directions)
+        prior = view[4] * corner_radius2(camera, view[2]) / CORNER_DISTORTION_SIGMA
+        return np.r_[(projected - live_px).ravel(), prior]
 
-    return least_squares(residuals, initial_pose, loss="soft_l1", f_scale=1.0, x_scale=[1.0, 1.0, 0.01]).x
+    scale = [1.0, 1.0, 0.01, 1.0, 0.1]
+    return least_squares(residuals, initial, loss="soft_l1", f_scale=1.0, x_scale=scale).x
