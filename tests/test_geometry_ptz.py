@@ -16,8 +16,10 @@ from ptztrack.geometry.ptz import (
     inside_image,
     look_at,
     plane_homography,
+    aim_at,
     project_people,
     projection_matrix,
+    rotation_homography,
     rotation_world_to_camera,
 )
 
@@ -238,6 +240,51 @@ def test_look_at_batched():
     np.testing.assert_allclose(batch[2, 0], 0.0, atol=1e-12)
     np.testing.assert_allclose(batch[3, 0], 90.0, atol=1e-12)
     np.testing.assert_allclose(batch[2, 1], np.rad2deg(np.arctan2(7.0, 14.0)), atol=1e-12)
+
+
+@PROPERTY
+@given(
+    st.floats(10.0, 50.0),
+    st.floats(-180.0, 180.0),
+    st.floats(0.0, 2.0),
+    st.tuples(unit, unit),
+    zooms,
+)
+def test_aim_at_shows_the_point_at_the_pixel(distance_m, bearing_deg, height_m, fractions, zoom):
+    """The pose aim_at returns sees the point in front of the camera, at the pixel asked for.
+
+    At 10 m or more from a camera 7 m up every pixel can reach the point with a tilt below 90 deg."""
+    bearing = np.deg2rad(bearing_deg)
+    point = CAMERA.centre_m + [distance_m * np.sin(bearing), distance_m * np.cos(bearing), 0.0]
+    point[2] = height_m
+    pixel = np.array(fractions) * [CAMERA.image_width_px, CAMERA.image_height_px]
+    pose = aim_at(CAMERA, point, pixel, zoom)
+    homogeneous = projection_matrix(CAMERA, pose) @ np.append(point, 1.0)
+    assert homogeneous[2] > 0
+    np.testing.assert_allclose(homogeneous[:2] / homogeneous[2], pixel, rtol=0, atol=1e-7)
+    assert pose[2] == zoom
+
+
+def test_aim_at_the_principal_point_is_look_at_and_batches():
+    targets = np.array([[0.0, 0.0], [15.0, 15.0], [7.5, 10.0], [20.0, -4.0]])
+    poses = aim_at(CAMERA, with_z(targets), CENTRE, 2.0)
+    np.testing.assert_allclose(poses, look_at(CAMERA, targets, 2.0), atol=1e-9)
+
+
+@PROPERTY
+@given(poses, poses, st.lists(st.tuples(unit, unit), min_size=1, max_size=5))
+def test_rotation_homography_maps_the_pixels_of_one_view_onto_the_other(pose1, pose2, fractions):
+    """A point seen at a pixel of one view is seen where the homography puts that pixel in the other."""
+    pixels = np.array(fractions) * [CAMERA.image_width_px, CAMERA.image_height_px]
+    R1 = rotation_world_to_camera(pose1[0], pose1[1])
+    rays_camera = np.c_[(pixels - CENTRE) / (pose1[2] * CAMERA.f_min_px), np.ones(len(pixels))]
+    points = CAMERA.centre_m + 7.0 * rays_camera @ R1  # anywhere along the rays
+    homogeneous = (projection_matrix(CAMERA, pose2) @ np.c_[points, np.ones(len(points))].T).T
+    assume(np.all(homogeneous[:, 2] > 1e-3))
+    expected = homogeneous[:, :2] / homogeneous[:, 2:]
+    mapped = apply_homography(rotation_homography(CAMERA, pose1, pose2), pixels)
+    np.testing.assert_allclose(mapped, expected, rtol=1e-7, atol=1e-6)
+    np.testing.assert_allclose(rotation_homography(CAMERA, pose1, pose1), np.eye(3), atol=1e-12)
 
 
 @PROPERTY

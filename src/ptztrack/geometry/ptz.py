@@ -262,6 +262,47 @@ def look_at(camera: PTZCamera, target_xy, zoom=1.0) -> np.ndarray:
     return np.stack([pan_deg, tilt_deg, np.broadcast_to(zoom, pan_deg.shape)], axis=-1)
 
 
+def rotation_homography(camera: PTZCamera, from_poses, to_poses) -> np.ndarray:
+    """The homography ``K2 R2 R1^T K1^-1`` taking pixels of the view at ``from_poses`` to the view at ``to_poses``.
+
+    The camera turns about its optical centre, so every point of the scene (near or far) maps
+    through it. Poses broadcast; shape ``(*P, 3, 3)``.
+    """
+    from_poses, to_poses = np.asarray(from_poses, dtype=float), np.asarray(to_poses, dtype=float)
+    R1 = rotation_world_to_camera(from_poses[..., PAN], from_poses[..., TILT])
+    R2 = rotation_world_to_camera(to_poses[..., PAN], to_poses[..., TILT])
+    K1_inv = np.linalg.inv(intrinsics(camera, from_poses[..., ZOOM]))
+    return intrinsics(camera, to_poses[..., ZOOM]) @ R2 @ np.swapaxes(R1, -1, -2) @ K1_inv
+
+
+def aim_at(camera: PTZCamera, points_m, pixels_px, zoom) -> np.ndarray:
+    """The poses at ``zoom`` that show the world points ``points_m`` (..., 3) at the pixels ``pixels_px`` (..., 2).
+
+    Returns (..., 3) (pan_deg, tilt_deg, zoom). In closed form: with the pixel's ray
+    ``(a, b, 1)`` in the camera frame and the point seen at depression ``delta`` below the
+    horizon, the ray's depression at tilt ``phi`` satisfies ``tan delta = (b cos phi + sin phi) /
+    sqrt(a^2 + (cos phi - b sin phi)^2)``, whose solution is ``phi = psi - atan b`` with
+    ``cos^2 psi = cos^2 delta - a^2 sin^2 delta / (1 + b^2)``; the pan then turns the ray's
+    azimuth, ``atan2(a, cos phi - b sin phi)`` to the right of the optical axis, onto the
+    point's. Where no tilt within +-90 deg brings the pixel's ray down (or up) to the point (a
+    point nearly below the camera, a pixel far from the image's vertical centre line), there is
+    no such pose, and the one returned turns the pixel's ray as steeply as it goes (psi = +-90 deg).
+    """
+    points_m, pixels_px = np.asarray(points_m, dtype=float), np.asarray(pixels_px, dtype=float)
+    zoom = np.asarray(zoom, dtype=float)
+    ray = (pixels_px - camera.principal_point_px) / (zoom * camera.f_min_px)[..., None]
+    a, b = ray[..., 0], ray[..., 1]
+    offset = points_m - camera.centre_m
+    horizontal_m = np.hypot(offset[..., 0], offset[..., 1])
+    depression = np.arctan2(-offset[..., 2], horizontal_m)
+    cos_psi_squared = np.cos(depression) ** 2 - a**2 * np.sin(depression) ** 2 / (1 + b**2)
+    psi = np.sign(depression) * np.arccos(np.sqrt(np.clip(cos_psi_squared, 0.0, 1.0)))
+    tilt = psi - np.arctan(b)
+    pan = np.arctan2(offset[..., 0], offset[..., 1]) - np.arctan2(a, np.cos(tilt) - b * np.sin(tilt))
+    pan_deg = (np.rad2deg(pan) + 180.0) % 360.0 - 180.0
+    return np.stack([pan_deg, np.rad2deg(tilt), np.broadcast_to(zoom, pan_deg.shape)], axis=-1)
+
+
 def ground_footprint(camera: PTZCamera, poses, points_per_edge: int = 16, max_range_m: float = 60.0) -> np.ndarray:
     """The field of view on the ground: a polygon (*P, 4 * points_per_edge, 2) in metres.
 
