@@ -68,3 +68,13 @@ def test_rendered_views_show_the_recording():
         zoomed[60 - 6 * 3 // 5 : 60 + 6 * 3 // 5, 80 - 8 * 3 // 5 : 80 + 8 * 3 // 5].astype(float).mean(axis=(0, 1))
     )
     assert np.max(np.abs(centre - zoomed_centre)) < 25
+
+
+@pytest.mark.parametrize("pose", [CENTRE_POSE + [0.0, 0.0, 0.0], CENTRE_POSE + [-6.0, -1.5, 3.0]])
+def test_a_map_interpolated_over_a_grid_of_8_px_is_the_exact_one_to_a_hundredth_of_a_pixel(pose):
+    exact_u, exact_v = virtual_ptz(RECORDING, image_size_px=(640, 480))[0].sampling_maps(pose)
+    coarse = virtual_ptz(RECORDING, image_size_px=(640, 480), map_grid_px=8)[0]
+    coarse_u, coarse_v = coarse.sampling_maps(pose)
+    assert coarse_u.shape == exact_u.shape == (480, 640)
+    assert np.max(np.hypot(coarse_u - exact_u, coarse_v - exact_v)) < 0.01
+

@@ -271,6 +271,9 @@ class Recording(_Strict):
     frame_range : [first, stop) video frames (0-based) to run on; default all.
     area_m : the walkable area, a polygon of [x, y] points in metres; default the ground the
     recorded view shows (see :func:`ptztrack.builders.world.visible_ground_m`).
+    map_grid_px : the virtual camera computes where each pixel reads the recording exactly every
+    ``map_grid_px`` pixels and interpolates in between (1: every pixel; see
+    :class:`ptztrack.camera.virtual.VirtualPTZ`).
     """
 
     ground_truth: str
@@ -282,6 +285,7 @@ class Recording(_Strict):
     occluded_above: float = Field(0.25, ge=0, le=1)
     frame_range: tuple[Annotated[int, Field(ge=0)], Annotated[int, Field(ge=0)]] | None = None
     area_m: tuple[tuple[float, float], ...] | None = None
+    map_grid_px: int = Field(1, ge=1)
 
     @model_validator(mode="after")
     def _range_and_area(self):

@@ -74,7 +74,9 @@ def build_scene(scenario: Scenario, scene_rng: np.random.Generator) -> BuiltScen
         return BuiltScene(ptz_camera(scenario), action_grid(scenario), truth, rectangle_m(*scenario.area_m))
     recording = scenario.recording
     calibration = load_calibration(recording.calibration, recording.view)
-    virtual, whole_frame_pose = virtual_ptz(calibration, recording.recorded_size_px, scenario.camera.image_size_px)
+    virtual, whole_frame_pose = virtual_ptz(
+        calibration, recording.recorded_size_px, scenario.camera.image_size_px, recording.map_grid_px
+    )
     offsets = action_grid(scenario)
     grid = ActionGrid(
         offsets.pan_deg + whole_frame_pose[0], offsets.tilt_deg + whole_frame_pose[1], offsets.zoom, offsets.max_steps

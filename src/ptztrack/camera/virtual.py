@@ -31,11 +31,16 @@ class VirtualPTZ:
     camera : the virtual camera (centre in metres, virtual image size, f_min).
     recording : the recording camera's calibration (millimetres).
     recorded_size_px : (width, height) of the recorded frames.
+    map_grid_px : where each virtual pixel reads the recording is computed exactly for every pixel
+        (1) or every ``map_grid_px``-th pixel in both directions and interpolated bilinearly in
+        between. The map is smooth: on a grid of 8 px a 640 x 480 view's map is within 0.005 px of
+        the exact one (below cv2.remap's 1/32 px resolution) and takes 2.5 ms instead of 150-300 ms.
     """
 
     camera: PTZCamera
     recording: PinholeCalibration
     recorded_size_px: tuple[int, int]
+    map_grid_px: int = 1
 
     def pixel_centres(self) -> np.ndarray:
         """(h * w, 2) centres of the virtual pixels, row by row: pixel (row, col) at (col + 0.5, row + 0.5)."""
@@ -45,18 +50,36 @@ class VirtualPTZ:
 
     def sampling_maps(self, pose) -> tuple[np.ndarray, np.ndarray]:
         """Where each virtual pixel (centre) reads the recorded frame: two (h, w) float32 maps for cv2.remap."""
-        pixels = np.c_[self.pixel_centres(), np.ones(self.camera.image_width_px * self.camera.image_height_px)]
+        width, height, step = self.camera.image_width_px, self.camera.image_height_px, self.map_grid_px
+        if step == 1:
+            centres, shape = self.pixel_centres(), (height, width)
+        else:
+            # Nodes at the centres of every step-th pixel, the last ones at or beyond the image's last pixel.
+            columns, rows = (np.arange(0, -(-(size - 1) // step) * step + 1, step) for size in (width, height))
+            u, v = np.meshgrid(columns + 0.5, rows + 0.5)
+            centres, shape = np.c_[u.ravel(), v.ravel()], (len(rows), len(columns))
+        pixels = np.c_[centres, np.ones(len(centres))]
         pose = np.asarray(pose, dtype=float)
         rays = pixels @ np.linalg.inv(intrinsics(self.camera, pose[2])).T @ rotation_world_to_camera(pose[0], pose[1])
-        return self.maps_of_directions(rays)
+        maps = self._maps_of_directions(rays, shape)
+        if step > 1:
+            # Pixel (i, j) lies at (j / step, i / step) among the nodes: multiples of 1/8 for a step of 8,
+            # which remap's 1/32 px interpolation weights hold exactly.
+            node_u, node_v = np.meshgrid(np.arange(width) / step, np.arange(height) / step)
+            maps = cv2.remap(maps, node_u.astype(np.float32), node_v.astype(np.float32), cv2.INTER_LINEAR)
+        return maps[..., 0], maps[..., 1]
 
     def maps_of_directions(self, directions) -> tuple[np.ndarray, np.ndarray]:
         """Sampling maps (two (h, w) float32) of the virtual pixels that look along world ``directions``
         (h * w, 3), row by row."""
+        maps = self._maps_of_directions(directions, (self.camera.image_height_px, self.camera.image_width_px))
+        return maps[..., 0], maps[..., 1]
+
+    def _maps_of_directions(self, directions, shape: tuple[int, int]) -> np.ndarray:
+        """One (rows, columns, 2) float32 array of where world ``directions`` read the recorded frame."""
         recorded = _project_directions(self.recording, directions)
         # The centre of recorded pixel (i, j) is at (i + 0.5, j + 0.5); remap indexes from 0.
-        maps = (recorded - 0.5).reshape(self.camera.image_height_px, self.camera.image_width_px, 2).astype(np.float32)
-        return maps[..., 0], maps[..., 1]
+        return (recorded - 0.5).reshape(*shape, 2).astype(np.float32)
 
     def render(self, frame, pose) -> np.ndarray:
         """The virtual view (h, w, 3) of a recorded frame; black where the recording does not reach."""
@@ -110,7 +133,7 @@ def _project_directions(recording: PinholeCalibration, directions) -> np.ndarray
 
 
 def virtual_ptz(
-    recording: PinholeCalibration, recorded_size_px=(768, 576), image_size_px=(160, 120)
+    recording: PinholeCalibration, recorded_size_px=(768, 576), image_size_px=(160, 120), map_grid_px: int = 1
 ) -> tuple[VirtualPTZ, np.ndarray]:
     """The virtual PTZ camera over a recording, and the pose that reproduces the recorded view.
 
@@ -119,7 +142,7 @@ def virtual_ptz(
     recording's focal length scaled by the width ratio. Returns the camera and
     the (pan_deg, tilt_deg, 1) pose looking through the centre of the
     recorded image, which the recording's principal point need not be (the
-    recording's small roll is not reproduced: the mount is level).
+    recording's small roll is not reproduced: the mount is level). map_grid_px : see :class:`VirtualPTZ`.
     """
     centre_m = -recording.R.T @ recording.t / MM_PER_M
     focal_px = 0.5 * (recording.K[0, 0] + recording.K[1, 1]) * image_size_px[0] / recorded_size_px[0]
@@ -134,4 +157,4 @@ def virtual_ptz(
     forward = np.array([*normalised, 1.0]) @ recording.R
     forward /= np.linalg.norm(forward)
     pose = np.array([np.rad2deg(np.arctan2(forward[0], forward[1])), np.rad2deg(np.arcsin(-forward[2])), 1.0])
-    return VirtualPTZ(camera, recording, tuple(recorded_size_px)), pose
+    return VirtualPTZ(camera, recording, tuple(recorded_size_px), map_grid_px), pose
