@@ -77,4 +77,3 @@ def test_a_map_interpolated_over_a_grid_of_8_px_is_the_exact_one_to_a_hundredth_
     coarse_u, coarse_v = coarse.sampling_maps(pose)
     assert coarse_u.shape == exact_u.shape == (480, 640)
     assert np.max(np.hypot(coarse_u - exact_u, coarse_v - exact_v)) < 0.01
-

@@ -6,6 +6,7 @@ from hypothesis import strategies as st
 
 from ptztrack.geometry.ptz import (
     PTZCamera,
+    aim_at,
     apply_homography,
     camera_depth_m,
     feet_jacobian,
@@ -16,7 +17,6 @@ from ptztrack.geometry.ptz import (
     inside_image,
     look_at,
     plane_homography,
-    aim_at,
     project_people,
     projection_matrix,
     rotation_homography,
