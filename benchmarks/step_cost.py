@@ -68,7 +68,7 @@ def step_costs(scenario, policy_name: str, steps: int, warmup: int, seed: int = 
     The loop is run_loop's (a perfect camera, the commanded pose) with the backend's image split
     into reading and warping.
     """
-    scene_seed, _detector_seed, policy_seed, _landing_seed = episode_seeds(seed)
+    scene_seed, _detector_seed, policy_seed, _landing_seed, _tracker_seed = episode_seeds(seed)
     world = build_world(scenario, np.random.default_rng(scene_seed))
     backend, detector = world.backend, world.detector
     if not isinstance(detector, HogPeopleDetector):

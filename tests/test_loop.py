@@ -3,6 +3,7 @@ import numpy as np
 from ptztrack.builders.episode import run_episode
 from ptztrack.config import scenario_from_dict
 from ptztrack.evaluate.metrics import episode_metrics
+from ptztrack.loop import episode_seeds
 
 SEEDS = range(6)
 
@@ -47,3 +48,10 @@ def test_policies_meet_the_same_people_under_the_same_seed():
     scenario = scenario_from_dict({})
     fix, patrol = run_episode(scenario, "fix", 5), run_episode(scenario, "patrol", 5)
     np.testing.assert_array_equal(fix.truth.positions_m, patrol.truth.positions_m)
+
+
+def test_the_trackers_stream_leaves_the_first_four_streams_as_they_were():
+    draws = [np.random.default_rng(stream).random(3) for stream in episode_seeds(7)]
+    before = [np.random.default_rng(stream).random(3) for stream in np.random.SeedSequence(7).spawn(4)]
+    np.testing.assert_array_equal(draws[:4], before)
+    assert not np.array_equal(draws[4], draws[3])

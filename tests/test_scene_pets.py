@@ -12,7 +12,7 @@ from ptztrack.geometry.calibration import (
     project_pinhole,
     project_tsai,
 )
-from ptztrack.scene.pets import DatasetError, load_cvml, load_mot_ground_truth, read_video
+from ptztrack.scene.pets import DatasetError, load_cvml, load_mot_ground_truth, read_video, recorded_scene
 
 EXCERPT = Path(__file__).parent / "data" / "pets_s2l1_excerpt"
 
@@ -145,3 +145,12 @@ def test_malformed_calibrations_are_named_with_the_problem(tmp_path):
         load_pinhole(EXCERPT / "pinhole.json", view="View_009")
     with pytest.raises(CalibrationError, match="no such calibration file"):
         load_tsai(tmp_path / "nothing.xml")
+
+
+def test_the_steps_of_a_recording_may_start_at_a_later_frame():
+    annotations = load_mot_ground_truth(EXCERPT / "gt_mot15.txt")
+    later = recorded_scene(annotations, frame_step=3, steps=4, frame_rate_hz=5.0, frame_range=(10, 30))
+    np.testing.assert_array_equal(later.video_frame, [10, 13, 16, 19])
+    whole = recorded_scene(annotations, frame_step=1, steps=30, frame_rate_hz=5.0)
+    columns = np.searchsorted(whole.person_id, later.person_id)
+    np.testing.assert_array_equal(later.truth.positions_m, whole.truth.positions_m[[10, 13, 16, 19]][:, columns])

@@ -4,7 +4,8 @@
 backend, a detector, a tracker and a policy, and where the camera lands and
 which pose the tracker believes. Random draws come from independent streams
 spawned from the seed (:func:`episode_seeds`): the scene, one detector
-stream per frame, the policy, and the camera's landing errors. So different
+stream per frame, the policy, the camera's landing errors, and the tracker
+(for a tracker that draws, such as a particle filter; the world carries it). So different
 policies run with the same seed meet the same people and, frame by frame,
 the same detector luck (common random numbers), which makes their paired
 comparison far less noisy.
@@ -34,6 +35,7 @@ class World:
     start_action : the flat action the camera is at before the first step.
     pose_source : the pose the tracker maps detections with (:mod:`ptztrack.camera.pose_feedback`).
     landing_error : where the camera lands when sent to a pose.
+    tracker_seed : the episode's stream for a tracker that draws (its factory seeds it from this).
     """
 
     camera: PTZCamera
@@ -45,6 +47,7 @@ class World:
     start_action: int
     pose_source: PoseSource
     landing_error: LandingError
+    tracker_seed: np.random.SeedSequence | None = None
 
 
 @dataclass(frozen=True)
@@ -93,13 +96,17 @@ def command(grid: ActionGrid, choice: int | np.ndarray) -> tuple[int, np.ndarray
 
 
 def episode_seeds(seed: int) -> list[np.random.SeedSequence]:
-    """The independent streams of an episode: scene, detector, policy, the camera's landing errors."""
-    return np.random.SeedSequence(seed).spawn(4)
+    """The independent streams of an episode: scene, detector, policy, the camera's landing errors, tracker.
+
+    The first four are those of a seed before the tracker's was added (spawning more children does
+    not change the earlier ones).
+    """
+    return np.random.SeedSequence(seed).spawn(5)
 
 
 def run_loop(world: World, policy: Policy, tracker: Tracker, seed: int) -> Episode:
     """Run the closed loop for every frame of ``world.truth``, with the streams of ``seed``."""
-    _, detector_seed, policy_seed, landing_seed = episode_seeds(seed)
+    _, detector_seed, policy_seed, landing_seed, _ = episode_seeds(seed)
     steps = world.truth.positions_m.shape[0]
     frame_seeds = detector_seed.spawn(steps)
     policy_rng = np.random.default_rng(policy_seed)

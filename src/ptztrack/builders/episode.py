@@ -19,7 +19,8 @@ def episode_world(
     scenario: Scenario, seed: int, camera: CameraSpec | None = None, detector: DetectorSpec | None = None
 ) -> World:
     """The world that ``run_episode(scenario, any_policy, seed)`` runs in: the same people."""
-    return build_world(scenario, np.random.default_rng(episode_seeds(seed)[0]), camera, detector)
+    streams = episode_seeds(seed)
+    return build_world(scenario, np.random.default_rng(streams[0]), camera, detector, tracker_seed=streams[4])
 
 
 def make_policy(spec: PolicySpec, scenario: Scenario, world: World) -> Policy:

@@ -138,11 +138,13 @@ def build_world(
     scene_rng: np.random.Generator,
     camera: CameraSpec | None = None,
     detector: DetectorSpec | None = None,
+    tracker_seed: np.random.SeedSequence | None = None,
 ) -> World:
     """The world of ``scenario``: its scene, camera backend, detector and pose source.
 
     camera : the backend, by default ``camera.backend`` of the scenario ('simulated' for the
-    synthetic scene, 'virtual' for a recording); detector : by default ``detector.kind``.
+    synthetic scene, 'virtual' for a recording); detector : by default ``detector.kind``;
+    tracker_seed : the stream of a tracker that draws.
     """
     scene = build_scene(scenario, scene_rng)
     default_backend = "virtual" if scenario.recording is not None else "simulated"
@@ -158,4 +160,5 @@ def build_world(
         start_action=widest_view_action(scene.camera, scene.grid, scene.area_polygon_m),
         pose_source=pose_source(scenario, scene),
         landing_error=landing_error(scenario),
+        tracker_seed=tracker_seed,
     )
