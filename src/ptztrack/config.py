@@ -296,6 +296,87 @@ class Recording(_Strict):
         return self
 
 
+Fraction = Annotated[float, Field(gt=0, lt=1)]
+Patch = tuple[
+    Annotated[float, Field(ge=0, le=1)],
+    Annotated[float, Field(ge=0, le=1)],
+    Annotated[float, Field(gt=0, le=1)],
+    Annotated[float, Field(gt=0, le=1)],
+]
+
+
+class Follow(_Strict):
+    """The follow camera (the robot-cameraman paper, seed 003): one person kept at an image point and size.
+
+    The ``tracker.kind`` 'particle' (the paper's particle filter), 'csrt' or 'mil' (OpenCV's) follows
+    the person and the policy 'follow' moves the camera. Each default's source is in the README
+    ("Follow camera: parameters"); none was tuned on PETS.
+
+    target_id : the annotated person followed; the tracker starts from their first annotated box.
+    target_point_px : (x*, y*) where the middle of the person should be; null: the image centre.
+    target_height_px : the person's height wanted in the image.
+    max_speed_deg_s, max_acceleration_deg_s2 : of pan and of tilt; max_zoom_speed (per s),
+    max_zoom_acceleration (per s^2) : of the natural logarithm of the zoom; zoom_range : [lowest, highest].
+    smoothing_cutoff_hz : the tracker's output low-pass filter.
+    particles, search_particles : tracking, and searching after a loss.
+    patches : [left, top, width, height] in units of the person's box (default: head, torso, legs).
+    histogram_bins : N of the N x N hue-saturation histograms; samples_per_patch : grid points per axis.
+    achromatic_bins : N more bins by value for pixels too grey or dark to have a hue (Perez et al.);
+    false: the paper's hue-saturation histograms alone.
+    lambda_colour, lambda_motion : equations 3 and 4.
+    walk_heights_per_s : random-walk spread of the box position, box heights per second;
+    scale_change_per_s : relative random-walk spread of its height per second.
+    loss_fraction, adapt_fraction : the loss test (P < loss_fraction P_ref) and when P_ref adapts.
+    reference_time_constant_s : how slowly P_ref adapts.
+    search_heights : spread of the diffuse prior after a loss, in box heights; search_scale : of its height.
+    motion_threshold : grey levels; motion_memory_s : how long the motion history lasts;
+    motion_scale : the motion image's resolution relative to the view's.
+    """
+
+    target_id: int | None = None
+    target_point_px: tuple[NonNegativeFloat, NonNegativeFloat] | None = None
+    target_height_px: PositiveFloat = 160.0
+    max_speed_deg_s: PositiveFloat = 30.0
+    max_acceleration_deg_s2: PositiveFloat = 30.0
+    max_zoom_speed: PositiveFloat = 0.7
+    max_zoom_acceleration: PositiveFloat = 0.7
+    zoom_range: tuple[Annotated[float, Field(ge=1)], Annotated[float, Field(ge=1)]] = (1.0, 4.0)
+    smoothing_cutoff_hz: PositiveFloat = 1.0
+    particles: int = Field(100, ge=1)
+    search_particles: int = Field(400, ge=2)
+    patches: tuple[Patch, ...] = ((0.3, 0.0, 0.4, 0.15), (0.15, 0.15, 0.7, 0.35), (0.2, 0.5, 0.6, 0.5))
+    histogram_bins: int = Field(10, ge=1, le=64)
+    achromatic_bins: bool = False
+    samples_per_patch: int = Field(20, ge=1)
+    lambda_colour: PositiveFloat = 0.15
+    lambda_motion: PositiveFloat = 0.434
+    walk_heights_per_s: PositiveFloat = 1.0
+    scale_change_per_s: PositiveFloat = 0.2
+    loss_fraction: Fraction = 0.1
+    adapt_fraction: Fraction = 0.6
+    reference_time_constant_s: PositiveFloat = 2.0
+    search_heights: PositiveFloat = 1.0
+    search_scale: PositiveFloat = 0.2
+    motion_threshold: NonNegativeFloat = 15.0
+    motion_memory_s: PositiveFloat = 0.3
+    motion_scale: Annotated[float, Field(gt=0, le=1)] = 0.5
+
+    @model_validator(mode="after")
+    def _consistent(self):
+        if self.zoom_range[1] < self.zoom_range[0]:
+            raise ValueError(f"zoom_range must be [lowest, highest] (got {list(self.zoom_range)})")
+        if self.adapt_fraction <= self.loss_fraction:
+            raise ValueError(
+                f"adapt_fraction ({self.adapt_fraction}) must be above loss_fraction ({self.loss_fraction})"
+            )
+        if not self.patches:
+            raise ValueError("patches must hold at least one [left, top, width, height]")
+        for number, (left, top, width, height) in enumerate(self.patches):
+            if left + width > 1 or top + height > 1:
+                raise ValueError(f"patch {number} {[left, top, width, height]} reaches outside the box")
+        return self
+
+
 class Scenario(_Strict):
     """Everything a run needs besides the policy and the seed."""
 
@@ -309,6 +390,7 @@ class Scenario(_Strict):
     tracker: Tracker = Tracker()
     control: Control = Control()
     pose_feedback: PoseFeedback = PoseFeedback()
+    follow: Follow = Follow()
     recording: Recording | None = None
 
     @model_validator(mode="after")
@@ -367,6 +449,16 @@ def scenario_from_dict(data: dict, source: str = "scenario", **overrides) -> Sce
         raise ScenarioError(_first_error_line(error, source)) from None
 
 
+def _pets_recording() -> dict:
+    """The files of the PETS 2009 S2.L1 recording that ship with the package."""
+    data_dir = resources.files("ptztrack.data") / "pets2009_s2l1"
+    return {
+        "ground_truth": str(data_dir / "gt_mot15.txt"),
+        "calibration": str(data_dir / "pinhole.json"),
+        "video": str(data_dir / "View_001.avi"),
+    }
+
+
 def pets_scenario(detector: str = "ideal", **overrides) -> Scenario:
     """The built-in PETS 2009 S2.L1 scenario: the paper's realistic experiment (section 5.2), with every
     parameter fixed a priori (the defaults; :mod:`ptztrack.builders.pets` fits the detector's model on
@@ -376,12 +468,7 @@ def pets_scenario(detector: str = "ideal", **overrides) -> Scenario:
     """
     if detector not in ("ideal", "hog"):
         raise ScenarioError(f"pets: detector {detector!r} is not available; expected ideal or hog")
-    data_dir = resources.files("ptztrack.data") / "pets2009_s2l1"
-    recording = {
-        "ground_truth": str(data_dir / "gt_mot15.txt"),
-        "calibration": str(data_dir / "pinhole.json"),
-        "video": str(data_dir / "View_001.avi"),
-    }
+    recording = _pets_recording()
     data = {
         "frames": 398,
         "frame_rate_hz": 5.0,
@@ -401,6 +488,34 @@ def pets_scenario(detector: str = "ideal", **overrides) -> Scenario:
         "recording": recording,
     }
     return scenario_from_dict(data, "pets", **overrides)
+
+
+def pets_follow_scenario(tracker: str = "particle", **overrides) -> Scenario:
+    """The follow camera on PETS 2009 S2.L1: every recorded frame (10 Hz), seen by a 640 x 480 virtual view.
+
+    640 x 480 is the paper's camera (section IV). The camera starts at the view of the whole recorded
+    frame (the action grid's only pose). tracker : 'particle', 'csrt' or 'mil'. The person
+    is ``follow.target_id``; :func:`ptztrack.builders.follow.target_scenario` narrows the steps to
+    their annotated frames. The virtual camera interpolates its sampling map over 8 px, which keeps a
+    view's rendering at a few milliseconds (see ``recording.map_grid_px``).
+    """
+    data = {
+        "frames": 795,
+        "frame_rate_hz": 10.0,
+        "camera": {"image_size_px": (640, 480)},
+        # One action: the view of the whole recorded frame, where the camera starts; the policy
+        # commands every other pose itself.
+        "actions": {
+            "pan_deg": {"start": 0.0, "stop": 0.0, "count": 1},
+            "tilt_deg": {"start": 0.0, "stop": 0.0, "count": 1},
+            "zoom": (1.0,),
+        },
+        # The annotations lie about 2 px from the calibrated feet in the 768 px frame (0.5 px at 160 px).
+        "detector": {"kind": "ideal", "pixel_noise_px": 0.5},
+        "tracker": {"kind": tracker},
+        "recording": {**_pets_recording(), "frame_step": 1, "map_grid_px": 8},
+    }
+    return scenario_from_dict(data, "pets follow", **overrides)
 
 
 def load_scenario(path: str | Path, **overrides) -> Scenario:

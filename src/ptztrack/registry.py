@@ -33,11 +33,18 @@ ENTRY_POINT_GROUPS = {kind: f"ptztrack.{kind}" for kind in KINDS}
 _SINGULAR = {"policies": "policy", "detectors": "detector", "cameras": "camera backend", "trackers": "tracker"}
 
 _FACTORIES = "ptztrack.builders.factories"
+_FOLLOW = "ptztrack.builders.follow"
 _BUILT_IN: dict[str, dict[str, str]] = {
-    "policies": {name: f"{_FACTORIES}:{name}_policy" for name in ("fix", "patrol", "random", "intg", "smpl")},
+    "policies": {
+        **{name: f"{_FACTORIES}:{name}_policy" for name in ("fix", "patrol", "random", "intg", "smpl")},
+        "follow": f"{_FOLLOW}:follow_policy",
+    },
     "detectors": {name: f"{_FACTORIES}:{name}_detector" for name in ("ideal", "realistic", "hog")},
     "cameras": {"simulated": f"{_FACTORIES}:simulated_camera", "virtual": f"{_FACTORIES}:virtual_camera"},
-    "trackers": {"ekf": f"{_FACTORIES}:ekf_tracker"},
+    "trackers": {
+        "ekf": f"{_FACTORIES}:ekf_tracker",
+        **{name: f"{_FOLLOW}:{name}_tracker" for name in ("particle", "csrt", "mil")},
+    },
 }
 _registered: dict[str, dict[str, Callable[..., Any]]] = {kind: {} for kind in KINDS}
 

@@ -1,0 +1,183 @@
+"""The follow camera from a scenario: its trackers ('particle', 'csrt', 'mil') and its policy ('follow').
+
+The scenario's ``follow`` section holds the parameters (rates per second);
+here they become the per-step dataclasses of :mod:`ptztrack.track.particle_filter`,
+:mod:`ptztrack.track.target` and :mod:`ptztrack.control.follow`. The person
+followed is ``follow.target_id``, started from their annotated box at the
+first step, moved into the view the camera is at before it.
+"""
+
+import numpy as np
+
+from ptztrack.camera.recorded import RecordedPTZ
+from ptztrack.camera.virtual import virtual_ptz
+from ptztrack.config import Actions, Scenario, ScenarioError
+from ptztrack.control.follow import FollowParameters, FollowPolicy, framing_pose
+from ptztrack.geometry.calibration import load_calibration
+from ptztrack.geometry.ptz import PTZCamera, aim_at
+from ptztrack.loop import World
+from ptztrack.scene.pets import load_mot_ground_truth
+from ptztrack.track.particle_filter import ParticleFilterParameters
+from ptztrack.track.target import OpenCVSource, ParticleSource, TargetSource, TargetTracker, opencv_tracker_factory
+
+FOLLOW_TRACKERS = ("particle", "csrt", "mil")
+
+
+def particle_filter_parameters(scenario: Scenario) -> ParticleFilterParameters:
+    """The particle filter's per-step parameters at the scenario's frame rate."""
+    follow, step_s = scenario.follow, 1.0 / scenario.frame_rate_hz
+    return ParticleFilterParameters(
+        particles=follow.particles,
+        search_particles=follow.search_particles,
+        patches=np.asarray(follow.patches, dtype=float),
+        bins=follow.histogram_bins,
+        achromatic=follow.achromatic_bins,
+        samples=follow.samples_per_patch,
+        lambda_colour=follow.lambda_colour,
+        lambda_motion=follow.lambda_motion,
+        walk_sigma=follow.walk_heights_per_s * step_s,
+        scale_sigma=follow.scale_change_per_s * step_s,
+        loss_fraction=follow.loss_fraction,
+        adapt_fraction=follow.adapt_fraction,
+        reference_rate=min(1.0, step_s / follow.reference_time_constant_s),
+        search_sigma=follow.search_heights,
+        search_scale_sigma=follow.search_scale,
+        motion_threshold=follow.motion_threshold,
+        motion_decay=min(1.0, step_s / follow.motion_memory_s),
+        motion_scale=follow.motion_scale,
+    )
+
+
+def smoothing_pole(scenario: Scenario) -> float:
+    """The output filter's pole ``exp(-2 pi f_c step)`` for the cut-off ``follow.smoothing_cutoff_hz``."""
+    return float(np.exp(-2 * np.pi * scenario.follow.smoothing_cutoff_hz / scenario.frame_rate_hz))
+
+
+def follow_parameters(scenario: Scenario, camera: PTZCamera) -> FollowParameters:
+    follow = scenario.follow
+    target_point_px = follow.target_point_px or (camera.image_width_px / 2, camera.image_height_px / 2)
+    if not (0 <= target_point_px[0] <= camera.image_width_px and 0 <= target_point_px[1] <= camera.image_height_px):
+        raise ScenarioError(
+            f"follow.target_point_px: {list(target_point_px)} lies outside the "
+            f"{camera.image_width_px} x {camera.image_height_px} image"
+        )
+    return FollowParameters(
+        target_point_px=np.asarray(target_point_px, dtype=float),
+        target_height_px=follow.target_height_px,
+        person_height_m=scenario.control.person_height_m,
+        person_width_m=scenario.people.width_m,
+        max_speed_deg_s=follow.max_speed_deg_s,
+        max_acceleration_deg_s2=follow.max_acceleration_deg_s2,
+        max_zoom_speed=follow.max_zoom_speed,
+        max_zoom_acceleration=follow.max_zoom_acceleration,
+        zoom_range=follow.zoom_range,
+        step_s=1.0 / scenario.frame_rate_hz,
+    )
+
+
+def follow_policy(scenario: Scenario, world: World) -> FollowPolicy:
+    return FollowPolicy(world.camera, follow_parameters(scenario, world.camera))
+
+
+def initial_box(scenario: Scenario, world: World) -> tuple[np.ndarray, np.ndarray]:
+    """The followed person's annotated box at the first step, in the view the camera starts at.
+
+    Returns the box (4,) (left, top, width, height) px (the bounding box of the annotated box's
+    corners in the view) and that view's pose (3,).
+    """
+    target_id = scenario.follow.target_id
+    if target_id is None:
+        raise ScenarioError("the follow camera needs a person to follow (follow.target_id)")
+    backend = world.backend
+    if not isinstance(backend, RecordedPTZ):
+        raise ScenarioError("the follow camera needs a recording seen by the virtual camera (camera.backend 'virtual')")
+    annotations = backend.scene.annotations
+    first_frame = backend.scene.video_frame[0]
+    row = np.flatnonzero((annotations.person_id == target_id) & (annotations.frame == first_frame))
+    if len(row) == 0:
+        raise ScenarioError(
+            f"follow.target_id: person {target_id} is not annotated at the first step (frame {first_frame})"
+        )
+    left, top, width, height = annotations.box_px[row[0]]
+    corners = np.array([[left, top], [left + width, top], [left, top + height], [left + width, top + height]])
+    start_pose = world.grid.poses[world.start_action]
+    in_view = backend.virtual.recorded_to_virtual(corners, start_pose)
+    low, high = in_view.min(axis=0), in_view.max(axis=0)
+    return np.r_[low, high - low], start_pose
+
+
+def target_source(scenario: Scenario, tracker: str, rng: np.random.Generator) -> TargetSource:
+    """The source of a follow tracker by name: 'particle' (drawing from ``rng``), 'csrt' or 'mil'."""
+    if tracker == "particle":
+        return ParticleSource(particle_filter_parameters(scenario), rng)
+    if tracker in ("csrt", "mil"):
+        return OpenCVSource(opencv_tracker_factory(tracker))
+    raise ScenarioError(f"no follow tracker {tracker!r}; expected one of {', '.join(FOLLOW_TRACKERS)}")
+
+
+def _target_tracker(scenario: Scenario, world: World, tracker: str) -> TargetTracker:
+    box_px, start_pose = initial_box(scenario, world)
+    # A world built without the episode's tracker stream (build_world called directly) draws from seed 0.
+    rng = np.random.default_rng(world.tracker_seed if world.tracker_seed is not None else 0)
+    return TargetTracker(
+        world.camera,
+        target_source(scenario, tracker, rng),
+        box_px,
+        start_pose,
+        scenario.control.person_height_m,
+        smoothing_pole(scenario),
+        1.0 / scenario.frame_rate_hz,
+    )
+
+
+def particle_tracker(scenario: Scenario, world: World) -> TargetTracker:
+    """The robot-cameraman paper's particle filter, drawing from the episode's tracker stream."""
+    return _target_tracker(scenario, world, "particle")
+
+
+def csrt_tracker(scenario: Scenario, world: World) -> TargetTracker:
+    """OpenCV's CSRT tracker (discriminative correlation filter with channel and spatial reliability)."""
+    return _target_tracker(scenario, world, "csrt")
+
+
+def mil_tracker(scenario: Scenario, world: World) -> TargetTracker:
+    """OpenCV's MIL tracker (multiple-instance learning)."""
+    return _target_tracker(scenario, world, "mil")
+
+
+def target_scenario(scenario: Scenario, target_id: int) -> Scenario:
+    """The scenario narrowed to one person.
+
+    ``follow.target_id`` is set; the steps run from the person's first annotated frame to their last
+    (``recording.first_frame`` and ``frames``); and the action grid becomes the one pose that frames
+    the person at their first annotated position (where the camera starts, as a camera operator would
+    hand a framed shot over to the controller; the policy commands every later pose itself).
+    """
+    recording = scenario.required_recording("the follow camera")
+    annotations = load_mot_ground_truth(recording.ground_truth)
+    rows = np.flatnonzero(annotations.person_id == target_id)
+    if len(rows) == 0:
+        known = ", ".join(str(i) for i in np.unique(annotations.person_id))
+        raise ScenarioError(f"{recording.ground_truth}: no person {target_id} (the people are {known})")
+    rows = rows[np.argsort(annotations.frame[rows])]
+    first, last = int(annotations.frame[rows[0]]), int(annotations.frame[rows[-1]])
+    calibration = load_calibration(recording.calibration, recording.view)
+    virtual, whole_frame_pose = virtual_ptz(calibration, recording.recorded_size_px, scenario.camera.image_size_px)
+    position_m = annotations.ground_m[rows[0]]
+    parameters = follow_parameters(scenario, virtual.camera)
+    middle_m = np.r_[position_m, parameters.person_height_m / 2]
+    centred = aim_at(virtual.camera, middle_m, virtual.camera.principal_point_px, 1.0)
+    start = framing_pose(virtual.camera, position_m, centred, parameters) - [*whole_frame_pose[:2], 0.0]
+    actions = {
+        "pan_deg": {"start": start[0], "stop": start[0], "count": 1},
+        "tilt_deg": {"start": start[1], "stop": start[1], "count": 1},
+        "zoom": (start[2],),
+    }
+    return scenario.model_copy(
+        update={
+            "frames": (last - first) // recording.frame_step + 1,
+            "actions": Actions.model_validate(actions),
+            "follow": scenario.follow.model_copy(update={"target_id": target_id}),
+            "recording": recording.model_copy(update={"first_frame": first}),
+        }
+    )

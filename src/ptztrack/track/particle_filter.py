@@ -1,0 +1,275 @@
+"""The robot-cameraman paper's particle filter (seed 003, section III-C): one person in the image.
+
+State: ``(x, y, h)`` in the image, the centre of the person's box and its
+height in pixels, as in the paper. We keep the image state rather than a
+ground position with a height because the measurements (colour and motion)
+live in the image, because it needs no calibration to track (the ground
+plane only comes in to report a track and to set the zoom), and because the
+same filter then runs on a still camera's video (the OTB benchmark). The
+camera's own motion is taken out before each step: every particle's box is
+carried from the previous view into the current one by the homography of
+the two poses.
+
+Each step (:func:`step_filter`):
+
+1. resample the particles by their previous weights, deterministically
+   (systematic resampling: one uniform draw, then evenly spaced);
+2. predict by a random walk (equation 1): Gaussian steps of ``walk_sigma``
+   box heights in x and y and a relative ``scale_sigma`` in h;
+3. weigh by the product of the colour and motion likelihoods (equations 3-5;
+   :mod:`ptztrack.track.colour_model`, :mod:`ptztrack.track.motion_image`),
+   computed in logarithms so that no weight underflows;
+4. output the weighted mean (equation 6), whose colour likelihood
+   ``P(z_col | s_t)`` decides on a loss.
+
+Loss and re-initialisation (section III-C7). The reference ``P_ref`` is
+"initially set to the maximum likelihood value": the colour likelihood of
+the best particle at the first step after the start. (Not the likelihood's
+upper bound, 1: a patch's histogram is never the same from one frame to the
+next, and from 1 the reference would never come within the 60 % that lets
+it adapt.) A loss
+is declared when ``P(z_col | s_t) < loss_fraction * P_ref`` (10 %);
+``P_ref`` moves towards the last likelihood by ``reference_rate`` per step
+whenever that is at least ``adapt_fraction * P_ref`` (60 %). While lost, the
+estimate stays where it was last (a controller holds the camera there) and
+the filter searches with ``search_particles``, more than when tracking: the
+paper's diffuse prior "that also acts as a target detector" and "converges
+to the target". Half of them are drawn anew from the diffuse prior at every
+step, the other half continue the filter (resampled and walked), so that
+particles that land near the person climb onto it while the fresh ones keep
+searching. The track is back when the estimate's likelihood passes the loss
+threshold again; the particles are then resampled down to ``particles``.
+The diffuse prior is Gaussian in x and y around the last estimate,
+``search_sigma`` box heights across plus ``walk_sigma`` for every step lost
+(the person walks on) up to the image's size, and log-normal in h with
+``search_scale_sigma``.
+
+Likelihoods: colour from the patches' hue-saturation histograms, motion
+``exp(-E^2 / lambda_mot)`` with E the fraction of non-moving pixels under the
+patches (the paper's count of non-motion pixels, divided by the pixels there
+so that smaller boxes are not favoured).
+"""
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from ptztrack.geometry.ptz import apply_homography
+from ptztrack.track.colour_model import (
+    bhattacharyya_distance,
+    bin_count,
+    box_of_states,
+    colour_bins,
+    colour_log_likelihood,
+    patch_boxes,
+    patch_histograms,
+)
+from ptztrack.track.motion_image import MotionImage, first_motion_image, next_motion_image, non_motion_fraction
+
+# A box is never smaller than this many pixels high: the random walk would otherwise shrink one
+# that lost its person to nothing.
+MIN_HEIGHT_PX = 8.0
+# The reference histograms are sampled this much more densely per axis than the particles' ones.
+REFERENCE_OVERSAMPLING = 4
+
+
+@dataclass(frozen=True)
+class ParticleFilterParameters:
+    """The filter's parameters, per step (the builder converts rates at the frame rate; the scenario's
+    ``follow`` section gives them and their sources).
+
+    particles, search_particles : while tracking, and while lost.
+    patches : (K, 4) (left, top, width, height) in box units (:mod:`ptztrack.track.colour_model`).
+    bins : N of the N x N hue-saturation histograms; achromatic : N more bins by value for greys
+    (:func:`ptztrack.track.colour_model.colour_bins`); samples : grid points per patch axis.
+    lambda_colour, lambda_motion : equations 3 and 4.
+    walk_sigma : random-walk step of x and y in box heights; scale_sigma : relative step of h.
+    loss_fraction, adapt_fraction, reference_rate : the loss test and the adaptation of ``P_ref``.
+    search_sigma, search_scale_sigma : the diffuse prior after a loss (see the module).
+    motion_threshold : grey levels; motion_decay : per step; motion_scale : resolution of the motion image.
+    """
+
+    particles: int
+    search_particles: int
+    patches: np.ndarray
+    bins: int
+    achromatic: bool
+    samples: int
+    lambda_colour: float
+    lambda_motion: float
+    walk_sigma: float
+    scale_sigma: float
+    loss_fraction: float
+    adapt_fraction: float
+    reference_rate: float
+    search_sigma: float
+    search_scale_sigma: float
+    motion_threshold: float
+    motion_decay: float
+    motion_scale: float
+
+
+@dataclass(frozen=True)
+class ParticleFilter:
+    """The filter after a step.
+
+    particles : (P, 3) states (x_px, y_px, h_px) in the current view; weights : (P,), summing to 1.
+    estimate : (3,) the weighted mean (equation 6); likelihood : its colour likelihood P(z_col | s_t).
+    reference : (K, N * N) the patches' reference histograms; aspect : box width / height.
+    reference_likelihood : P_ref (None before the first step); lost_steps : steps lost (0 while tracking).
+    motion : the motion history image.
+    """
+
+    particles: np.ndarray
+    weights: np.ndarray
+    estimate: np.ndarray
+    likelihood: float
+    reference: np.ndarray
+    aspect: float
+    reference_likelihood: float | None
+    lost_steps: int
+    motion: MotionImage
+
+    @property
+    def lost(self) -> bool:
+        return self.lost_steps > 0
+
+    def box_px(self) -> np.ndarray:
+        """(4,) (left, top, width, height) of the estimate."""
+        return box_of_states(self.estimate, self.aspect)
+
+    def centre_covariance_px2(self) -> np.ndarray:
+        """(2, 2) px^2: the weighted covariance of the particles' box centres."""
+        offset = self.particles[:, :2] - self.weights @ self.particles[:, :2]
+        return (self.weights[:, None] * offset).T @ offset
+
+
+def systematic_resample(weights, count: int, rng: np.random.Generator) -> np.ndarray:
+    """Indices (count,) drawn by systematic resampling: points ``(u + i) / count`` on the cumulative weights."""
+    cumulative = np.cumsum(weights)
+    points = (rng.random() + np.arange(count)) / count * cumulative[-1]
+    return np.minimum(np.searchsorted(cumulative, points, side="right"), len(cumulative) - 1)
+
+
+def carry_states(states, homography) -> np.ndarray:
+    """States (..., 3) of one view in another: the box's top and bottom centres through ``homography`` (3, 3)."""
+    states = np.asarray(states, dtype=float)
+    x, y, h = states[..., 0], states[..., 1], states[..., 2]
+    ends = np.stack([np.stack([x, y - h / 2], -1), np.stack([x, y + h / 2], -1)], axis=-2)
+    top, bottom = np.moveaxis(apply_homography(homography, ends.reshape(-1, 2)).reshape(ends.shape), -2, 0)
+    return np.concatenate([(top + bottom) / 2, np.linalg.norm(bottom - top, axis=-1, keepdims=True)], axis=-1)
+
+
+def start_filter(image_bgr, box_px, parameters: ParticleFilterParameters) -> ParticleFilter:
+    """A filter on the person in ``box_px`` (left, top, width, height) of the view (h, w, 3) uint8 BGR.
+
+    The reference histograms are the box's patches; every particle starts on the box.
+    """
+    left, top, width, height = (float(value) for value in box_px)
+    state = np.array([left + width / 2, top + height / 2, height])
+    bins = colour_bins(image_bgr, parameters.bins, parameters.achromatic)
+    patches = patch_boxes(np.asarray(box_px, dtype=float), parameters.patches)
+    total_bins = bin_count(parameters.bins, parameters.achromatic)
+    reference = patch_histograms(bins, patches, total_bins, REFERENCE_OVERSAMPLING * parameters.samples)
+    return ParticleFilter(
+        particles=np.tile(state, (parameters.particles, 1)),
+        weights=np.full(parameters.particles, 1.0 / parameters.particles),
+        estimate=state,
+        likelihood=1.0,
+        reference=reference,
+        aspect=width / height,
+        reference_likelihood=None,
+        lost_steps=0,
+        motion=first_motion_image(image_bgr, parameters.motion_scale),
+    )
+
+
+def step_filter(
+    state: ParticleFilter, image_bgr, homography, parameters: ParticleFilterParameters, rng: np.random.Generator
+) -> ParticleFilter:
+    """One step on the next view (h, w, 3) uint8 BGR, into which the previous view maps by ``homography``."""
+    motion = next_motion_image(
+        state.motion, image_bgr, homography, parameters.motion_threshold, parameters.motion_decay
+    )
+    last = carry_states(state.estimate, homography)
+    carried = carry_states(state.particles, homography)
+    if state.lost:
+        kept = parameters.search_particles // 2
+        chosen = carried[systematic_resample(state.weights, kept, rng)]
+        image_size_px = image_bgr.shape[1::-1]
+        fresh = _diffuse_prior(
+            last, state.lost_steps, parameters.search_particles - kept, image_size_px, parameters, rng
+        )
+        particles = np.vstack([_random_walk(chosen, parameters.walk_sigma, parameters.scale_sigma, rng), fresh])
+    else:
+        chosen = carried[systematic_resample(state.weights, parameters.particles, rng)]
+        particles = _random_walk(chosen, parameters.walk_sigma, parameters.scale_sigma, rng)
+    colour = _colour_log_likelihood(image_bgr, particles, state, parameters)
+    log_weights = colour + _motion_log_likelihood(motion, particles, state.aspect, parameters)
+    weights = np.exp(log_weights - log_weights.max())
+    weights /= weights.sum()
+    estimate = weights @ particles
+    likelihood = float(np.exp(_colour_log_likelihood(image_bgr, estimate[None], state, parameters)[0]))
+    reference = state.reference_likelihood
+    if reference is None:  # the first step: P_ref is the best particle's likelihood
+        reference = float(np.exp(colour.max()))
+    elif not state.lost and state.likelihood >= parameters.adapt_fraction * reference:
+        reference += parameters.reference_rate * (state.likelihood - reference)
+    found = likelihood >= parameters.loss_fraction * reference
+    lost_steps = 0 if found else state.lost_steps + 1
+    if state.lost and found:
+        survivors = systematic_resample(weights, parameters.particles, rng)
+        particles, weights = particles[survivors], np.full(parameters.particles, 1.0 / parameters.particles)
+    return replace(
+        state,
+        particles=particles,
+        weights=weights,
+        estimate=estimate if lost_steps == 0 else last,
+        likelihood=likelihood,
+        reference_likelihood=reference,
+        lost_steps=lost_steps,
+        motion=motion,
+    )
+
+
+def _random_walk(states, walk_sigma: float, scale_sigma: float, rng: np.random.Generator) -> np.ndarray:
+    """Equation 1: states (P, 3) plus Gaussian steps, ``walk_sigma`` heights in x and y, ``scale_sigma`` of h."""
+    steps = rng.standard_normal(states.shape)
+    h = states[:, 2:]
+    moved = states + np.c_[walk_sigma * h * steps[:, :2], scale_sigma * h * steps[:, 2:]]
+    moved[:, 2] = np.maximum(moved[:, 2], MIN_HEIGHT_PX)
+    return moved
+
+
+def _diffuse_prior(last, lost_steps: int, count: int, image_size_px, parameters, rng) -> np.ndarray:
+    """``count`` states (count, 3) around the last estimate (3,), wider the longer the person is lost, but
+    never wider than the image (``image_size_px`` (width, height)), beyond which a particle is wasted."""
+    steps = rng.standard_normal((count, 3))
+    spread_px = (parameters.search_sigma + parameters.walk_sigma * lost_steps) * last[2]
+    centres = last[:2] + min(spread_px, max(image_size_px)) * steps[:, :2]
+    heights = np.maximum(last[2] * np.exp(parameters.search_scale_sigma * steps[:, 2]), MIN_HEIGHT_PX)
+    return np.c_[centres, heights]
+
+
+def _colour_log_likelihood(image_bgr, states, filter_state: ParticleFilter, parameters) -> np.ndarray:
+    """Log colour likelihoods (n,) of states (n, 3) in the view (h, w, 3) uint8 BGR."""
+    boxes = patch_boxes(box_of_states(states, filter_state.aspect), parameters.patches)  # (n, K, 4)
+    # Only the pixels under some box are binned: the region they span, cut to the image.
+    image_height, image_width = image_bgr.shape[:2]
+    low = np.floor(boxes[..., :2].min(axis=(0, 1)))
+    high = np.ceil((boxes[..., :2] + boxes[..., 2:]).max(axis=(0, 1)))
+    (col0, row0), (col1, row1) = (np.clip(corner, 0, [image_width, image_height]).astype(int) for corner in (low, high))
+    total_bins = bin_count(parameters.bins, parameters.achromatic)
+    if col1 <= col0 or row1 <= row0:
+        histograms = np.zeros(boxes.shape[:-1] + (total_bins,))
+    else:
+        bins = colour_bins(image_bgr[row0:row1, col0:col1], parameters.bins, parameters.achromatic)
+        histograms = patch_histograms(bins, boxes - [col0, row0, 0, 0], total_bins, parameters.samples)
+    distances = bhattacharyya_distance(filter_state.reference, histograms)
+    return colour_log_likelihood(distances, parameters.lambda_colour)
+
+
+def _motion_log_likelihood(motion: MotionImage, states, aspect: float, parameters) -> np.ndarray:
+    """Log of equation 4, ``-E^2 / lambda_mot``, (n,) for states (n, 3)."""
+    boxes = patch_boxes(box_of_states(states, aspect), parameters.patches)
+    return -(non_motion_fraction(motion, boxes) ** 2) / parameters.lambda_motion

@@ -1,0 +1,246 @@
+"""One person followed in the image, reported as one ground-plane track: the follow camera's tracker.
+
+A *target source* follows the person's box from view to view: the
+robot-cameraman paper's particle filter (:mod:`ptztrack.track.particle_filter`)
+or an OpenCV tracker (CSRT, MIL) as the comparator. :class:`TargetTracker`
+wraps either into a :class:`ptztrack.roles.Tracker`: it asks for no
+detections, reads the view, gives the source the homography from the
+previous pose to the current one, and reports the box as one track on the
+ground, so that the project's metrics and pictures apply unchanged.
+
+Ground position. The box's centre is better found than its bottom edge:
+colour and motion pin down where a person is sooner than how tall the box
+around them is, and a box whose height is 20 % off moves its feet by 10 %
+of the person's height. So the track's position is where the ray through
+the box centre meets the plane ``person_height_m / 2`` above the ground (the
+middle of a standing person), which is the point under the person's middle
+on the ground; a controller that projects that middle back into the view
+finds the box centre again. Its covariance is the source's pixel covariance
+of the centre carried through that mapping's Jacobian.
+
+Output filter (section III-C6): "filtering the tracking output by a further
+temporal low-pass filter". A critically damped alpha-beta filter on the
+ground position (both poles at ``smoothing``; alpha = 1 - smoothing^2, beta
+= (1 - smoothing)^2): a second-order low-pass that follows a walker's
+constant velocity without lag, and whose velocity the controller uses to
+lead the person. While the source is lost the track holds its last position
+with no velocity (the paper's robot "does not drift but simply keeps the
+last estimated position"), counting the steps in ``missed_steps``; when the
+source finds the person again the filter starts afresh from the new
+position.
+"""
+
+from collections.abc import Callable
+from dataclasses import dataclass, field, replace
+from typing import Protocol
+
+import cv2
+import numpy as np
+
+from ptztrack.geometry.ptz import (
+    PTZCamera,
+    apply_homography,
+    homography_jacobian,
+    plane_homography,
+    rotation_homography,
+)
+from ptztrack.roles import ImageSource
+from ptztrack.track.particle_filter import ParticleFilter, ParticleFilterParameters, start_filter, step_filter
+from ptztrack.types import Detections, Tracks, TrackUpdate
+
+TRACK_ID = 0
+
+
+@dataclass(frozen=True)
+class TargetEstimate:
+    """Where a source puts the person in the current view.
+
+    box_px : (4,) (left, top, width, height); lost : the source has lost the person (the box is
+    then its last one); centre_covariance_px2 : (2, 2), the uncertainty of the box centre.
+    """
+
+    box_px: np.ndarray
+    lost: bool
+    centre_covariance_px2: np.ndarray
+
+
+class TargetSource(Protocol):
+    """Follows one person's box from view to view."""
+
+    def start(self, image_bgr: np.ndarray, box_px: np.ndarray) -> TargetEstimate:
+        """Begin on the person in ``box_px`` (left, top, width, height) of the first view (h, w, 3) uint8 BGR."""
+        ...
+
+    def step(self, image_bgr: np.ndarray, homography: np.ndarray) -> TargetEstimate:
+        """The person in the next view, into which the previous view maps by ``homography`` (3, 3)."""
+        ...
+
+
+def box_corners_carried(box_px, homography) -> np.ndarray:
+    """The bounding box (4,) of a box (left, top, width, height) whose corners are carried by ``homography``."""
+    left, top, width, height = np.asarray(box_px, dtype=float)
+    corners = np.array([[left, top], [left + width, top], [left, top + height], [left + width, top + height]])
+    carried = apply_homography(homography, corners)
+    low, high = carried.min(axis=0), carried.max(axis=0)
+    return np.r_[low, high - low]
+
+
+@dataclass
+class ParticleSource:
+    """The robot-cameraman paper's particle filter as a target source; ``rng`` draws every particle."""
+
+    parameters: ParticleFilterParameters
+    rng: np.random.Generator
+    filter: ParticleFilter | None = None
+
+    def start(self, image_bgr, box_px) -> TargetEstimate:
+        self.filter = start_filter(image_bgr, box_px, self.parameters)
+        return self._estimate()
+
+    def step(self, image_bgr, homography) -> TargetEstimate:
+        if self.filter is None:
+            raise RuntimeError("the particle filter steps before it started")
+        self.filter = step_filter(self.filter, image_bgr, homography, self.parameters, self.rng)
+        return self._estimate()
+
+    def _estimate(self) -> TargetEstimate:
+        assert self.filter is not None
+        return TargetEstimate(self.filter.box_px(), self.filter.lost, self.filter.centre_covariance_px2())
+
+
+@dataclass
+class OpenCVSource:
+    """An OpenCV tracker (``create``: ``cv2.TrackerCSRT.create``, say) as a target source.
+
+    It sees every view as it comes: OpenCV's trackers cannot be told that the camera moved, except by
+    starting them again, which the one-pass protocol forbids. While it reports failure the box is its
+    last good one. The box centre's uncertainty is ``spread`` of the box height per axis (a tracker
+    gives none of its own).
+    """
+
+    create: Callable[[], cv2.Tracker]
+    spread: float = 0.1
+    tracker: cv2.Tracker | None = None
+    box_px: np.ndarray = field(default_factory=lambda: np.zeros(4))
+
+    def start(self, image_bgr, box_px) -> TargetEstimate:
+        self.tracker = self.create()
+        self.box_px = np.asarray(box_px, dtype=float)
+        left, top, width, height = (int(round(value)) for value in self.box_px)
+        self.tracker.init(image_bgr, (left, top, width, height))
+        return self._estimate(lost=False)
+
+    def step(self, image_bgr, homography) -> TargetEstimate:
+        if self.tracker is None:
+            raise RuntimeError("the OpenCV tracker steps before it started")
+        found, box = self.tracker.update(image_bgr)
+        if found:
+            self.box_px = np.asarray(box, dtype=float)
+        return self._estimate(lost=not found)
+
+    def _estimate(self, lost: bool) -> TargetEstimate:
+        return TargetEstimate(self.box_px, lost, (self.spread * self.box_px[3]) ** 2 * np.eye(2))
+
+
+def opencv_tracker_factory(name: str) -> Callable[[], cv2.Tracker]:
+    """The OpenCV tracker constructor of a name: 'csrt' or 'mil' (CSRT needs opencv-contrib)."""
+    creators: dict[str, Callable[[], cv2.Tracker]] = {"csrt": cv2.TrackerCSRT.create, "mil": cv2.TrackerMIL.create}
+    return creators[name]
+
+
+@dataclass
+class TargetTracker:
+    """One person followed by a target source, reported as one ground track (a :class:`ptztrack.roles.Tracker`).
+
+    camera : the PTZ camera model; source : the target source.
+    initial_box_px : (4,) the person's box (left, top, width, height) in the view at ``initial_pose``
+        (3,), the pose the camera was at before the first step.
+    person_height_m : the height assumed for everybody (the track is under the person's middle).
+    smoothing : the alpha-beta output filter's pole, in (0, 1) (0: no smoothing).
+    step_s : seconds per step.
+    """
+
+    camera: PTZCamera
+    source: TargetSource
+    initial_box_px: np.ndarray
+    initial_pose: np.ndarray
+    person_height_m: float
+    smoothing: float
+    step_s: float
+    pose: np.ndarray | None = None
+    track: Tracks | None = None
+
+    def predict(self) -> Tracks:
+        """The track predicted to this step (one step of its velocity on), or the initial box's before the first."""
+        if self.track is None:
+            box = np.asarray(self.initial_box_px, dtype=float)
+            centre = box[:2] + box[2:] / 2
+            position, covariance = self._ground(centre, (0.1 * box[3]) ** 2 * np.eye(2), self.initial_pose)
+            return self._tracks(position, np.zeros(2), covariance, missed_steps=0, hits=0)
+        mean = self.track.mean[0]
+        return replace(self.track, mean=np.r_[mean[:2] + self.step_s * mean[2:], mean[2:]][None])
+
+    def wants_detections(self, step: int) -> bool:
+        return False
+
+    def update(self, detections: Detections | None, pose, view: ImageSource) -> TrackUpdate:
+        image = view()
+        if image is None:
+            raise RuntimeError("the follow camera's tracker needs a camera backend that renders images")
+        pose = np.asarray(pose, dtype=float)
+        if self.pose is None:
+            carried = box_corners_carried(
+                self.initial_box_px, rotation_homography(self.camera, self.initial_pose, pose)
+            )
+            estimate = self.source.start(image, carried)
+        else:
+            estimate = self.source.step(image, rotation_homography(self.camera, self.pose, pose))
+        self.pose = pose
+        box = np.asarray(estimate.box_px, dtype=float)
+        position, covariance = self._ground(box[:2] + box[2:] / 2, estimate.centre_covariance_px2, pose)
+        self.track = self._filtered(position, covariance, estimate.lost)
+        feet_px = np.array([[box[0] + box[2] / 2, box[1] + box[3]]])
+        measured = Detections(feet_px, np.array([box[3]]), np.array([-1]))
+        updated = np.array([], dtype=int) if estimate.lost else np.array([TRACK_ID])
+        return TrackUpdate(self.track, updated, np.zeros(len(updated), dtype=int), measured)
+
+    def reported(self) -> Tracks:
+        return self.track if self.track is not None else Tracks.empty()
+
+    def _ground(self, centre_px, covariance_px2, pose) -> tuple[np.ndarray, np.ndarray]:
+        """The ground point (2,) under the person whose box centre is ``centre_px``, and its covariance (2, 2)."""
+        to_ground = np.linalg.inv(plane_homography(self.camera, pose, self.person_height_m / 2))
+        centre_px = np.asarray(centre_px, dtype=float)[None]
+        J = homography_jacobian(to_ground, centre_px)[0]
+        return apply_homography(to_ground, centre_px)[0], J @ covariance_px2 @ J.T
+
+    def _filtered(self, position, covariance, lost: bool) -> Tracks:
+        """The track after a step: the alpha-beta filter on ``position``, or held while ``lost``."""
+        previous = self.track
+        if previous is None or previous.missed_steps[0] > 0 and not lost:
+            return self._tracks(position, np.zeros(2), covariance, missed_steps=0, hits=1)
+        mean, hits = previous.mean[0], int(previous.hits[0])
+        if lost:
+            return self._tracks(
+                mean[:2], np.zeros(2), previous.covariance[0, :2, :2], previous.missed_steps[0] + 1, hits
+            )
+        predicted = mean[:2] + self.step_s * mean[2:]
+        residual = position - predicted
+        alpha, beta = 1 - self.smoothing**2, (1 - self.smoothing) ** 2
+        velocity = mean[2:] + beta / self.step_s * residual
+        return self._tracks(predicted + alpha * residual, velocity, covariance, missed_steps=0, hits=hits + 1)
+
+    def _tracks(self, position, velocity, covariance, missed_steps: int, hits: int) -> Tracks:
+        # The filter's velocity is a difference of positions over about its time constant.
+        time_constant_s = self.step_s / max(1 - self.smoothing, 1e-9)
+        full = np.zeros((4, 4))
+        full[:2, :2] = covariance
+        full[2:, 2:] = covariance / time_constant_s**2
+        return Tracks(
+            np.array([TRACK_ID]),
+            np.r_[position, velocity][None],
+            full[None],
+            np.array([missed_steps]),
+            np.array([hits]),
+            next_id=TRACK_ID + 1,
+        )

@@ -1,0 +1,105 @@
+"""The robot-cameraman paper's particle filter on synthetic sequences with known truth."""
+
+import cv2
+import numpy as np
+import pytest
+
+from ptztrack.builders.follow import particle_filter_parameters
+from ptztrack.config import scenario_from_dict
+from ptztrack.track.particle_filter import carry_states, start_filter, step_filter, systematic_resample
+
+PARAMETERS = particle_filter_parameters(scenario_from_dict({"frame_rate_hz": 10.0}))
+HEIGHT_PX = 120
+WIDTH_PX = 48
+
+
+def textured_background(shape=(480, 640), seed=0) -> np.ndarray:
+    """Blurred colour noise stretched to the full range: texture everywhere, no colour of the figure's."""
+    rng = np.random.default_rng(seed)
+    noise = cv2.GaussianBlur(rng.integers(0, 256, (*shape, 3)).astype(np.uint8), (0, 0), 3)
+    return cv2.normalize(noise, None, 0, 255, cv2.NORM_MINMAX)
+
+
+def draw_figure(image, centre_px) -> np.ndarray:
+    """A standing figure, HEIGHT_PX x WIDTH_PX around ``centre_px``: skin head, red shirt, blue trousers."""
+    image = image.copy()
+    left, top = int(round(centre_px[0] - WIDTH_PX / 2)), int(round(centre_px[1] - HEIGHT_PX / 2))
+    for (x0, y0, x1, y1), bgr in (
+        ((0.3, 0.0, 0.7, 0.15), (80, 140, 220)),
+        ((0.1, 0.15, 0.9, 0.5), (40, 40, 200)),
+        ((0.2, 0.5, 0.8, 1.0), (150, 60, 20)),
+    ):
+        corner0 = (left + int(x0 * WIDTH_PX), top + int(y0 * HEIGHT_PX))
+        corner1 = (left + int(x1 * WIDTH_PX), top + int(y1 * HEIGHT_PX))
+        cv2.rectangle(image, corner0, corner1, bgr, -1)
+    return image
+
+
+def initial_box(centre_px) -> np.ndarray:
+    return np.array([centre_px[0] - WIDTH_PX / 2, centre_px[1] - HEIGHT_PX / 2, WIDTH_PX, HEIGHT_PX])
+
+
+def test_systematic_resampling_keeps_proportions_and_drops_weightless_particles():
+    rng = np.random.default_rng(0)
+    np.testing.assert_array_equal(systematic_resample([0.0, 1.0, 0.0], 5, rng), [1, 1, 1, 1, 1])
+    np.testing.assert_array_equal(np.sort(systematic_resample(np.full(4, 0.25), 4, rng)), [0, 1, 2, 3])
+    counts = np.bincount(systematic_resample([0.5, 0.25, 0.25], 8, rng), minlength=3)
+    np.testing.assert_array_equal(counts, [4, 2, 2])  # systematic: within one of count x weight
+
+
+def test_carrying_states_through_a_zoom_about_a_point_scales_them():
+    zoom = np.array([[2.0, 0.0, -100.0], [0.0, 2.0, -50.0], [0.0, 0.0, 1.0]])  # x -> 2x - (100, 50)
+    np.testing.assert_allclose(carry_states([[100.0, 60.0, 30.0]], zoom), [[100.0, 70.0, 60.0]])
+
+
+def test_the_filter_follows_a_figure_over_a_textured_background_within_a_few_pixels():
+    background = textured_background()
+    steps = np.arange(40)
+    path = np.c_[200 + 5 * steps, 240 + 25 * np.sin(steps / 6)]
+    rng = np.random.default_rng(1)
+    state = start_filter(draw_figure(background, path[0]), initial_box(path[0]), PARAMETERS)
+    errors_px = []
+    for centre in path[1:]:
+        state = step_filter(state, draw_figure(background, centre), np.eye(3), PARAMETERS, rng)
+        assert not state.lost
+        errors_px.append(np.hypot(*(state.estimate[:2] - centre)))
+    assert np.mean(errors_px) < 4.0 and np.max(errors_px) < 10.0
+
+
+def test_the_filter_declares_a_loss_when_the_figure_leaves_and_recovers_when_it_returns():
+    background = textured_background(seed=2)
+    rng = np.random.default_rng(3)
+    centre = np.array([300.0, 240.0])
+    state = start_filter(draw_figure(background, centre), initial_box(centre), PARAMETERS)
+    for _ in range(10):
+        state = step_filter(state, draw_figure(background, centre), np.eye(3), PARAMETERS, rng)
+    assert not state.lost
+    held = state.estimate.copy()
+    for _ in range(5):
+        state = step_filter(state, background, np.eye(3), PARAMETERS, rng)
+        assert state.lost
+        np.testing.assert_allclose(state.estimate, held, atol=1e-9)  # the last estimate is held while lost
+    back = centre + [40.0, 10.0]  # it comes back a little further on
+    for _ in range(10):
+        state = step_filter(state, draw_figure(background, back), np.eye(3), PARAMETERS, rng)
+        if not state.lost:
+            break
+    assert not state.lost, "not found again within 10 steps"
+    state = step_filter(state, draw_figure(background, back), np.eye(3), PARAMETERS, rng)
+    assert len(state.particles) == PARAMETERS.particles
+    assert np.hypot(*(state.estimate[:2] - back)) < 8.0
+
+
+@pytest.mark.parametrize("compensated", [True, False])
+def test_the_filter_takes_out_the_cameras_motion(compensated):
+    """A still figure seen by a camera that pans 30 px a step: with the camera's motion taken out the
+    filter stays on it; without, its random walk cannot keep up."""
+    scene = draw_figure(textured_background((480, 1400), seed=4), (700.0, 240.0))
+    rng = np.random.default_rng(5)
+    offsets = 100 + 30 * np.arange(12)
+    state = start_filter(scene[:, offsets[0] : offsets[0] + 640], initial_box((700.0 - offsets[0], 240.0)), PARAMETERS)
+    for previous, offset in zip(offsets, offsets[1:], strict=False):
+        pan = np.array([[1.0, 0.0, previous - offset], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]])
+        state = step_filter(state, scene[:, offset : offset + 640], pan if compensated else np.eye(3), PARAMETERS, rng)
+    error_px = np.hypot(*(state.estimate[:2] - [700.0 - offsets[-1], 240.0]))
+    assert (error_px < 5.0) if compensated else (error_px > 30.0 or state.lost)
