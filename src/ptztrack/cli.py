@@ -23,6 +23,17 @@ from ptztrack.builders.experiments import (
     run_closed_loop_cell,
     synthetic_cells,
 )
+from ptztrack.builders.follow import FOLLOW_TRACKERS
+from ptztrack.builders.follow_experiment import (
+    OTB_TRACKS,
+    FollowCell,
+    follow_cells,
+    follow_row,
+    follow_run,
+    otb_cells,
+    run_follow_cell,
+    run_otb_cell,
+)
 from ptztrack.builders.pets import PROTOCOLS, protocol_folds
 from ptztrack.builders.registration import reference_index
 from ptztrack.config import (
@@ -31,11 +42,19 @@ from ptztrack.config import (
     Scenario,
     ScenarioError,
     load_scenario,
+    pets_follow_scenario,
     pets_scenario,
     scenario_from_dict,
 )
 from ptztrack.control.msg_scheduler import SCHEDULERS
 from ptztrack.evaluate.executors import EXECUTORS, print_progress, run_cells
+from ptztrack.evaluate.follow import (
+    FOLLOW_FIGURES,
+    OTB_FIGURES,
+    format_follow_people,
+    format_follow_table,
+    summarise_follow,
+)
 from ptztrack.evaluate.metrics import DISPLAY, episode_metrics
 from ptztrack.evaluate.msg import (
     ambiguity_figure,
@@ -282,6 +301,60 @@ def _run_table(
     return 0
 
 
+def _follow_scenario(args: argparse.Namespace, tracker: str = "particle") -> Scenario:
+    """The follow camera's scenario: the built-in PETS one or a YAML file, with the command line's changes."""
+    overrides: dict[str, object] = {
+        f"recording.{key}": str(path) for key, path in recording_paths(args).items() if path is not None
+    }
+    if args.achromatic_bins:
+        overrides["follow.achromatic_bins"] = True
+    if getattr(args, "target_point_px", None) is not None:
+        overrides["follow.target_point_px"] = tuple(args.target_point_px)
+    if args.scenario == "pets":
+        return pets_follow_scenario(tracker, **overrides)
+    return load_scenario(args.scenario, **overrides, **{"tracker.kind": tracker})
+
+
+def follow_command(args: argparse.Namespace) -> int:
+    scenario = _follow_scenario(args, args.tracker)
+    if args.frames is not None:
+        scenario = scenario.model_copy(update={"frames": args.frames})
+    narrowed, world, episode = follow_run(FollowCell(scenario, args.tracker, args.target, args.seed))
+    row = follow_row(narrowed, world, episode)
+    first_frame = narrowed.required_recording("the follow camera").first_frame
+    print(f"person {args.target} followed by {args.tracker} from frame {first_frame}, {row['steps']} steps")
+    print(format_follow_table([row], FOLLOW_FIGURES))
+    out = args.out or Path(f"follow-{args.target}")
+    title = f"person {args.target}, {args.tracker}: in view {row['in_view_fraction']:.0%}"
+    write_outputs(out, episode, row, title, view_renderer(world))
+    print(f"wrote {', '.join(RUN_FILES)} into {out}")
+    return 0
+
+
+def follow_experiment_command(args: argparse.Namespace) -> int:
+    scenario = _follow_scenario(args)
+    cells = follow_cells(scenario, args.trackers, args.targets, args.seed)
+    print(f"{len(cells)} closed-loop runs, {args.executor} executor", file=sys.stderr)
+    people = run_cells(cells, run_follow_cell, args.executor, args.workers, print_progress)
+    otb_runs = otb_cells(scenario, args.trackers, args.otb_tracks, args.seed)
+    print(f"{len(otb_runs)} one-pass runs on the still recording", file=sys.stderr)
+    otb_people = run_cells(otb_runs, run_otb_cell, args.executor, args.workers, partial(print_progress, noun="runs"))
+    closed_loop, otb = summarise_follow(people, FOLLOW_FIGURES), summarise_follow(otb_people, OTB_FIGURES)
+    print(
+        f"Follow camera, {scenario.camera.image_size_px[0]} x {scenario.camera.image_size_px[1]} view, "
+        f"person {scenario.follow.target_height_px:g} px tall wanted; per person:"
+    )
+    print(format_follow_people(people))
+    print(format_follow_table(closed_loop, FOLLOW_FIGURES, "\nMeans over the people:"))
+    tracks = ", ".join(str(row["target_id"]) for row in otb_people[: len(otb_people) // len(args.trackers)])
+    print(format_follow_table(otb, OTB_FIGURES, f"\nOne-pass (OTB) on the still recording, people {tracks}:"))
+    if args.json is not None:
+        document = {"closed_loop": closed_loop, "otb": otb, "people": people, "otb_people": otb_people}
+        write_atomically(args.json, (json.dumps(document, indent=2) + "\n").encode())
+        print(f"wrote {args.json}")
+    return 0
+
+
 class OneLineParser(argparse.ArgumentParser):
     """Command-line mistakes end in one line on stderr and exit status 2, like every other bad input."""
 
@@ -307,7 +380,9 @@ def parser() -> argparse.ArgumentParser:
     run.set_defaults(handler=run_command)
 
     experiment = commands.add_parser("experiment", help="run one of the papers' experiments and print its table")
-    experiments = experiment.add_subparsers(dest="name", required=True, metavar="{synthetic,pets,msg,registration}")
+    experiments = experiment.add_subparsers(
+        dest="name", required=True, metavar="{synthetic,pets,msg,registration,follow}"
+    )
 
     synthetic = experiments.add_parser("synthetic", help="the PTZ paper's Tables 1-2 on the synthetic scene")
     synthetic.add_argument("--scenario", default="synthetic", help="'synthetic' (built in) or a scenario YAML file")
@@ -386,7 +461,48 @@ def parser() -> argparse.ArgumentParser:
     _add_executor_arguments(registration, "the registration errors and the closed-loop rows")
     _add_recording_arguments(registration)
     registration.set_defaults(handler=registration_experiment_command)
+    _add_follow_commands(commands, experiments)
     return root
+
+
+def _add_follow_commands(commands, experiments) -> None:
+    """``ptztrack follow`` and ``ptztrack experiment follow``: the robot-cameraman paper's follow camera."""
+    follow = commands.add_parser("follow", help="follow one annotated PETS person with the virtual PTZ camera")
+    follow.add_argument("--target", type=_non_negative_int, required=True, help="the annotated person's id")
+    follow.add_argument("--tracker", choices=FOLLOW_TRACKERS, default="particle")
+    follow.add_argument("--seed", type=_non_negative_int, default=0)
+    follow.add_argument("--frames", type=_positive_int, help="at most this many steps")
+    follow.add_argument(
+        "--target-point-px", type=float, nargs=2, metavar=("X", "Y"), help="(x*, y*); default: the image centre"
+    )
+    follow.add_argument("--out", type=Path, help=f"directory for {', '.join(RUN_FILES)} (default follow-TARGET)")
+    _add_follow_scenario_arguments(follow)
+    follow.set_defaults(handler=follow_command)
+
+    experiment = experiments.add_parser(
+        "follow", help="the robot-cameraman paper: every PETS person followed, and the one-pass benchmark"
+    )
+    experiment.add_argument("--trackers", nargs="+", choices=FOLLOW_TRACKERS, default=list(FOLLOW_TRACKERS))
+    experiment.add_argument("--targets", type=_non_negative_int, nargs="+", help="people to follow (default: all)")
+    experiment.add_argument(
+        "--otb-tracks", type=_non_negative_int, default=OTB_TRACKS, help="longest tracks of the one-pass benchmark"
+    )
+    experiment.add_argument("--seed", type=_non_negative_int, default=0)
+    _add_follow_scenario_arguments(experiment)
+    _add_executor_arguments(experiment, '{"closed_loop": [...], "otb": [...]} and the rows per person')
+    experiment.set_defaults(handler=follow_experiment_command)
+
+
+def _add_follow_scenario_arguments(command: argparse.ArgumentParser) -> None:
+    command.add_argument(
+        "--scenario", default="pets", help="'pets' (built in) or a recording scenario YAML file with a follow section"
+    )
+    command.add_argument(
+        "--achromatic-bins",
+        action="store_true",
+        help="the particle filter bins greys by value (Perez et al.) besides the paper's hue-saturation bins",
+    )
+    _add_recording_arguments(command)
 
 
 def _strategies(policies: list[str]) -> list[str]:

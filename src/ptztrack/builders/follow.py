@@ -149,9 +149,10 @@ def target_scenario(scenario: Scenario, target_id: int) -> Scenario:
     """The scenario narrowed to one person.
 
     ``follow.target_id`` is set; the steps run from the person's first annotated frame to their last
-    (``recording.first_frame`` and ``frames``); and the action grid becomes the one pose that frames
-    the person at their first annotated position (where the camera starts, as a camera operator would
-    hand a framed shot over to the controller; the policy commands every later pose itself).
+    (``recording.first_frame``; ``frames``, at most the scenario's); and the action grid becomes the
+    one pose that frames the person at their first annotated position, where the camera starts (as a
+    camera operator would hand a framed shot over to the controller; the policy commands every later
+    pose itself).
     """
     recording = scenario.required_recording("the follow camera")
     annotations = load_mot_ground_truth(recording.ground_truth)
@@ -175,7 +176,7 @@ def target_scenario(scenario: Scenario, target_id: int) -> Scenario:
     }
     return scenario.model_copy(
         update={
-            "frames": (last - first) // recording.frame_step + 1,
+            "frames": min(scenario.frames, (last - first) // recording.frame_step + 1),
             "actions": Actions.model_validate(actions),
             "follow": scenario.follow.model_copy(update={"target_id": target_id}),
             "recording": recording.model_copy(update={"first_frame": first}),

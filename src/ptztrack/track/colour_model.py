@@ -84,11 +84,12 @@ def patch_histograms(bin_image, boxes_px, total_bins: int, samples: int) -> np.n
     fractions = (np.arange(samples) + 0.5) / samples
     columns = np.floor(flat_boxes[:, :1] + fractions * flat_boxes[:, 2:3]).astype(np.intp)  # (n, S)
     rows = np.floor(flat_boxes[:, 1:2] + fractions * flat_boxes[:, 3:4]).astype(np.intp)
-    inside = ((rows >= 0) & (rows < height))[:, :, None] & ((columns >= 0) & (columns < width))[:, None, :]
-    labels = bin_image[np.clip(rows, 0, height - 1)[:, :, None], np.clip(columns, 0, width - 1)[:, None, :]]
-    index = labels + (np.arange(len(flat_boxes)) * total_bins)[:, None, None]
-    counts = np.bincount(index.ravel(), weights=inside.ravel(), minlength=len(flat_boxes) * total_bins)
-    counts = counts.reshape(len(flat_boxes), total_bins)
+    # A border of one extra bin, ``total_bins``, catches the points outside the image; it is dropped after.
+    padded = np.pad(bin_image.astype(np.int32), 1, constant_values=total_bins).ravel()
+    at = np.clip(rows + 1, 0, height + 1)[:, :, None] * (width + 2) + np.clip(columns + 1, 0, width + 1)[:, None, :]
+    labels = padded.take(at) + (np.arange(len(flat_boxes), dtype=np.int32) * (total_bins + 1))[:, None, None]
+    counts = np.bincount(labels.ravel(), minlength=len(flat_boxes) * (total_bins + 1))
+    counts = counts.reshape(len(flat_boxes), total_bins + 1)[:, :total_bins]
     return (counts / np.maximum(counts.sum(axis=1, keepdims=True), 1.0)).reshape(*leading, total_bins)
 
 

@@ -51,6 +51,7 @@ so that smaller boxes are not favoured).
 """
 
 from dataclasses import dataclass, replace
+from typing import NamedTuple
 
 import numpy as np
 
@@ -204,12 +205,14 @@ def step_filter(
     else:
         chosen = carried[systematic_resample(state.weights, parameters.particles, rng)]
         particles = _random_walk(chosen, parameters.walk_sigma, parameters.scale_sigma, rng)
-    colour = _colour_log_likelihood(image_bgr, particles, state, parameters)
+    # The weighted mean's box lies within the particles' boxes' extent: one region of bins serves both.
+    region = _ColourRegion.of(image_bgr, particles, state.aspect, parameters)
+    colour = region.log_likelihood(particles, state.reference, state.aspect, parameters)
     log_weights = colour + _motion_log_likelihood(motion, particles, state.aspect, parameters)
     weights = np.exp(log_weights - log_weights.max())
     weights /= weights.sum()
     estimate = weights @ particles
-    likelihood = float(np.exp(_colour_log_likelihood(image_bgr, estimate[None], state, parameters)[0]))
+    likelihood = float(np.exp(region.log_likelihood(estimate[None], state.reference, state.aspect, parameters)[0]))
     reference = state.reference_likelihood
     if reference is None:  # the first step: P_ref is the best particle's likelihood
         reference = float(np.exp(colour.max()))
@@ -251,22 +254,33 @@ def _diffuse_prior(last, lost_steps: int, count: int, image_size_px, parameters,
     return np.c_[centres, heights]
 
 
-def _colour_log_likelihood(image_bgr, states, filter_state: ParticleFilter, parameters) -> np.ndarray:
-    """Log colour likelihoods (n,) of states (n, 3) in the view (h, w, 3) uint8 BGR."""
-    boxes = patch_boxes(box_of_states(states, filter_state.aspect), parameters.patches)  # (n, K, 4)
-    # Only the pixels under some box are binned: the region they span, cut to the image.
-    image_height, image_width = image_bgr.shape[:2]
-    low = np.floor(boxes[..., :2].min(axis=(0, 1)))
-    high = np.ceil((boxes[..., :2] + boxes[..., 2:]).max(axis=(0, 1)))
-    (col0, row0), (col1, row1) = (np.clip(corner, 0, [image_width, image_height]).astype(int) for corner in (low, high))
-    total_bins = bin_count(parameters.bins, parameters.achromatic)
-    if col1 <= col0 or row1 <= row0:
-        histograms = np.zeros(boxes.shape[:-1] + (total_bins,))
-    else:
-        bins = colour_bins(image_bgr[row0:row1, col0:col1], parameters.bins, parameters.achromatic)
-        histograms = patch_histograms(bins, boxes - [col0, row0, 0, 0], total_bins, parameters.samples)
-    distances = bhattacharyya_distance(filter_state.reference, histograms)
-    return colour_log_likelihood(distances, parameters.lambda_colour)
+class _ColourRegion(NamedTuple):
+    """The colour bins (h, w) of the part of a view that some states' patches span, and its top-left
+    corner (col, row) in the view; empty where they span none of it."""
+
+    bins: np.ndarray
+    origin: np.ndarray
+
+    @classmethod
+    def of(cls, image_bgr, states, aspect: float, parameters) -> "_ColourRegion":
+        boxes = patch_boxes(box_of_states(states, aspect), parameters.patches)
+        image_height, image_width = image_bgr.shape[:2]
+        low = np.floor(boxes[..., :2].min(axis=(0, 1)))
+        high = np.ceil((boxes[..., :2] + boxes[..., 2:]).max(axis=(0, 1)))
+        (col0, row0), (col1, row1) = (np.clip(c, 0, [image_width, image_height]).astype(int) for c in (low, high))
+        region = image_bgr[row0 : max(row0, row1), col0 : max(col0, col1)]
+        bins = colour_bins(region, parameters.bins, parameters.achromatic) if region.size else np.zeros((0, 0), int)
+        return cls(bins, np.array([col0, row0]))
+
+    def log_likelihood(self, states, reference, aspect: float, parameters) -> np.ndarray:
+        """Log colour likelihoods (n,) of states (n, 3) whose patches lie within the region."""
+        boxes = patch_boxes(box_of_states(states, aspect), parameters.patches) - [*self.origin, 0, 0]
+        total_bins = bin_count(parameters.bins, parameters.achromatic)
+        if self.bins.size:
+            histograms = patch_histograms(self.bins, boxes, total_bins, parameters.samples)
+        else:
+            histograms = np.zeros(boxes.shape[:-1] + (total_bins,))
+        return colour_log_likelihood(bhattacharyya_distance(reference, histograms), parameters.lambda_colour)
 
 
 def _motion_log_likelihood(motion: MotionImage, states, aspect: float, parameters) -> np.ndarray:

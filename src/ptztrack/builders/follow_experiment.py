@@ -1,0 +1,154 @@
+"""The follow experiment as cells: every person followed by every tracker in the closed loop, and the
+trackers alone on the still recording (the OTB one-pass protocol).
+
+Each cell is a function of its inputs (the seed fixes the particle filter's
+draws), so every executor gives the same rows.
+"""
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from ptztrack.builders.episode import episode_world, run_episode
+from ptztrack.builders.follow import follow_parameters, target_scenario, target_source
+from ptztrack.camera.recorded import RecordedPTZ
+from ptztrack.config import Scenario
+from ptztrack.evaluate.follow import follow_metrics, one_pass_scores, target_in_views
+from ptztrack.loop import Episode, World, episode_seeds
+from ptztrack.scene.pets import Annotations, RecordedVideo, load_mot_ground_truth
+
+OTB_TRACKS = 5
+
+
+@dataclass(frozen=True)
+class FollowCell:
+    """One person (``target_id``) followed by one tracker ('particle', 'csrt', 'mil') in ``scenario``
+    (a follow scenario, :func:`ptztrack.config.pets_follow_scenario`); ``seed`` fixes the run's draws."""
+
+    scenario: Scenario
+    tracker: str
+    target_id: int
+    seed: int = 0
+
+
+def annotated_people(scenario: Scenario) -> np.ndarray:
+    """The ids of the recording's annotated people, longest annotated first (ties by id)."""
+    annotations = load_mot_ground_truth(scenario.required_recording("the follow experiment").ground_truth)
+    ids, frames = np.unique(annotations.person_id, return_counts=True)
+    return ids[np.lexsort((ids, -frames))]
+
+
+def follow_cells(scenario: Scenario, trackers, targets=None, seed: int = 0) -> list[FollowCell]:
+    """Every tracker on every person (all annotated people by default, by id)."""
+    people = sorted(annotated_people(scenario).tolist()) if targets is None else list(targets)
+    return [FollowCell(scenario, tracker, int(person), seed) for tracker in trackers for person in people]
+
+
+def follow_run(cell: FollowCell) -> tuple[Scenario, World, Episode]:
+    """The cell's scenario narrowed to its person, its world and its episode."""
+    scenario = target_scenario(cell.scenario.model_copy(update={"tracker": _tracker(cell)}), cell.target_id)
+    world = episode_world(scenario, cell.seed)
+    return scenario, world, run_episode(scenario, "follow", cell.seed, world)
+
+
+def _tracker(cell: FollowCell):
+    return cell.scenario.tracker.model_copy(update={"kind": cell.tracker})
+
+
+def target_boxes(world: World, target_id: int) -> np.ndarray:
+    """(T, 4) the person's annotated box (left, top, width, height) at every step, NaN where not annotated."""
+    backend = world.backend
+    assert isinstance(backend, RecordedPTZ)
+    scene = backend.scene
+    return _boxes_by_frame(scene.annotations, target_id, scene.video_frame)
+
+
+def _boxes_by_frame(annotations: Annotations, target_id: int, frames) -> np.ndarray:
+    boxes = np.full((len(frames), 4), np.nan)
+    mine = annotations.select(annotations.person_id == target_id)
+    step = np.searchsorted(frames, mine.frame)
+    found = (step < len(frames)) & (frames[np.minimum(step, len(frames) - 1)] == mine.frame)
+    boxes[step[found]] = mine.box_px[found]
+    return boxes
+
+
+def follow_row(scenario: Scenario, world: World, episode: Episode) -> dict:
+    """The figures of one followed person (:func:`ptztrack.evaluate.follow.follow_metrics`) and the
+    mean ground distance of the track from the person while the tracker was not lost (``ground_error_m``)."""
+    target_id = scenario.follow.target_id
+    assert target_id is not None
+    backend = world.backend
+    assert isinstance(backend, RecordedPTZ)
+    centres_px, heights_px = target_in_views(backend.virtual, target_boxes(world, target_id), episode.poses)
+    lost = np.array([tracks.missed_steps[0] > 0 for tracks in episode.tracks])
+    camera = world.camera
+    target_point_px = follow_parameters(scenario, camera).target_point_px
+    metrics = follow_metrics(
+        centres_px,
+        heights_px,
+        episode.commanded,
+        lost,
+        (camera.image_width_px, camera.image_height_px),
+        target_point_px,
+    )
+    column = int(np.searchsorted(backend.scene.person_id, target_id))
+    truth_m = episode.truth.positions_m[:, column]
+    tracked_m = np.array([tracks.mean[0, :2] for tracks in episode.tracks])
+    seen = ~lost & np.isfinite(truth_m[:, 0])
+    ground_error_m = float(np.linalg.norm(tracked_m[seen] - truth_m[seen], axis=1).mean()) if seen.any() else np.nan
+    return {
+        "tracker": scenario.tracker.kind,
+        "target_id": target_id,
+        "steps": len(episode.poses),
+        **metrics,
+        "ground_error_m": ground_error_m,
+        "zoom": float(episode.poses[:, 2].mean()),
+    }
+
+
+def run_follow_cell(cell: FollowCell) -> dict:
+    """Run one person with one tracker in the closed loop; its figures (:func:`follow_row`)."""
+    return follow_row(*follow_run(cell))
+
+
+@dataclass(frozen=True)
+class OnePassCell:
+    """One tracker on one person's frames of the still recording (the OTB one-pass protocol)."""
+
+    scenario: Scenario
+    tracker: str
+    target_id: int
+    seed: int = 0
+
+
+def otb_cells(scenario: Scenario, trackers, tracks: int = OTB_TRACKS, seed: int = 0) -> list[OnePassCell]:
+    """Every tracker on the ``tracks`` longest annotated people."""
+    longest = annotated_people(scenario)[:tracks]
+    return [OnePassCell(scenario, tracker, int(person), seed) for tracker in trackers for person in longest]
+
+
+def run_otb_cell(cell: OnePassCell) -> dict:
+    """One tracker over the recorded frames of one person, from their first annotated box to their last
+    annotated frame, the camera still; scores over the annotated frames (the first included) and the
+    frames per second of the tracker's own updates (decoding not counted)."""
+    recording = cell.scenario.required_recording("the one-pass benchmark")
+    annotations = load_mot_ground_truth(recording.ground_truth)
+    mine = annotations.frame[annotations.person_id == cell.target_id]
+    frames = np.arange(mine.min(), mine.max() + 1)
+    boxes = _boxes_by_frame(annotations, cell.target_id, frames)
+    video = RecordedVideo(cell.scenario.required_video("the one-pass benchmark"), recording.recorded_size_px)
+    rng = np.random.default_rng(episode_seeds(cell.seed)[4])
+    source = target_source(cell.scenario, cell.tracker, rng)
+    still = np.eye(3)
+    tracked = np.zeros((len(frames), 4))
+    elapsed_s = 0.0
+    for index, frame in enumerate(frames):
+        image = video.frame(int(frame))
+        started = time.perf_counter()
+        estimate = source.start(image, boxes[0]) if index == 0 else source.step(image, still)
+        elapsed_s += time.perf_counter() - started
+        tracked[index] = estimate.box_px
+    annotated = np.all(np.isfinite(boxes), axis=1)
+    scores = one_pass_scores(tracked[annotated], boxes[annotated])
+    return {"tracker": cell.tracker, "target_id": cell.target_id, **scores, "fps": len(frames) / elapsed_s}
