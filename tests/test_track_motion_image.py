@@ -9,7 +9,7 @@ from ptztrack.camera.virtual import virtual_ptz
 from ptztrack.geometry.calibration import load_pinhole
 from ptztrack.geometry.ptz import rotation_homography
 from ptztrack.scene.pets import read_video
-from ptztrack.track.motion_image import first_motion_image, next_motion_image, non_motion_fraction
+from ptztrack.track.motion_image import first_motion_image, motion_image_of, next_motion_image, non_motion_fraction
 
 EXCERPT = Path(__file__).parent / "data" / "pets_s2l1_excerpt"
 
@@ -58,14 +58,14 @@ def test_a_moving_square_moves_and_its_trail_fades():
 
 
 def test_non_motion_fraction_counts_known_pixels_under_all_patches():
-    motion = first_motion_image(np.zeros((10, 10, 3), np.uint8), scale=1.0)
     history = np.zeros((10, 10), np.float32)
     history[0:4, 0:5] = 1.0  # 20 moving pixels
     known = np.ones((10, 10), bool)
     known[:, 8:] = False
-    motion = type(motion)(history, known, motion.grey, 1.0)
+    motion = motion_image_of(history, known, np.zeros((10, 10), np.float32), 1.0)
     # Two patches: rows 0-3 x cols 0-9 (32 known, 20 moving) and rows 5-6 x cols 0-1 (4 known, none moving).
     boxes = np.array([[0.0, 0.0, 10.0, 4.0], [0.0, 5.0, 2.0, 2.0]])
     assert non_motion_fraction(motion, boxes) == pytest.approx(1 - 20 / 36)
     assert non_motion_fraction(motion, np.array([[8.0, 0.0, 2.0, 10.0]])) == 1.0  # nothing known
-    assert non_motion_fraction(motion, boxes * [1, 1, 1, 1] + [0, 0, 0, 0]).shape == ()
+    assert non_motion_fraction(motion, boxes).shape == ()
+    assert non_motion_fraction(motion, np.stack([boxes] * 3)).shape == (3,)

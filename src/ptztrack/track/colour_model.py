@@ -35,19 +35,18 @@ ACHROMATIC_SATURATION, ACHROMATIC_VALUE = 0.1, 0.2
 
 
 def colour_bins(image_bgr, bins: int, achromatic: bool = False) -> np.ndarray:
-    """The bin (h, w) intp of every pixel of a uint8 BGR image (h, w, 3): ``hue_bin * bins + saturation_bin``.
+    """The bin (h, w) int32 of every pixel of a uint8 BGR image (h, w, 3): ``hue_bin * bins + saturation_bin``.
 
     achromatic : as Perez et al. (ECCV 2002) do, pixels whose saturation is below 0.1 or value below
     0.2 (their hue and saturation are noise) go to ``bins`` extra bins by value alone, after the
     ``bins * bins`` hue-saturation ones.
     """
-    hsv = cv2.cvtColor(np.ascontiguousarray(image_bgr, dtype=np.uint8), cv2.COLOR_BGR2HSV)
-    hue = hsv[..., 0].astype(np.intp) * bins // HUE_LEVELS
-    labels = hue * bins + hsv[..., 1].astype(np.intp) * bins // CHANNEL_LEVELS
+    hsv = cv2.cvtColor(np.ascontiguousarray(image_bgr, dtype=np.uint8), cv2.COLOR_BGR2HSV).astype(np.int32)
+    hue, saturation, value = hsv[..., 0], hsv[..., 1], hsv[..., 2]
+    labels = hue * bins // HUE_LEVELS * bins + saturation * bins // CHANNEL_LEVELS
     if achromatic:
-        saturation, value = hsv[..., 1], hsv[..., 2]
         grey = (saturation < ACHROMATIC_SATURATION * CHANNEL_LEVELS) | (value < ACHROMATIC_VALUE * CHANNEL_LEVELS)
-        labels = np.where(grey, bins * bins + value.astype(np.intp) * bins // CHANNEL_LEVELS, labels)
+        labels = np.where(grey, bins * bins + value * bins // CHANNEL_LEVELS, labels)
     return labels
 
 
@@ -85,7 +84,7 @@ def patch_histograms(bin_image, boxes_px, total_bins: int, samples: int) -> np.n
     columns = np.floor(flat_boxes[:, :1] + fractions * flat_boxes[:, 2:3]).astype(np.intp)  # (n, S)
     rows = np.floor(flat_boxes[:, 1:2] + fractions * flat_boxes[:, 3:4]).astype(np.intp)
     # A border of one extra bin, ``total_bins``, catches the points outside the image; it is dropped after.
-    padded = np.pad(bin_image.astype(np.int32), 1, constant_values=total_bins).ravel()
+    padded = np.pad(bin_image.astype(np.int32, copy=False), 1, constant_values=total_bins).ravel()
     at = np.clip(rows + 1, 0, height + 1)[:, :, None] * (width + 2) + np.clip(columns + 1, 0, width + 1)[:, None, :]
     labels = padded.take(at) + (np.arange(len(flat_boxes), dtype=np.int32) * (total_bins + 1))[:, None, None]
     counts = np.bincount(labels.ravel(), minlength=len(flat_boxes) * (total_bins + 1))

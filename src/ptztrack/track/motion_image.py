@@ -49,12 +49,21 @@ class MotionImage:
     known : (h, w) bool, pixels the previous view also saw (all False at the first frame).
     grey : (h, w) float32, this frame in grey levels, to difference the next one against.
     scale : the resolution relative to the view's.
+    sums : (h + 1, w + 1, 2) float64, the integral images of ``known`` and ``history`` (box sums by
+        four look-ups).
     """
 
     history: np.ndarray
     known: np.ndarray
     grey: np.ndarray
     scale: float
+    sums: np.ndarray
+
+
+def motion_image_of(history, known, grey, scale: float) -> MotionImage:
+    """The motion image with its integral images, of (h, w) float32 history, bool known and float32 grey."""
+    sums = cv2.integral(cv2.merge([known.astype(np.float32), history]), sdepth=cv2.CV_64F)
+    return MotionImage(history, known, grey, scale, sums)
 
 
 def _grey(image_bgr, scale: float) -> np.ndarray:
@@ -67,7 +76,7 @@ def _grey(image_bgr, scale: float) -> np.ndarray:
 def first_motion_image(image_bgr, scale: float = 0.5) -> MotionImage:
     """The motion image of the first frame: nothing known, nothing moving."""
     grey = _grey(image_bgr, scale)
-    return MotionImage(np.zeros_like(grey), np.zeros(grey.shape, bool), grey, scale)
+    return motion_image_of(np.zeros_like(grey), np.zeros(grey.shape, bool), grey, scale)
 
 
 def next_motion_image(
@@ -84,16 +93,34 @@ def next_motion_image(
     # From the view's pixel coordinates to OpenCV's at this scale (pixel centres at integers) and back.
     to_scaled = np.array([[previous.scale, 0, -0.5], [0, previous.scale, -0.5], [0, 0, 1]])
     scaled_homography = to_scaled @ np.asarray(homography, dtype=float) @ np.linalg.inv(to_scaled)
-    stacked = np.dstack([previous.grey, previous.history, np.ones_like(grey)])
     warped = cv2.warpPerspective(
-        stacked, scaled_homography, (width, height), flags=cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT
+        cv2.merge([previous.grey, previous.history]), scaled_homography, (width, height), flags=cv2.INTER_LINEAR
     )
-    known = cv2.erode((warped[..., 2] > 0.999).astype(np.uint8), NEIGHBOURHOOD).astype(bool)
-    highest = cv2.dilate(warped[..., 0], NEIGHBOURHOOD)
-    lowest = cv2.erode(warped[..., 0], NEIGHBOURHOOD)
-    moving = ((grey > highest + threshold) | (grey < lowest - threshold)) & known
-    history = np.where(moving, np.float32(1.0), np.maximum(warped[..., 1] - np.float32(decay), 0.0))
-    return MotionImage(np.where(known, history, np.float32(0.0)), known, grey, previous.scale)
+    warped_grey, warped_history = cv2.split(warped)
+    known = _seen_before(scaled_homography, (width, height))
+    # OpenCV's element-wise operations: several times faster than NumPy's on these images.
+    rose = cv2.compare(cv2.subtract(grey, cv2.dilate(warped_grey, NEIGHBOURHOOD)), threshold, cv2.CMP_GT)
+    fell = cv2.compare(cv2.subtract(cv2.erode(warped_grey, NEIGHBOURHOOD), grey), threshold, cv2.CMP_GT)
+    moving = cv2.bitwise_and(cv2.bitwise_or(rose, fell), known)
+    faded = cv2.max(cv2.subtract(warped_history, float(decay)), 0.0)
+    history = cv2.max(faded, moving * np.float32(1 / 255))
+    return motion_image_of(cv2.multiply(history, known * np.float32(1 / 255)), known > 0, grey, previous.scale)
+
+
+def _seen_before(homography, size) -> np.ndarray:
+    """(h, w) uint8 255 where the previous view (the same size) maps with its 3 x 3 neighbourhood, else 0.
+
+    The previous image's rectangle maps to a convex quadrilateral when the camera turns by less
+    than the field of view; a turn beyond it leaves nothing known.
+    """
+    width, height = size
+    corners = np.array([[0, 0], [width - 1, 0], [width - 1, height - 1], [0, height - 1]], dtype=float)
+    mapped = np.c_[corners, np.ones(4)] @ np.asarray(homography).T
+    known = np.zeros((height, width), np.uint8)
+    if np.all(mapped[:, 2] > 0):
+        polygon = np.round(mapped[:, :2] / mapped[:, 2:] * 16).astype(np.int32)  # 4 fractional bits
+        cv2.fillConvexPoly(known, polygon, 255, lineType=cv2.LINE_8, shift=4)
+    return cv2.erode(known, NEIGHBOURHOOD)
 
 
 def non_motion_fraction(motion: MotionImage, boxes_px) -> np.ndarray:
@@ -110,12 +137,7 @@ def non_motion_fraction(motion: MotionImage, boxes_px) -> np.ndarray:
     col0, col1 = pixel_span(boxes[..., 0], boxes[..., 0] + boxes[..., 2], width)
     row0, row1 = pixel_span(boxes[..., 1], boxes[..., 1] + boxes[..., 3], height)
 
-    def box_sums(image) -> np.ndarray:
-        integral = cv2.integral(image, sdepth=cv2.CV_64F)
-        return np.sum(
-            integral[row1, col1] - integral[row0, col1] - integral[row1, col0] + integral[row0, col0], axis=-1
-        )
-
-    known = box_sums(motion.known.astype(np.float32))
-    moving = box_sums(motion.history)
+    sums = motion.sums
+    box_sums = sums[row1, col1] - sums[row0, col1] - sums[row1, col0] + sums[row0, col0]  # (..., K, 2)
+    known, moving = np.moveaxis(np.sum(box_sums, axis=-2), -1, 0)
     return np.where(known > 0, 1.0 - moving / np.maximum(known, 1.0), 1.0)
