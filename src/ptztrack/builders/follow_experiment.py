@@ -2,7 +2,9 @@
 trackers alone on the still recording (the OTB one-pass protocol).
 
 Each cell is a function of its inputs (the seed fixes the particle filter's
-draws), so every executor gives the same rows.
+draws), so every executor gives the same rows; but not MIL's: OpenCV's MIL
+tracker gives other boxes on the same frames from run to run (also with
+``cv2.setRNGSeed`` and one thread), CSRT the same.
 """
 
 import time
