@@ -27,6 +27,7 @@ _HOME = {
     "load_scenario": ".config",
     "scenario_from_dict": ".config",
     "pets_scenario": ".config",
+    "pets_follow_scenario": ".config",
     # the roles and their data
     "CameraBackend": ".roles",
     "Detector": ".roles",
@@ -68,7 +69,7 @@ if TYPE_CHECKING:
     from .builders.experiments import Cell, recording_cells, run_cell, synthetic_cells
     from .builders.world import BuiltScene, build_world
     from .camera.actions import ActionGrid
-    from .config import Scenario, ScenarioError, load_scenario, pets_scenario, scenario_from_dict
+    from .config import Scenario, ScenarioError, load_scenario, pets_follow_scenario, pets_scenario, scenario_from_dict
     from .evaluate.executors import run_cells
     from .evaluate.metrics import episode_metrics
     from .evaluate.report import write_outputs
