@@ -48,7 +48,8 @@ from ptztrack.geometry.ptz import PAN, TILT, ZOOM, PTZCamera, aim_at, project_pe
 from ptztrack.types import DecisionContext
 
 # Fixed-point iterations between the framing pose's pan and tilt and its zoom (they depend on each
-# other unless (x*, y*) is the image centre): the change after two is far below a pixel.
+# other unless (x*, y*) is the image centre): for (x*, y*) = (100, 400) px in 640 x 480 and a person
+# 20 m away, three leave 0.0015 deg and 0.03 px of height to go.
 FRAMING_ITERATIONS = 3
 
 

@@ -116,7 +116,7 @@ class ParticleFilter:
 
     particles : (P, 3) states (x_px, y_px, h_px) in the current view; weights : (P,), summing to 1.
     estimate : (3,) the weighted mean (equation 6); likelihood : its colour likelihood P(z_col | s_t).
-    reference : (K, N * N) the patches' reference histograms; aspect : box width / height.
+    reference : (K, B) the patches' reference histograms (B bins); aspect : box width / height.
     reference_likelihood : P_ref (None before the first step); lost_steps : steps lost (0 while tracking).
     motion : the motion history image.
     """

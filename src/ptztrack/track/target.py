@@ -49,6 +49,10 @@ from ptztrack.track.particle_filter import ParticleFilter, ParticleFilterParamet
 from ptztrack.types import Detections, Tracks, TrackUpdate
 
 TRACK_ID = 0
+# The uncertainty of a box centre given without one (the initial box, an OpenCV tracker's box), as a
+# fraction of the box height per axis; set a priori, it only sizes the reported covariance (nothing
+# that steers the camera or scores a run reads it).
+BOX_CENTRE_SPREAD = 0.1
 
 
 @dataclass(frozen=True)
@@ -120,7 +124,7 @@ class OpenCVSource:
     """
 
     create: Callable[[], cv2.Tracker]
-    spread: float = 0.1
+    spread: float = BOX_CENTRE_SPREAD
     tracker: cv2.Tracker | None = None
     box_px: np.ndarray = field(default_factory=lambda: np.zeros(4))
 
@@ -176,7 +180,8 @@ class TargetTracker:
         if self.track is None:
             box = np.asarray(self.initial_box_px, dtype=float)
             centre = box[:2] + box[2:] / 2
-            position, covariance = self._ground(centre, (0.1 * box[3]) ** 2 * np.eye(2), self.initial_pose)
+            spread_px2 = (BOX_CENTRE_SPREAD * box[3]) ** 2 * np.eye(2)
+            position, covariance = self._ground(centre, spread_px2, self.initial_pose)
             return self._tracks(position, np.zeros(2), covariance, missed_steps=0, hits=0)
         mean = self.track.mean[0]
         return replace(self.track, mean=np.r_[mean[:2] + self.step_s * mean[2:], mean[2:]][None])
@@ -218,9 +223,10 @@ class TargetTracker:
     def _filtered(self, position, covariance, lost: bool) -> Tracks:
         """The track after a step: the alpha-beta filter on ``position``, or held while ``lost``."""
         previous = self.track
+        hits = 0 if previous is None else int(previous.hits[0])
         if previous is None or previous.missed_steps[0] > 0 and not lost:
-            return self._tracks(position, np.zeros(2), covariance, missed_steps=0, hits=1)
-        mean, hits = previous.mean[0], int(previous.hits[0])
+            return self._tracks(position, np.zeros(2), covariance, missed_steps=0, hits=hits + 1)
+        mean = previous.mean[0]
         if lost:
             return self._tracks(
                 mean[:2], np.zeros(2), previous.covariance[0, :2, :2], previous.missed_steps[0] + 1, hits
