@@ -27,7 +27,7 @@ def excerpt_scenario(tracker="particle", frames=8, **overrides):
 def test_a_person_narrows_the_steps_and_the_camera_starts_framing_them():
     scenario = target_scenario(excerpt_scenario(frames=795), 11)
     assert scenario.follow.target_id == 11
-    assert scenario.recording.first_frame == 16 and scenario.frames == 14  # person 11: frames 16-29
+    assert scenario.recording.frame_range == (16, 30) and scenario.frames == 14  # person 11: frames 16-29
     shorter = target_scenario(excerpt_scenario(frames=5), 11)
     assert shorter.frames == 5
     cell = FollowCell(excerpt_scenario("csrt", frames=1), "csrt", 9)

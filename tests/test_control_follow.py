@@ -22,12 +22,12 @@ PARAMETERS = FollowParameters(
 )
 
 
-def track_at(position_m, velocity_m_s=(0.0, 0.0), missed_steps=0) -> Tracks:
+def track_at(position_m, velocity_m_s=(0.0, 0.0), lost=False) -> Tracks:
     return Tracks(
         np.array([0]),
         np.r_[position_m, velocity_m_s][None],
         np.eye(4)[None] * 0.01,
-        np.array([missed_steps]),
+        np.array([0.0 if lost else 1.0]),
         np.array([1]),
     )
 
@@ -91,7 +91,7 @@ def test_without_a_track_or_with_a_held_one_the_camera_comes_to_rest():
     for step in range(20):
         pose = policy.choose(context(step, Tracks.empty(), pose))
     np.testing.assert_allclose(policy.velocity, 0.0, atol=1e-12)
-    held = track_at([3.0, 15.0], missed_steps=4)  # a lost track holds its last position, no velocity
+    held = track_at([3.0, 15.0], lost=True)  # a lost track holds its last position, no velocity
     for step in range(80):
         pose = policy.choose(context(step, held, pose))
     np.testing.assert_allclose(pose, framing_pose(CAMERA, [3.0, 15.0], pose, PARAMETERS), atol=1e-3)

@@ -97,11 +97,11 @@ def test_a_lost_target_is_held_still_and_found_again_where_the_source_finds_it()
     before = follower.reported().mean[0].copy()
     for missed in (1, 2):
         update = follower.update(None, POSE, lambda: IMAGE)
-        assert update.tracks.missed_steps[0] == missed and len(update.track_ids) == 0
+        assert follower.missed_steps == missed and update.tracks.existence[0] == 0 and len(update.track_ids) == 0
         np.testing.assert_allclose(update.tracks.mean[0], np.r_[before[:2], 0.0, 0.0])
         np.testing.assert_allclose(follower.predict().mean[0], np.r_[before[:2], 0.0, 0.0])
     found = follower.update(None, POSE, lambda: IMAGE)
-    assert found.tracks.missed_steps[0] == 0
+    assert follower.missed_steps == 0 and found.tracks.existence[0] == 1
     np.testing.assert_allclose(found.tracks.mean[0], [2.0, 16.0, 0.0, 0.0], atol=1e-9)
 
 

@@ -321,7 +321,8 @@ def follow_command(args: argparse.Namespace) -> int:
         scenario = scenario.model_copy(update={"frames": args.frames})
     narrowed, world, episode = follow_run(FollowCell(scenario, args.tracker, args.target, args.seed))
     row = follow_row(narrowed, world, episode)
-    first_frame = narrowed.required_recording("the follow camera").first_frame
+    frame_range = narrowed.required_recording("the follow camera").frame_range
+    first_frame = frame_range[0] if frame_range is not None else 0
     print(f"person {args.target} followed by {args.tracker} from frame {first_frame}, {row['steps']} steps")
     print(format_follow_table([row], FOLLOW_FIGURES))
     out = args.out or Path(f"follow-{args.target}")

@@ -149,7 +149,7 @@ def target_scenario(scenario: Scenario, target_id: int) -> Scenario:
     """The scenario narrowed to one person.
 
     ``follow.target_id`` is set; the steps run from the person's first annotated frame to their last
-    (``recording.first_frame``; ``frames``, at most the scenario's); and the action grid becomes the
+    (``recording.frame_range``; ``frames``, at most the scenario's); and the action grid becomes the
     one pose that frames the person at their first annotated position, where the camera starts (as a
     camera operator would hand a framed shot over to the controller; the policy commands every later
     pose itself).
@@ -179,6 +179,6 @@ def target_scenario(scenario: Scenario, target_id: int) -> Scenario:
             "frames": min(scenario.frames, (last - first) // recording.frame_step + 1),
             "actions": Actions.model_validate(actions),
             "follow": scenario.follow.model_copy(update={"target_id": target_id}),
-            "recording": recording.model_copy(update={"first_frame": first}),
+            "recording": recording.model_copy(update={"frame_range": (first, last + 1)}),
         }
     )

@@ -83,7 +83,7 @@ def follow_row(scenario: Scenario, world: World, episode: Episode) -> dict:
     backend = world.backend
     assert isinstance(backend, RecordedPTZ)
     centres_px, heights_px = target_in_views(backend.virtual, target_boxes(world, target_id), episode.poses)
-    lost = np.array([tracks.missed_steps[0] > 0 for tracks in episode.tracks])
+    lost = np.array([tracks.existence[0] == 0 for tracks in episode.tracks])
     camera = world.camera
     target_point_px = follow_parameters(scenario, camera).target_point_px
     metrics = follow_metrics(

@@ -35,7 +35,7 @@ so the commanded velocity changes by at most ``max_acceleration`` per
 second: the second difference of the commanded angles (the jitter) is at
 most ``max_acceleration * step^2``. With ``time_constant = max_speed / (2
 max_acceleration)`` a camera at full speed starts braking early enough not
-to overshoot. While the track is lost (``missed_steps > 0``) the tracker
+to overshoot. While the track is lost (existence 0) the tracker
 holds its last position with no velocity, so the camera settles on it and
 waits.
 """

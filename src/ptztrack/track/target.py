@@ -25,7 +25,8 @@ ground position (both poles at ``smoothing``; alpha = 1 - smoothing^2, beta
 constant velocity without lag, and whose velocity the controller uses to
 lead the person. While the source is lost the track holds its last position
 with no velocity (the paper's robot "does not drift but simply keeps the
-last estimated position"), counting the steps in ``missed_steps``; when the
+last estimated position"), with existence 0 (the tracker does not see the
+person) and the steps counted in the tracker's ``missed_steps``; when the
 source finds the person again the filter starts afresh from the new
 position.
 """
@@ -174,6 +175,7 @@ class TargetTracker:
     step_s: float
     pose: np.ndarray | None = None
     track: Tracks | None = None
+    missed_steps: int = 0
 
     def predict(self) -> Tracks:
         """The track predicted to this step (one step of its velocity on), or the initial box's before the first."""
@@ -224,13 +226,13 @@ class TargetTracker:
         """The track after a step: the alpha-beta filter on ``position``, or held while ``lost``."""
         previous = self.track
         hits = 0 if previous is None else int(previous.hits[0])
-        if previous is None or previous.missed_steps[0] > 0 and not lost:
+        was_lost = self.missed_steps > 0
+        self.missed_steps = self.missed_steps + 1 if lost and previous is not None else 0
+        if previous is None or was_lost and not lost:
             return self._tracks(position, np.zeros(2), covariance, missed_steps=0, hits=hits + 1)
         mean = previous.mean[0]
         if lost:
-            return self._tracks(
-                mean[:2], np.zeros(2), previous.covariance[0, :2, :2], previous.missed_steps[0] + 1, hits
-            )
+            return self._tracks(mean[:2], np.zeros(2), previous.covariance[0, :2, :2], self.missed_steps, hits)
         predicted = mean[:2] + self.step_s * mean[2:]
         residual = position - predicted
         alpha, beta = 1 - self.smoothing**2, (1 - self.smoothing) ** 2
@@ -247,7 +249,7 @@ class TargetTracker:
             np.array([TRACK_ID]),
             np.r_[position, velocity][None],
             full[None],
-            np.array([missed_steps]),
+            np.array([1.0 if missed_steps == 0 else 0.0]),
             np.array([hits]),
             next_id=TRACK_ID + 1,
         )
