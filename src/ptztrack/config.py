@@ -324,6 +324,9 @@ class Follow(_Strict):
     achromatic_bins : N more bins by value for pixels too grey or dark to have a hue (Perez et al.);
     false: the paper's hue-saturation histograms alone.
     lambda_colour, lambda_motion : equations 3 and 4.
+    lambda_loss : the colour likelihood's lambda in the loss test, exp(-sum_p B_p^2 / lambda_loss): the
+    weights stay sharp (``lambda_colour``) while the loss test tolerates the appearance changes of a
+    walking person (chosen on the even-numbered PETS people; see the README).
     walk_heights_per_s : random-walk spread of the box position, box heights per second;
     scale_change_per_s : relative random-walk spread of its height per second.
     loss_fraction, adapt_fraction : the loss test (P < loss_fraction P_ref) and when P_ref adapts.
@@ -349,6 +352,7 @@ class Follow(_Strict):
     achromatic_bins: bool = False
     samples_per_patch: int = Field(20, ge=1)
     lambda_colour: PositiveFloat = 0.15
+    lambda_loss: PositiveFloat = 1.0
     lambda_motion: PositiveFloat = 0.434
     walk_heights_per_s: PositiveFloat = 1.0
     scale_change_per_s: PositiveFloat = 0.2

@@ -34,6 +34,7 @@ def particle_filter_parameters(scenario: Scenario) -> ParticleFilterParameters:
         achromatic=follow.achromatic_bins,
         samples=follow.samples_per_patch,
         lambda_colour=follow.lambda_colour,
+        lambda_loss=follow.lambda_loss,
         lambda_motion=follow.lambda_motion,
         walk_sigma=follow.walk_heights_per_s * step_s,
         scale_sigma=follow.scale_change_per_s * step_s,

@@ -84,6 +84,7 @@ class ParticleFilterParameters:
     bins : N of the N x N hue-saturation histograms; achromatic : N more bins by value for greys
     (:func:`ptztrack.track.colour_model.colour_bins`); samples : grid points per patch axis.
     lambda_colour, lambda_motion : equations 3 and 4.
+    lambda_loss : the colour likelihood's lambda in the loss test (``likelihood``, ``P_ref``).
     walk_sigma : random-walk step of x and y in box heights; scale_sigma : relative step of h.
     loss_fraction, adapt_fraction, reference_rate : the loss test and the adaptation of ``P_ref``.
     search_sigma, search_scale_sigma : the diffuse prior after a loss (see the module).
@@ -98,6 +99,7 @@ class ParticleFilterParameters:
     samples: int
     lambda_colour: float
     lambda_motion: float
+    lambda_loss: float
     walk_sigma: float
     scale_sigma: float
     loss_fraction: float
@@ -212,10 +214,13 @@ def step_filter(
     weights = np.exp(log_weights - log_weights.max())
     weights /= weights.sum()
     estimate = weights @ particles
-    likelihood = float(np.exp(region.log_likelihood(estimate[None], state.reference, state.aspect, parameters)[0]))
+    # The loss test's likelihoods: the same sum of squared distances over lambda_loss.
+    to_loss = parameters.lambda_colour / parameters.lambda_loss
+    estimate_colour = region.log_likelihood(estimate[None], state.reference, state.aspect, parameters)[0]
+    likelihood = float(np.exp(to_loss * estimate_colour))
     reference = state.reference_likelihood
     if reference is None:  # the first step: P_ref is the best particle's likelihood
-        reference = float(np.exp(colour.max()))
+        reference = float(np.exp(to_loss * colour.max()))
     elif not state.lost and state.likelihood >= parameters.adapt_fraction * reference:
         reference += parameters.reference_rate * (state.likelihood - reference)
     found = likelihood >= parameters.loss_fraction * reference
