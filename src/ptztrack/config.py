@@ -467,8 +467,11 @@ def load_scenario(path: str | Path, **overrides) -> Scenario:
     """Read and validate a YAML scenario file (see the README for the format)."""
     path = Path(path)
     data = read_yaml(path, "scenario", ScenarioError)
-    data = {} if data is None else data
-    recording = data.get("recording") if isinstance(data, dict) else None
+    if data is None:
+        data = {}
+    if not isinstance(data, dict):
+        raise ScenarioError(f"{path}: expected a mapping of scenario fields (got {type(data).__name__})")
+    recording = data.get("recording")
     if isinstance(recording, dict):
         data = {**data, "recording": {**recording, **_resolved_paths(recording, path.parent)}}
     return scenario_from_dict(data, str(path), **overrides)

@@ -101,15 +101,15 @@ def load_cvml(path: str | Path) -> Annotations:
     path = Path(path)
     root = read_xml_root(path, "annotation", GROUND_TRUTH_MAX_BYTES, DatasetError)
     rows = []
-    for frame in root.iter("frame"):
-        for person in frame.iter("object"):
+    for frame_element in root.iter("frame"):
+        for person in frame_element.iter("object"):
             box = person.find("box")
             try:
-                values = [float(box.get(name)) for name in ("xc", "yc", "w", "h")]
-                rows.append([int(frame.get("number")), int(person.get("id")), *values])
-            except (AttributeError, TypeError, ValueError):
+                values = [float(box.get(name, "")) for name in ("xc", "yc", "w", "h")]  # type: ignore[union-attr]
+                rows.append([int(frame_element.get("number", "")), int(person.get("id", "")), *values])
+            except (AttributeError, ValueError):
                 raise DatasetError(
-                    f"{path}: frame {frame.get('number')!r} object {person.get('id')!r} needs "
+                    f"{path}: frame {shown(frame_element.get('number'))} object {shown(person.get('id'))} needs "
                     "integer number and id and a <box> with numeric xc, yc, w, h"
                 ) from None
     if not rows:
