@@ -127,6 +127,9 @@ class PoseError(_Strict):
 _Coordinate = Annotated[float, Field(ge=-10_000), at_most(10_000, "metres: the ground a camera can see")]
 
 
+_Gain = Annotated[PositiveFloat, at_most(100, "a factor on the contrast")]
+
+
 class LiveView(_Strict):
     """How a real PTZ camera's views depart from the pinhole model (:mod:`ptztrack.camera.live_view`);
     the defaults are the realistic model of the registration experiment.
@@ -140,16 +143,16 @@ class LiveView(_Strict):
     view's values are fixed by ``seed`` (the camera unit) and its pose.
     """
 
-    roll_max_deg: NonNegativeFloat = 2.0
-    principal_offset_max_px: NonNegativeFloat = 10.0
+    roll_max_deg: Annotated[NonNegativeFloat, at_most(45, "degrees: a mount rolled further is not level")] = 2.0
+    principal_offset_max_px: Annotated[NonNegativeFloat, at_most(1000, "pixels")] = 10.0
     # The PETS camera's own lens over the field of our zoom-1 view (its calibration's k1).
     k1_wide: Annotated[float, Field(gt=-1, lt=1)] = -0.15
     k1_tele: Annotated[float, Field(gt=-1, lt=1)] = 0.0
-    tele_zoom: Annotated[float, Field(gt=1)] = 4.0
-    gain: tuple[PositiveFloat, PositiveFloat] = (0.7, 1.3)
-    brightness_max: NonNegativeFloat = 20.0
+    tele_zoom: Annotated[float, Field(gt=1), at_most(100, "a PTZ camera's optical zoom")] = 4.0
+    gain: tuple[_Gain, _Gain] = (0.7, 1.3)
+    brightness_max: Annotated[NonNegativeFloat, at_most(255, "grey levels")] = 20.0
     jpeg_quality: int = Field(75, ge=1, le=100)
-    seed: int = Field(0, ge=0)
+    seed: int = Field(0, ge=0, lt=2**63)
 
     @model_validator(mode="after")
     def _gain_ordered(self):
