@@ -57,7 +57,7 @@ def test_an_output_path_that_cannot_be_a_directory_exits_2_naming_it(tmp_path, c
     blocker = tmp_path / "file"
     blocker.write_text("keep me")
     assert main(["run", "--frames", "3", "--out", str(blocker / "out")]) == 2
-    assert f"{blocker / 'out'}: Not a directory" in capsys.readouterr().err
+    assert f"{blocker / 'out'}: {blocker} is a file, not a folder" in capsys.readouterr().err
     assert blocker.read_text() == "keep me"
 
 
@@ -82,7 +82,7 @@ def test_pets_runs_on_recording_files_given_on_the_command_line_either_calibrati
     [
         ("--gt", "missing.txt", "no such ground-truth file"),
         ("--calibration", "calibration.json", "not valid JSON"),
-        ("--video", "short.avi", "the video ends before frame"),
+        ("--video", "short.avi", "30 frames, the run needs"),
     ],
 )
 def test_a_bad_recording_file_exits_2_naming_the_file_and_the_problem(tmp_path, capsys, option, name, problem):

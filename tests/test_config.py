@@ -47,7 +47,7 @@ def test_bad_scenarios_get_one_line_naming_the_file_field_and_value(tmp_path, te
 
 
 def test_a_missing_file_is_named(tmp_path):
-    with pytest.raises(ScenarioError, match="nope.yaml: cannot read scenario file"):
+    with pytest.raises(ScenarioError, match="nope.yaml: no such scenario file"):
         load_scenario(tmp_path / "nope.yaml")
 
 

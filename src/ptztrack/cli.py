@@ -1,7 +1,7 @@
 """The ``ptztrack`` command: a thin layer over the Python API."""
 
 import argparse
-import json
+import math
 import os
 import sys
 import tempfile
@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from ptztrack import registry
+from ptztrack.builders.budget import refuse_if_too_large
 from ptztrack.builders.episode import episode_world, run_episode
 from ptztrack.builders.experiments import (
     POSE_SOURCES,
@@ -67,12 +68,10 @@ from ptztrack.evaluate.msg import (
     trails_figure,
 )
 from ptztrack.evaluate.registration import summarise_registration
-from ptztrack.evaluate.report import RUN_FILES, write_atomically, write_figure, write_outputs
+from ptztrack.evaluate.report import RUN_FILES, write_figure, write_outputs
 from ptztrack.evaluate.tables import format_table, paired_difference, summarise
 from ptztrack.evaluate.video import view_renderer
-from ptztrack.geometry.calibration import CalibrationError
-from ptztrack.geometry.registration import RegistrationIndexError
-from ptztrack.scene.pets import DatasetError
+from ptztrack.files import InputError, check_output_file, check_output_folder, run_folder, strict_json, write_atomically
 from ptztrack.scene.roads import walk_roads
 
 RUN_FIGURES = ("mota", "motp_m", "idf1", "height_px", "detections", "zoom", "switches")
@@ -123,6 +122,7 @@ def run_command(args: argparse.Namespace) -> int:
     scenario = build_scenario(
         args.scenario, args.detector, args.frames, recording_paths(args), args.association, args.measurement_source
     )
+    refuse_if_too_large(scenario, (args.policy,))
     world = episode_world(scenario, args.seed)
     episode = run_episode(scenario, args.policy, args.seed, world)
     metrics = episode_metrics(episode)
@@ -133,7 +133,8 @@ def run_command(args: argparse.Namespace) -> int:
     print(format_metrics(metrics))
     if args.out is not None:
         title = f"{args.policy}, {scenario.detector.kind} detector, seed {args.seed}: MOTA {metrics['mota']:.1%}"
-        write_outputs(args.out, episode, metrics, title, view_renderer(world))
+        with run_folder(args.out, args.overwrite) as folder:
+            write_outputs(folder, episode, metrics, title, view_renderer(world))
         print(f"wrote {', '.join(RUN_FILES)} into {args.out}")
     return 0
 
@@ -147,7 +148,7 @@ def msg_experiment_command(args: argparse.Namespace) -> int:
     print(format_paired_differences(rows))
     written = []
     if args.json is not None:
-        write_atomically(args.json, (json.dumps(rows, indent=2) + "\n").encode())
+        write_atomically(args.json, strict_json(rows))
         written.append(args.json)
     if args.plot is not None:
         write_figure(args.plot, ambiguity_figure(rows))
@@ -222,7 +223,7 @@ def registration_experiment_command(args: argparse.Namespace) -> int:
         )
     if args.json is not None:
         document = {**summary, "live_view_model": settings, "closed_loop": closed_loop, "views_detail": views}
-        write_atomically(args.json, (json.dumps(document, indent=2) + "\n").encode())
+        write_atomically(args.json, strict_json(document))
         print(f"wrote {args.json}")
     return 0
 
@@ -287,6 +288,8 @@ def _run_table(
     args: argparse.Namespace, cells: list, title: str, spread: str = "mota_se", extra: dict | None = None
 ) -> int:
     print(f"{len(cells)} episodes, {args.executor} executor", file=sys.stderr)
+    runs_at_once = 1 if args.executor == "serial" else min(len(cells), args.workers or os.cpu_count() or 1)
+    refuse_if_too_large(cells[0].scenario, tuple(args.strategies), runs_at_once)
     summary = summarise(run_cells(cells, run_cell, args.executor, args.workers, print_progress))
     summary = [{**row, **(extra or {})} for row in summary]
     print(format_table(summary, title, spread))
@@ -296,7 +299,7 @@ def _run_table(
         paired = f"paired over {count} sequences, standard error"
         print(f"smpl - intg: {100 * mean:+.1f} +- {100 * error:.1f} MOTA points ({paired})")
     if args.json is not None:
-        write_atomically(args.json, (json.dumps(summary, indent=2) + "\n").encode())
+        write_atomically(args.json, strict_json(summary))
         print(f"wrote {args.json}")
     return 0
 
@@ -316,6 +319,8 @@ def _follow_scenario(args: argparse.Namespace, tracker: str = "particle") -> Sce
 
 
 def follow_command(args: argparse.Namespace) -> int:
+    out = args.out or Path(f"follow-{args.target}")
+    check_output_folder(out, "--out", args.overwrite)
     scenario = _follow_scenario(args, args.tracker)
     if args.frames is not None:
         scenario = scenario.model_copy(update={"frames": args.frames})
@@ -325,9 +330,9 @@ def follow_command(args: argparse.Namespace) -> int:
     first_frame = frame_range[0] if frame_range is not None else 0
     print(f"person {args.target} followed by {args.tracker} from frame {first_frame}, {row['steps']} steps")
     print(format_follow_table([row], FOLLOW_FIGURES))
-    out = args.out or Path(f"follow-{args.target}")
     title = f"person {args.target}, {args.tracker}: in view {row['in_view_fraction']:.0%}"
-    write_outputs(out, episode, row, title, view_renderer(world))
+    with run_folder(out, args.overwrite) as folder:
+        write_outputs(folder, episode, row, title, view_renderer(world))
     print(f"wrote {', '.join(RUN_FILES)} into {out}")
     return 0
 
@@ -351,7 +356,7 @@ def follow_experiment_command(args: argparse.Namespace) -> int:
     print(format_follow_table(otb, OTB_FIGURES, f"\nOne-pass (OTB) on the still recording, people {tracks}:"))
     if args.json is not None:
         document = {"closed_loop": closed_loop, "otb": otb, "people": people, "otb_people": otb_people}
-        write_atomically(args.json, (json.dumps(document, indent=2) + "\n").encode())
+        write_atomically(args.json, strict_json(document))
         print(f"wrote {args.json}")
     return 0
 
@@ -376,7 +381,8 @@ def parser() -> argparse.ArgumentParser:
     run.add_argument("--seed", type=_non_negative_int, default=0)
     run.add_argument("--frames", type=_positive_int, help="overrides the scenario's number of frames")
     _add_tracker_arguments(run)
-    run.add_argument("--out", type=Path, help=f"directory for {', '.join(RUN_FILES)}")
+    run.add_argument("--out", type=Path, help=f"directory for {', '.join(RUN_FILES)}; written whole or not at all")
+    run.add_argument("--overwrite", action="store_true", help="replace a non-empty --out folder")
     _add_recording_arguments(run)
     run.set_defaults(handler=run_command)
 
@@ -474,9 +480,18 @@ def _add_follow_commands(commands, experiments) -> None:
     follow.add_argument("--seed", type=_non_negative_int, default=0)
     follow.add_argument("--frames", type=_positive_int, help="at most this many steps")
     follow.add_argument(
-        "--target-point-px", type=float, nargs=2, metavar=("X", "Y"), help="(x*, y*); default: the image centre"
+        "--target-point-px",
+        type=_non_negative_float,
+        nargs=2,
+        metavar=("X", "Y"),
+        help="(x*, y*); default: the image centre",
     )
-    follow.add_argument("--out", type=Path, help=f"directory for {', '.join(RUN_FILES)} (default follow-TARGET)")
+    follow.add_argument(
+        "--out",
+        type=Path,
+        help=f"directory for {', '.join(RUN_FILES)} (default follow-TARGET); written whole or not at all",
+    )
+    follow.add_argument("--overwrite", action="store_true", help="replace a non-empty --out folder")
     _add_follow_scenario_arguments(follow)
     follow.set_defaults(handler=follow_command)
 
@@ -541,9 +556,12 @@ def _add_recording_arguments(command: argparse.ArgumentParser) -> None:
 
 
 def _non_negative_float(text: str) -> float:
-    value = float(text)
-    if not value >= 0:
-        raise argparse.ArgumentTypeError(f"must be at least 0 (got {text})")
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number (got {text!r})") from None
+    if not (math.isfinite(value) and value >= 0):
+        raise argparse.ArgumentTypeError(f"must be a finite number of at least 0 (got {text})")
     return value
 
 
@@ -561,13 +579,29 @@ def _positive_int(text: str) -> int:
     return value
 
 
+def check_outputs(args: argparse.Namespace) -> None:
+    """Refuse, before any work, output paths that could not be written."""
+    for option in ("json", "plot", "trails"):
+        if getattr(args, option, None) is not None:
+            check_output_file(getattr(args, option), f"--{option}")
+    if getattr(args, "index", None) is not None and not args.index.exists():
+        check_output_file(args.index, "--index")
+    if getattr(args, "out", None) is not None:
+        check_output_folder(args.out, "--out", args.overwrite)
+
+
 def main(argv: list[str] | None = None) -> int:
-    args = parser().parse_args(argv)
+    """The command line: 0 when done, 2 with one line on stderr for any bad input, 130 on Ctrl-C."""
     try:
+        args = parser().parse_args(argv)
+        check_outputs(args)
         return args.handler(args)
-    except (ScenarioError, CalibrationError, DatasetError, RegistrationIndexError, RuntimeError) as error:
+    except (InputError, RuntimeError) as error:
         print(f"ptztrack: error: {error}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt:
+        print("ptztrack: interrupted; nothing was left half-written", file=sys.stderr)
+        return 130
     except BrokenPipeError:
         # The reader (say, `head`) has gone: stop quietly, and keep Python from
         # complaining again when it flushes stdout at exit.

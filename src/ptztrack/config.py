@@ -4,6 +4,7 @@ The defaults are the synthetic scene of the paper's section 5.1 with the
 camera mounting chosen in :mod:`ptztrack.scene.synthetic`.
 """
 
+from collections.abc import Hashable
 from importlib import resources
 from pathlib import Path
 from typing import Annotated, Any, Literal
@@ -14,13 +15,44 @@ import yaml
 from pydantic import AfterValidator, BaseModel, ConfigDict, Field, model_validator
 
 from ptztrack import registry
+from ptztrack.files import SHOWN_CHARACTERS, InputError, read_text, shown
 
 PositiveFloat = Annotated[float, Field(gt=0)]
 NonNegativeFloat = Annotated[float, Field(ge=0)]
+SCENARIO_MAX_BYTES = 1_000_000
+YAML_MAX_VALUES = 100_000
+"""How many values a scenario may hold once YAML's aliases are expanded (a 'billion laughs' holds 10^9)."""
 
 
-class ScenarioError(ValueError):
+class ScenarioError(InputError):
     """A scenario that cannot be run; the message is one line naming the field and value."""
+
+
+def at_most(limit: float, why: str):
+    """A bound on a size, count or rate, with the reason for it (memory, time, physics) in the message."""
+
+    def check(value):
+        if value > limit:
+            raise ValueError(f"must be at most {limit:g} ({why})")
+        return value
+
+    return AfterValidator(check)
+
+
+def at_most_items(limit: int, why: str):
+    """A bound on the length of a list, with the reason for it."""
+
+    def check(values):
+        if len(values) > limit:
+            raise ValueError(f"must have at most {limit} items ({why})")
+        return values
+
+    return AfterValidator(check)
+
+
+_MAX_FRAMES = 100_000
+Pixels = Annotated[int, Field(gt=0), at_most(8192, "memory: an 8192 x 8192 colour image is 200 MB")]
+Degrees = Annotated[float, Field(ge=-360), at_most(360, "an angle in degrees")]
 
 
 def _registered(kind: str):
@@ -39,7 +71,13 @@ Options = dict[str, Any]
 
 
 class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    # Every float is finite: no field gives infinity a meaning.
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+
+
+_Speed = Annotated[PositiveFloat, at_most(15, "metres per second: faster than anyone runs")]
+_Height = Annotated[PositiveFloat, at_most(3, "metres: taller than anyone")]
+_Stay = Annotated[PositiveFloat, at_most(86_400, "seconds: a day")]
 
 
 class People(_Strict):
@@ -47,15 +85,15 @@ class People(_Strict):
     ``count`` people who walk in pairs, side by side ``pair_spacing_m`` apart (pairs: the fraction
     of count / 2, rounded)."""
 
-    count: int = Field(7, ge=0)
-    speed_m_s: tuple[PositiveFloat, PositiveFloat] = (1.0, 1.5)
-    height_m: tuple[PositiveFloat, PositiveFloat] = (1.6, 1.9)
-    width_m: PositiveFloat = 0.62
-    turn_rate_sigma_deg_s: NonNegativeFloat = 40.0
+    count: Annotated[int, Field(ge=0), at_most(1000, "time: the policies score every person under every action")] = 7
+    speed_m_s: tuple[_Speed, _Speed] = (1.0, 1.5)
+    height_m: tuple[_Height, _Height] = (1.6, 1.9)
+    width_m: Annotated[PositiveFloat, at_most(3, "metres: a person's width")] = 0.62
+    turn_rate_sigma_deg_s: Annotated[NonNegativeFloat, at_most(3600, "degrees per second")] = 40.0
     enter_leave: bool = False
-    stay_s: tuple[PositiveFloat, PositiveFloat] = (8.0, 20.0)
+    stay_s: tuple[_Stay, _Stay] = (8.0, 20.0)
     paired_fraction: float = Field(0.85, ge=0, le=1)
-    pair_spacing_m: PositiveFloat = 0.75
+    pair_spacing_m: Annotated[PositiveFloat, at_most(10, "metres between two people walking together")] = 0.75
 
     @model_validator(mode="after")
     def _intervals_ordered(self):
@@ -80,10 +118,16 @@ class PoseError(_Strict):
     while the command does not change. The defaults are a perfect camera.
     """
 
-    pan_tilt_sigma_deg: NonNegativeFloat = 0.0
-    pan_tilt_bias_deg: tuple[float, float] = (0.0, 0.0)
+    pan_tilt_sigma_deg: Annotated[NonNegativeFloat, at_most(90, "degrees")] = 0.0
+    pan_tilt_bias_deg: tuple[Degrees, Degrees] = (0.0, 0.0)
     zoom_sigma: Annotated[float, Field(ge=0, lt=0.5)] = 0.0
-    zoom_bias: PositiveFloat = 1.0
+    zoom_bias: Annotated[PositiveFloat, at_most(10, "a factor on the zoom")] = 1.0
+
+
+_Coordinate = Annotated[float, Field(ge=-10_000), at_most(10_000, "metres: the ground a camera can see")]
+
+
+_Gain = Annotated[PositiveFloat, at_most(100, "a factor on the contrast")]
 
 
 class LiveView(_Strict):
@@ -99,16 +143,16 @@ class LiveView(_Strict):
     view's values are fixed by ``seed`` (the camera unit) and its pose.
     """
 
-    roll_max_deg: NonNegativeFloat = 2.0
-    principal_offset_max_px: NonNegativeFloat = 10.0
+    roll_max_deg: Annotated[NonNegativeFloat, at_most(45, "degrees: a mount rolled further is not level")] = 2.0
+    principal_offset_max_px: Annotated[NonNegativeFloat, at_most(1000, "pixels")] = 10.0
     # The PETS camera's own lens over the field of our zoom-1 view (its calibration's k1).
     k1_wide: Annotated[float, Field(gt=-1, lt=1)] = -0.15
     k1_tele: Annotated[float, Field(gt=-1, lt=1)] = 0.0
-    tele_zoom: Annotated[float, Field(gt=1)] = 4.0
-    gain: tuple[PositiveFloat, PositiveFloat] = (0.7, 1.3)
-    brightness_max: NonNegativeFloat = 20.0
+    tele_zoom: Annotated[float, Field(gt=1), at_most(100, "a PTZ camera's optical zoom")] = 4.0
+    gain: tuple[_Gain, _Gain] = (0.7, 1.3)
+    brightness_max: Annotated[NonNegativeFloat, at_most(255, "grey levels")] = 20.0
     jpeg_quality: int = Field(75, ge=1, le=100)
-    seed: int = Field(0, ge=0)
+    seed: int = Field(0, ge=0, lt=2**63)
 
     @model_validator(mode="after")
     def _gain_ordered(self):
@@ -123,13 +167,17 @@ class Camera(_Strict):
     recording's views depart from the pinhole model (None: exact pinhole views); the detector, the
     templates and registration all see the same views."""
 
-    position_m: tuple[float, float, PositiveFloat] = (7.5, -6.0, 2.5)
-    image_size_px: tuple[Annotated[int, Field(gt=0)], Annotated[int, Field(gt=0)]] = (640, 480)
-    f_min_px: PositiveFloat = 325.0
+    position_m: tuple[_Coordinate, _Coordinate, Annotated[PositiveFloat, at_most(10_000, "metres")]] = (7.5, -6.0, 2.5)
+    image_size_px: tuple[Pixels, Pixels] = (640, 480)
+    f_min_px: Annotated[PositiveFloat, at_most(1e6, "pixels")] = 325.0
     pose_error: PoseError = PoseError()
     live_view: LiveView | None = None
     backend: Annotated[str | None, _registered("cameras")] = None
     options: Options = Field(default_factory=dict)
+
+
+_Zoom = Annotated[float, Field(ge=1), at_most(100, "a PTZ camera's optical zoom")]
+_REFERENCE_TIME = "time: every reference view is rendered and its SIFT features indexed"
 
 
 class PoseFeedback(_Strict):
@@ -147,33 +195,37 @@ class PoseFeedback(_Strict):
     """
 
     source: Literal["commanded", "oracle", "registered"] = "commanded"
-    image_size_px: tuple[Annotated[int, Field(gt=0)], Annotated[int, Field(gt=0)]] = (640, 480)
-    reference_zooms: tuple[Annotated[float, Field(ge=1)], ...] = (1.0, 2.0, 3.2)
-    reference_pan_steps: int = Field(5, ge=1)
-    reference_tilt_steps: int = Field(3, ge=1)
-    reference_pose_sigma_deg: NonNegativeFloat = 0.5
+    image_size_px: tuple[Pixels, Pixels] = (640, 480)
+    reference_zooms: Annotated[tuple[_Zoom, ...], at_most_items(20, _REFERENCE_TIME)] = (1.0, 2.0, 3.2)
+    reference_pan_steps: Annotated[int, Field(ge=1), at_most(50, _REFERENCE_TIME)] = 5
+    reference_tilt_steps: Annotated[int, Field(ge=1), at_most(50, _REFERENCE_TIME)] = 3
+    reference_pose_sigma_deg: Annotated[NonNegativeFloat, at_most(90, "degrees")] = 0.5
     reference_zoom_spread: Annotated[float, Field(ge=0, lt=0.5)] = 0.03
     index: str | None = None
 
 
 class AxisRange(_Strict):
-    start: float
-    stop: float
-    count: int = Field(ge=1)
+    start: Degrees
+    stop: Degrees
+    count: Annotated[int, Field(ge=1), at_most(1000, "time: the policies score every action")]
 
     def values(self) -> np.ndarray:
         return np.linspace(self.start, self.stop, self.count)
 
 
+_GridSteps = Annotated[int, Field(ge=0), at_most(1000, "steps of the action grid")]
+
+
 class Actions(_Strict):
     pan_deg: AxisRange = AxisRange(start=-45.0, stop=45.0, count=7)
     tilt_deg: AxisRange = AxisRange(start=0.0, stop=24.0, count=10)
-    zoom: tuple[Annotated[float, Field(ge=1)], ...] = (1.0, 2.0, 3.0, 4.0)
-    max_steps: tuple[Annotated[int, Field(ge=0)], Annotated[int, Field(ge=0)], Annotated[int, Field(ge=0)]] = (
-        2,
-        2,
-        1,
+    zoom: Annotated[tuple[_Zoom, ...], at_most_items(100, "time: the policies score every action")] = (
+        1.0,
+        2.0,
+        3.0,
+        4.0,
     )
+    max_steps: tuple[_GridSteps, _GridSteps, _GridSteps] = (2, 2, 1)
 
     @model_validator(mode="after")
     def _zoom_increasing(self):
@@ -194,11 +246,13 @@ class Detector(_Strict):
 
     kind: Annotated[str, _registered("detectors")] = "realistic"
     options: Options = Field(default_factory=dict)
-    recall_kd: PositiveFloat = 0.0098
-    recall_r0_px: NonNegativeFloat = 21.29
-    pixel_noise_px: NonNegativeFloat = 2.0
-    false_positives_per_frame: NonNegativeFloat = 0.0
-    hog_upsample: PositiveFloat = 6.0
+    recall_kd: Annotated[PositiveFloat, at_most(100, "per pixel")] = 0.0098
+    recall_r0_px: Annotated[NonNegativeFloat, at_most(10_000, "pixels")] = 21.29
+    pixel_noise_px: Annotated[NonNegativeFloat, at_most(10_000, "pixels")] = 2.0
+    false_positives_per_frame: Annotated[
+        NonNegativeFloat, at_most(1000, "time and memory: every detection is kept and associated")
+    ] = 0.0
+    hog_upsample: Annotated[PositiveFloat, at_most(16, "memory: the view is upsampled this much each way")] = 6.0
     hog_hit_threshold: float = 0.0
     hog_nms_iou: float = Field(0.4, gt=0, le=1)
 
@@ -235,30 +289,36 @@ class Tracker(_Strict):
 
     kind: Annotated[str, _registered("trackers")] = "ekf"
     options: Options = Field(default_factory=dict)
-    acceleration_sigma_m_s2: PositiveFloat = 1.5
-    initial_speed_sigma_m_s: PositiveFloat = 0.9
+    acceleration_sigma_m_s2: Annotated[PositiveFloat, at_most(100, "metres per second squared")] = 1.5
+    initial_speed_sigma_m_s: Annotated[PositiveFloat, at_most(100, "metres per second")] = 0.9
     gate_probability: float = Field(0.99, gt=0, lt=1)
     existence_at_birth: float = Field(0.5, gt=0, lt=1)
     existence_when_detected: float = Field(0.99, gt=0, lt=1)
     existence_to_delete: float = Field(0.1, gt=0, lt=1)
-    max_position_sigma_m: PositiveFloat = 2.0
-    confirmation_hits: int = Field(1, ge=1)
-    report_position_sigma_m: PositiveFloat = 1.0
+    max_position_sigma_m: Annotated[PositiveFloat, at_most(10_000, "metres")] = 2.0
+    confirmation_hits: Annotated[int, Field(ge=1), at_most(_MAX_FRAMES, "steps")] = 1
+    report_position_sigma_m: Annotated[PositiveFloat, at_most(10_000, "metres")] = 1.0
     association: Literal["hungarian", "cjpdaf"] = "hungarian"
-    clutter_density_per_px2: NonNegativeFloat = 0.0
+    clutter_density_per_px2: Annotated[NonNegativeFloat, at_most(1, "detections per pixel")] = 0.0
     measurement_source: Literal["detector", "spatiogram"] = "detector"
-    detector_every_steps: int = Field(5, ge=1)
+    detector_every_steps: Annotated[int, Field(ge=1), at_most(_MAX_FRAMES, "steps")] = 5
 
 
 class Control(_Strict):
     """Parameters of the information-gain policies (paper sections 4 and 4.4)."""
 
-    samples: int = Field(100, ge=1)
-    beta: NonNegativeFloat = 0.0
-    person_height_m: PositiveFloat = 1.75
-    exploration_cell_m: PositiveFloat = 1.0
+    samples: Annotated[int, Field(ge=1), at_most(10_000, "time: smpl scores every sample under every action")] = 100
+    beta: Annotated[NonNegativeFloat, at_most(1e6, "a weight")] = 0.0
+    person_height_m: _Height = 1.75
+    exploration_cell_m: Annotated[float, Field(ge=0.05), at_most(1000, "metres")] = 1.0
     prior_occupancy: float = Field(0.05, ge=0, lt=1)
-    arrival_rate_per_m2_s: NonNegativeFloat = 0.002
+    arrival_rate_per_m2_s: Annotated[NonNegativeFloat, at_most(10, "people per square metre and second")] = 0.002
+
+
+_VideoFrame = Annotated[int, Field(ge=0), at_most(10_000_000, "video frames: 4 days at 30 Hz")]
+
+
+_Polygon = Annotated[tuple[tuple[_Coordinate, _Coordinate], ...], at_most_items(1000, "corners of a polygon")]
 
 
 class Recording(_Strict):
@@ -280,12 +340,14 @@ class Recording(_Strict):
     calibration: str
     view: str = "View_001"
     video: str | None = None
-    recorded_size_px: tuple[Annotated[int, Field(gt=0)], Annotated[int, Field(gt=0)]] = (768, 576)
-    frame_step: int = Field(2, ge=1)
+    recorded_size_px: tuple[Pixels, Pixels] = (768, 576)
+    frame_step: Annotated[int, Field(ge=1), at_most(_MAX_FRAMES, "video frames")] = 2
     occluded_above: float = Field(0.25, ge=0, le=1)
-    frame_range: tuple[Annotated[int, Field(ge=0)], Annotated[int, Field(ge=0)]] | None = None
-    area_m: tuple[tuple[float, float], ...] | None = None
-    map_grid_px: int = Field(1, ge=1)
+    frame_range: tuple[_VideoFrame, _VideoFrame] | None = None
+    area_m: (
+        Annotated[tuple[tuple[_Coordinate, _Coordinate], ...], at_most_items(1000, "corners of a polygon")] | None
+    ) = None
+    map_grid_px: Annotated[int, Field(ge=1), at_most(64, "pixels between the sampling map's grid points")] = 1
 
     @model_validator(mode="after")
     def _range_and_area(self):
@@ -296,6 +358,8 @@ class Recording(_Strict):
         return self
 
 
+_FollowPixels = Annotated[NonNegativeFloat, at_most(8192, "pixels")]
+_PARTICLE_TIME = "time: every particle is scored on every patch each step"
 Fraction = Annotated[float, Field(gt=0, lt=1)]
 Patch = tuple[
     Annotated[float, Field(ge=0, le=1)],
@@ -337,32 +401,36 @@ class Follow(_Strict):
     """
 
     target_id: int | None = None
-    target_point_px: tuple[NonNegativeFloat, NonNegativeFloat] | None = None
-    target_height_px: PositiveFloat = 160.0
-    max_speed_deg_s: PositiveFloat = 30.0
-    max_acceleration_deg_s2: PositiveFloat = 30.0
-    max_zoom_speed: PositiveFloat = 0.7
-    max_zoom_acceleration: PositiveFloat = 0.7
-    zoom_range: tuple[Annotated[float, Field(ge=1)], Annotated[float, Field(ge=1)]] = (1.0, 4.0)
-    smoothing_cutoff_hz: PositiveFloat = 1.0
-    particles: int = Field(100, ge=1)
-    search_particles: int = Field(400, ge=2)
-    patches: tuple[Patch, ...] = ((0.3, 0.0, 0.4, 0.15), (0.15, 0.15, 0.7, 0.35), (0.2, 0.5, 0.6, 0.5))
+    target_point_px: tuple[_FollowPixels, _FollowPixels] | None = None
+    target_height_px: Annotated[PositiveFloat, at_most(8192, "pixels")] = 160.0
+    max_speed_deg_s: Annotated[PositiveFloat, at_most(1000, "degrees per second")] = 30.0
+    max_acceleration_deg_s2: Annotated[PositiveFloat, at_most(10_000, "degrees per second squared")] = 30.0
+    max_zoom_speed: Annotated[PositiveFloat, at_most(100, "per second")] = 0.7
+    max_zoom_acceleration: Annotated[PositiveFloat, at_most(1000, "per second squared")] = 0.7
+    zoom_range: tuple[_Zoom, _Zoom] = (1.0, 4.0)
+    smoothing_cutoff_hz: Annotated[PositiveFloat, at_most(1000, "hertz")] = 1.0
+    particles: Annotated[int, Field(ge=1), at_most(100_000, _PARTICLE_TIME)] = 100
+    search_particles: Annotated[int, Field(ge=2), at_most(100_000, _PARTICLE_TIME)] = 400
+    patches: Annotated[tuple[Patch, ...], at_most_items(100, _PARTICLE_TIME)] = (
+        (0.3, 0.0, 0.4, 0.15),
+        (0.15, 0.15, 0.7, 0.35),
+        (0.2, 0.5, 0.6, 0.5),
+    )
     histogram_bins: int = Field(10, ge=1, le=64)
     achromatic_bins: bool = False
-    samples_per_patch: int = Field(20, ge=1)
-    lambda_colour: PositiveFloat = 0.15
-    lambda_loss: PositiveFloat = 1.0
-    lambda_motion: PositiveFloat = 0.434
-    walk_heights_per_s: PositiveFloat = 1.0
-    scale_change_per_s: PositiveFloat = 0.2
+    samples_per_patch: Annotated[int, Field(ge=1), at_most(1000, _PARTICLE_TIME)] = 20
+    lambda_colour: Annotated[PositiveFloat, at_most(1e6, "a likelihood scale")] = 0.15
+    lambda_loss: Annotated[PositiveFloat, at_most(1e6, "a likelihood scale")] = 1.0
+    lambda_motion: Annotated[PositiveFloat, at_most(1e6, "a likelihood scale")] = 0.434
+    walk_heights_per_s: Annotated[PositiveFloat, at_most(1000, "box heights per second")] = 1.0
+    scale_change_per_s: Annotated[PositiveFloat, at_most(100, "per second")] = 0.2
     loss_fraction: Fraction = 0.1
     adapt_fraction: Fraction = 0.6
-    reference_time_constant_s: PositiveFloat = 2.0
-    search_heights: PositiveFloat = 1.0
-    search_scale: PositiveFloat = 0.2
-    motion_threshold: NonNegativeFloat = 15.0
-    motion_memory_s: PositiveFloat = 0.3
+    reference_time_constant_s: Annotated[PositiveFloat, at_most(86_400, "seconds")] = 2.0
+    search_heights: Annotated[PositiveFloat, at_most(1000, "box heights")] = 1.0
+    search_scale: Annotated[PositiveFloat, at_most(100, "a relative spread")] = 0.2
+    motion_threshold: Annotated[NonNegativeFloat, at_most(255, "grey levels")] = 15.0
+    motion_memory_s: Annotated[PositiveFloat, at_most(86_400, "seconds")] = 0.3
     motion_scale: Annotated[float, Field(gt=0, le=1)] = 0.5
 
     @model_validator(mode="after")
@@ -381,12 +449,17 @@ class Follow(_Strict):
         return self
 
 
+_Side = Annotated[PositiveFloat, at_most(1000, "metres: the ground a PTZ camera can cover")]
+
+
 class Scenario(_Strict):
     """Everything a run needs besides the policy and the seed."""
 
-    area_m: tuple[PositiveFloat, PositiveFloat] = (15.0, 15.0)
-    frames: int = Field(50, ge=1)
-    frame_rate_hz: PositiveFloat = 5.0
+    area_m: tuple[_Side, _Side] = (15.0, 15.0)
+    frames: Annotated[
+        int, Field(ge=1), at_most(_MAX_FRAMES, "memory: a run keeps every step's history, a few kB a step")
+    ] = 50
+    frame_rate_hz: Annotated[PositiveFloat, at_most(1000, "steps per second")] = 5.0
     people: People = People()
     camera: Camera = Camera()
     actions: Actions = Actions()
@@ -424,13 +497,13 @@ class Scenario(_Strict):
 
 def _first_error_line(error: pydantic.ValidationError, source: str) -> str:
     first = error.errors()[0]
-    field = ".".join(str(part) for part in first["loc"]) or "(top level)"
+    field = ".".join(str(part) for part in first["loc"])[:SHOWN_CHARACTERS] or "(top level)"
     message = first["msg"]
     if first["type"] == "extra_forbidden":
         message = "unknown key"
     elif first["type"] == "value_error":
         message = str(first["ctx"]["error"])
-    return f"{source}: {field}: {message} (got {first['input']!r})"
+    return f"{source}: {field}: {message} (got {shown(first['input'])})"
 
 
 def scenario_from_dict(data: dict, source: str = "scenario", **overrides) -> Scenario:
@@ -525,21 +598,88 @@ def pets_follow_scenario(tracker: str = "particle", **overrides) -> Scenario:
 def load_scenario(path: str | Path, **overrides) -> Scenario:
     """Read and validate a YAML scenario file (see the README for the format)."""
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as error:
-        raise ScenarioError(f"{path}: cannot read scenario file ({error.strerror})") from None
-    try:
-        data = yaml.safe_load(text)
-    except yaml.YAMLError as error:
-        mark = getattr(error, "problem_mark", None)
-        where = f" at line {mark.line + 1}" if mark else ""
-        raise ScenarioError(f"{path}: not valid YAML{where}") from None
-    data = {} if data is None else data
-    recording = data.get("recording") if isinstance(data, dict) else None
+    data = read_yaml(path, "scenario", ScenarioError)
+    if data is None:
+        data = {}
+    if not isinstance(data, dict):
+        raise ScenarioError(f"{path}: expected a mapping of scenario fields (got {type(data).__name__})")
+    recording = data.get("recording")
     if isinstance(recording, dict):
         data = {**data, "recording": {**recording, **_resolved_paths(recording, path.parent)}}
     return scenario_from_dict(data, str(path), **overrides)
+
+
+class _LimitedLoader(yaml.SafeLoader):
+    """YAML's safe loader, refusing duplicate keys (YAML forbids them; PyYAML keeps the last)."""
+
+    def construct_mapping(self, node, deep=False):
+        seen = set()
+        for key_node, _ in node.value:
+            key = self.construct_object(key_node, deep=deep)
+            if isinstance(key, Hashable) and key in seen:
+                raise _DuplicateKey(key, key_node.start_mark.line + 1)
+            seen.add(key)
+        return super().construct_mapping(node, deep=deep)
+
+
+class _DuplicateKey(Exception):
+    def __init__(self, key, line: int):
+        super().__init__(key, line)
+        self.key, self.line = key, line
+
+
+def _expanded_values(node: yaml.Node, limit: int) -> int:
+    """How many values ``node`` holds with every alias expanded, counting no further than past ``limit``.
+
+    An alias is the node it names, so a shared node is counted once per reference; the sizes are
+    memoised per node, which takes time linear in the document even when the expansion is exponential.
+    """
+    sizes: dict[int, int] = {}
+
+    def size(current: yaml.Node) -> int:
+        if id(current) in sizes:
+            return sizes[id(current)]
+        sizes[id(current)] = limit + 1  # a node reached again while being sized is a cycle
+        if isinstance(current, yaml.SequenceNode):
+            total = 1 + sum(size(child) for child in current.value)
+        elif isinstance(current, yaml.MappingNode):
+            total = 1 + sum(size(key) + size(value) for key, value in current.value)
+        else:
+            total = 1
+        sizes[id(current)] = min(total, limit + 1)
+        return sizes[id(current)]
+
+    return size(node)
+
+
+def read_yaml(path: str | Path, what: str, error_type: type[InputError]) -> object:
+    """A user's YAML file, read safely: at most 1 MB of UTF-8 and 100 000 values once aliases are
+    expanded, no duplicate keys; any problem is ``error_type`` naming the file and the line."""
+    path = Path(path)
+    text = read_text(path, what, SCENARIO_MAX_BYTES, error_type)
+    try:
+        loader = _LimitedLoader(text)
+    except yaml.YAMLError as error:  # characters YAML does not allow, found as the reader starts
+        raise error_type(f"{path}: not valid YAML ({shown(str(error).splitlines()[0])})") from None
+    try:
+        node = loader.get_single_node()
+        if node is None:
+            return None
+        if _expanded_values(node, YAML_MAX_VALUES) > YAML_MAX_VALUES:
+            raise error_type(
+                f"{path}: more than {YAML_MAX_VALUES} values once its aliases are expanded; expected a {what} file"
+            )
+        return loader.construct_document(node)
+    except _DuplicateKey as duplicate:
+        raise error_type(f"{path}: line {duplicate.line}: key {shown(duplicate.key)} appears twice") from None
+    except yaml.YAMLError as error:
+        mark = getattr(error, "problem_mark", None)
+        where = f" at line {mark.line + 1}" if mark else ""
+        raise error_type(f"{path}: not valid YAML{where}") from None
+    except RecursionError:
+        raise error_type(f"{path}: YAML nested too deeply for a {what} file") from None
+    finally:
+        loader.dispose()
 
 
 def _resolved_paths(recording: dict, base: Path) -> dict:

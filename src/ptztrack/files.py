@@ -1,8 +1,124 @@
-"""Writing files so that a reader never sees half of one."""
+"""Reading inputs with one-line errors, and writing outputs so that a reader never sees half of one.
 
+Every reader of a user's file raises an :class:`InputError` (or a subclass) whose message is one
+line naming the file, the field or position, and what was expected; a value is shown by
+:func:`shown`, at most about 80 characters of it.
+"""
+
+import json
+import math
 import os
+import shutil
 import tempfile
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
+from xml.etree.ElementTree import Element
+
+import defusedxml
+import defusedxml.ElementTree as ElementTree
+
+SHOWN_CHARACTERS = 80
+
+
+class InputError(ValueError):
+    """An input that cannot be used; the message is one line naming where and what was expected."""
+
+
+def shown(value: object) -> str:
+    """``repr(value)``, cut to about 80 characters so that an error stays one readable line.
+
+    The value's repr is built piecewise for long containers, so a huge value is never printed whole.
+    """
+    if isinstance(value, list | tuple) and len(value) > SHOWN_CHARACTERS:
+        text = repr(type(value)(value[:SHOWN_CHARACTERS]))
+    elif isinstance(value, str | bytes) and len(value) > SHOWN_CHARACTERS:
+        text = repr(value[:SHOWN_CHARACTERS])
+    elif isinstance(value, dict) and len(value) > SHOWN_CHARACTERS:
+        text = repr(dict(list(value.items())[:SHOWN_CHARACTERS]))
+    else:
+        text = repr(value)
+    return text if len(text) <= SHOWN_CHARACTERS else text[: SHOWN_CHARACTERS - 3] + "..."
+
+
+def read_bytes(path: str | Path, what: str, max_bytes: int, error_type: type[InputError] = InputError) -> bytes:
+    """The contents of a user's file of at most ``max_bytes``; ``error_type`` naming the file otherwise.
+
+    what : the kind of file, for the message ('ground-truth', 'calibration', ...).
+    """
+    path = Path(path)
+    try:
+        with open(path, "rb") as file:
+            data = file.read(max_bytes + 1)
+    except FileNotFoundError:
+        raise error_type(f"{path}: no such {what} file") from None
+    except IsADirectoryError:
+        raise error_type(f"{path}: is a folder, expected a {what} file") from None
+    except OSError as error:
+        raise error_type(f"{path}: cannot read the {what} file ({error.strerror or error})") from None
+    if len(data) > max_bytes:
+        raise error_type(f"{path}: larger than {max_bytes / 1e6:g} MB, too large for a {what} file")
+    return data
+
+
+def read_text(path: str | Path, what: str, max_bytes: int, error_type: type[InputError] = InputError) -> str:
+    """A user's UTF-8 text file of at most ``max_bytes`` (see :func:`read_bytes`)."""
+    data = read_bytes(path, what, max_bytes, error_type)
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as error:
+        line = data[: error.start].count(b"\n") + 1
+        raise error_type(
+            f"{path}: not UTF-8 text (byte 0x{data[error.start]:02x} on line {line}); expected a {what} file"
+        ) from None
+
+
+def read_json(path: str | Path, what: str, max_bytes: int, error_type: type[InputError] = InputError) -> object:
+    """A user's JSON file, strictly: NaN and Infinity, which JSON does not have, are errors."""
+
+    def refuse(constant: str):
+        raise error_type(f"{path}: {constant} is not a JSON number; expected a finite number")
+
+    try:
+        return json.loads(read_text(path, what, max_bytes, error_type), parse_constant=refuse)
+    except json.JSONDecodeError as error:
+        raise error_type(f"{path}: not valid JSON ({error.msg} at line {error.lineno})") from None
+    except RecursionError:
+        raise error_type(f"{path}: JSON nested too deeply for a {what} file") from None
+
+
+def read_xml_root(path: str | Path, what: str, max_bytes: int, error_type: type[InputError] = InputError) -> Element:
+    """The root element of a user's XML file, parsed by defusedxml: entities, external references and
+    DTDs that could read other files, reach the network or expand without bound are errors."""
+    data = read_bytes(path, what, max_bytes, error_type)
+    try:
+        return ElementTree.fromstring(data)
+    except (ElementTree.ParseError, LookupError, ValueError) as error:
+        # LookupError: an encoding Python does not know, declared in the XML header
+        raise error_type(f"{path}: not valid XML ({shown(str(error))})") from None
+    except defusedxml.DefusedXmlException as error:
+        raise error_type(f"{path}: XML with {type(error).__name__}; expected a plain {what} file") from None
+
+
+def strict_json(document: object) -> bytes:
+    """``document`` as JSON that strict readers accept: NaN and infinities become ``null``.
+
+    Numpy scalars and arrays become numbers and lists. Say why a value is undefined beside it
+    (see :func:`ptztrack.evaluate.metrics.with_undefined_noted`).
+    """
+    return (json.dumps(_finite_or_null(document), indent=2, sort_keys=False, allow_nan=False) + "\n").encode()
+
+
+def _finite_or_null(value: object) -> object:
+    if isinstance(value, dict):
+        return {key: _finite_or_null(item) for key, item in value.items()}
+    if isinstance(value, list | tuple):
+        return [_finite_or_null(item) for item in value]
+    if hasattr(value, "tolist"):
+        return _finite_or_null(value.tolist())
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    return value
 
 
 def write_atomically(path: Path, data: bytes) -> None:
@@ -17,3 +133,51 @@ def write_atomically(path: Path, data: bytes) -> None:
     except BaseException:
         os.unlink(temporary)
         raise
+
+
+def check_output_file(path: Path, option: str) -> None:
+    """Refuse, before any work, an output file that could not be written: ``option`` names it."""
+    path = Path(path)
+    if path.is_dir():
+        raise InputError(f"{option} {path}: is a folder, expected a file name")
+    _check_writable_folder(path.parent, option, path)
+
+
+def check_output_folder(path: Path, option: str, overwrite: bool) -> None:
+    """Refuse, before any work, a run folder that could not be written whole (see :func:`run_folder`)."""
+    path = Path(path)
+    if path.exists() and not path.is_dir():
+        raise InputError(f"{option} {path}: is a file, expected a folder")
+    if path.is_dir() and any(path.iterdir()) and not overwrite:
+        raise InputError(f"{option} {path}: the folder is not empty (add --overwrite to replace it)")
+    _check_writable_folder(path.absolute().parent, option, path)
+
+
+def _check_writable_folder(folder: Path, option: str, path: Path) -> None:
+    if folder.exists() and not folder.is_dir():
+        raise InputError(f"{option} {path}: {folder} is a file, not a folder")
+    if not folder.is_dir():
+        raise InputError(f"{option} {path}: the folder {folder} does not exist")
+    if not os.access(folder, os.W_OK | os.X_OK):
+        raise InputError(f"{option} {path}: cannot write into {folder}")
+
+
+@contextmanager
+def run_folder(path: Path, overwrite: bool = False) -> Iterator[Path]:
+    """A folder that appears whole or not at all: the block writes into a temporary folder beside
+    ``path``, renamed into place when the block ends without an exception (an old ``path`` is then
+    removed, if ``overwrite``); on any exception, Ctrl-C included, the temporary folder is removed."""
+    path = Path(path)
+    check_output_folder(path, "output folder", overwrite)
+    temporary = Path(tempfile.mkdtemp(dir=path.absolute().parent, prefix=f".{path.name}.", suffix=".tmp"))
+    try:
+        yield temporary
+        if path.exists():
+            retired = Path(tempfile.mkdtemp(dir=temporary.parent, prefix=f".{path.name}.", suffix=".old"))
+            os.replace(path, retired / path.name)
+            os.replace(temporary, path)
+            shutil.rmtree(retired)
+        else:
+            os.replace(temporary, path)
+    finally:
+        shutil.rmtree(temporary, ignore_errors=True)

@@ -156,7 +156,10 @@ def simulated_camera(scenario: Scenario, scene) -> SimulatedPTZ:
 def virtual_camera(scenario: Scenario, scene) -> RecordedPTZ:
     """The virtual PTZ camera over the scenario's recording (images only if it names a video)."""
     recording = scenario.required_recording("camera.backend 'virtual'")
-    video = None if recording.video is None else RecordedVideo(recording.video, recording.recorded_size_px)
+    frames_needed = int(scene.recording.video_frame.max()) + 1
+    video = (
+        None if recording.video is None else RecordedVideo(recording.video, recording.recorded_size_px, frames_needed)
+    )
     return RecordedPTZ(scene.virtual, scene.recording, video, live_view_model(scenario))
 
 

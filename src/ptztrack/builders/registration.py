@@ -99,5 +99,7 @@ def registered_pose_source(scenario: Scenario, video_frame: np.ndarray) -> Regis
     it registers the views of ``camera.live_view``."""
     recording = scenario.required_recording("registration")
     camera = registration_camera(scenario)
-    video = RecordedVideo(scenario.required_video("registration"), recording.recorded_size_px)
+    video = RecordedVideo(
+        scenario.required_video("registration"), recording.recorded_size_px, int(video_frame.max()) + 1
+    )
     return RegisteredPose(camera[0], reference_index(scenario, camera), video, video_frame, live_view_model(scenario))

@@ -78,7 +78,7 @@ def patrol_route(camera: PTZCamera, grid: ActionGrid, area_polygon_m, zoom_index
     Along pan and tilt the waypoints are spread evenly from the first to the
     last grid value, at most as many grid steps apart as fit in the field of
     view at that zoom, so consecutive views touch; waypoints whose view does
-    not meet the area are skipped. ``zoom_index`` defaults to the lower
+    not meet the area are skipped (all kept if none meets it). ``zoom_index`` defaults to the lower
     middle of the zoom range (2x of 1-4x: 8 waypoints on the default grid,
     where 3x would need 19 and see each person about once in 50 steps).
     Returns the flat action indices in visiting order.
@@ -98,7 +98,9 @@ def patrol_route(camera: PTZCamera, grid: ActionGrid, area_polygon_m, zoom_index
         ]
     )
     sees_area = area_coverage(camera, grid.poses[route], area_polygon_m) > 0
-    return route[sees_area]
+    # Where no waypoint sees a whole standing person in the area (a tiny image, an area out of reach),
+    # the route keeps every waypoint: patrolling something beats an empty route.
+    return route[sees_area] if sees_area.any() else route
 
 
 def _spread_indices(count: int, max_stride: int) -> np.ndarray:

@@ -6,13 +6,16 @@ cell order.
 """
 
 import logging
+import multiprocessing
 import os
+import signal
 import sys
 from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from contextlib import contextmanager
 
 EXECUTORS = ("local", "ray", "serial")
+_IGNORE_CTRL_C = (signal.SIGINT, signal.SIG_IGN)
 
 
 def run_cells(
@@ -39,11 +42,19 @@ def run_cells(
             rows[index] = run(cell)
             report(index + 1, len(cells))
     elif executor == "local":
-        with ProcessPoolExecutor(max_workers=workers or os.cpu_count()) as pool:
+        # Ctrl-C reaches the whole process group: the workers ignore it, and this process stops them.
+        pool = ProcessPoolExecutor(workers or os.cpu_count(), initializer=signal.signal, initargs=_IGNORE_CTRL_C)
+        try:
             futures = {pool.submit(run, cell): index for index, cell in enumerate(cells)}
             for done, future in enumerate(as_completed(futures), start=1):
                 rows[futures[future]] = future.result()
                 report(done, len(cells))
+        except BaseException:
+            pool.shutdown(wait=False, cancel_futures=True)
+            for worker in multiprocessing.active_children():
+                worker.terminate()
+            raise
+        pool.shutdown()
     else:
         rows = _run_on_ray(cells, report, run)
     return rows

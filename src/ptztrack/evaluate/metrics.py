@@ -21,6 +21,14 @@ DISPLAY = {
     "zoom": ("Zoom [x]", "{:.2f}"),
     "switches": ("ID switches", "{:.0f}"),
 }
+# Why a figure can have no value: written beside it (metrics.json's ``undefined``), since JSON has no NaN.
+UNDEFINED_BECAUSE = {
+    "mota": "no person was in view of the scene: MOTA divides by the number of person-instances",
+    "motp_m": "no track was matched to a person: MOTP is a mean over matches",
+    "idf1": "there was neither a person nor a track: IDF1 divides by their number",
+    "height_px": "no detection had a known height",
+    "zoom": "the episode has no steps",
+}
 
 
 def clear_metrics(truth_positions_m, track_ids, track_positions_m, gate_m: float = GATE_M) -> dict:
@@ -82,3 +90,13 @@ def episode_metrics(episode: Episode) -> dict:
     metrics["detections"] = int(sum(len(d) for d in episode.detections))
     metrics["zoom"] = float(np.mean(episode.poses[:, 2]))
     return metrics
+
+
+def with_undefined_noted(metrics: dict) -> dict:
+    """``metrics`` with ``undefined``: {figure: why} for every figure that has no value (NaN)."""
+    undefined = {
+        key: UNDEFINED_BECAUSE.get(key, "undefined")
+        for key, value in metrics.items()
+        if isinstance(value, float) and not np.isfinite(value)
+    }
+    return {**metrics, "undefined": undefined}

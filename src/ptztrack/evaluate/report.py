@@ -13,7 +13,6 @@
 
 import csv
 import io
-import json
 from pathlib import Path
 
 import matplotlib
@@ -21,8 +20,9 @@ import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.patches import Polygon
 
+from ptztrack.evaluate.metrics import with_undefined_noted
 from ptztrack.evaluate.video import RenderView, write_episode_video
-from ptztrack.files import write_atomically
+from ptztrack.files import strict_json, write_atomically
 from ptztrack.geometry.area import bounds_m
 from ptztrack.geometry.ptz import ground_footprint
 from ptztrack.loop import Episode
@@ -59,7 +59,8 @@ RUN_FILES = (
 
 
 def metrics_json(metrics: dict) -> bytes:
-    return (json.dumps(metrics, indent=2, sort_keys=True) + "\n").encode()
+    """Strict JSON: a figure without a value is null, and ``undefined`` says why."""
+    return strict_json(dict(sorted(with_undefined_noted(metrics).items())))
 
 
 def _csv(header, rows) -> bytes:

@@ -5,18 +5,21 @@ recorded image. A malformed file gets a :class:`CalibrationError` naming the
 file and what is wrong.
 """
 
-import json
 from dataclasses import dataclass
 from pathlib import Path
 
 import cv2
-import defusedxml.ElementTree as ElementTree
 import numpy as np
 
+from ptztrack.files import InputError, read_json, read_xml_root, shown
+
 NEWTON_STEPS = 20
+MAX_IMAGE_SIDE_PX = 8192
+CALIBRATION_MAX_BYTES = 10_000_000
+"""A calibration file's size limit: PETS's are 1-3 kB."""
 
 
-class CalibrationError(ValueError):
+class CalibrationError(InputError):
     """A calibration file that cannot be used; the message names the file and the problem."""
 
 
@@ -154,27 +157,32 @@ def _attributes(root, tag: str, names: tuple[str, ...], path: Path) -> dict[str,
         try:
             values[name] = float(text)
         except ValueError:
-            raise CalibrationError(f"{path}: <{tag} {name}={text!r}> is not a number") from None
+            values[name] = float("nan")
+        if not np.isfinite(values[name]):
+            raise CalibrationError(f"{path}: <{tag} {name}={shown(text)}> is not a finite number")
     return values
-
-
-def read_xml_root(path: Path, error_type: type[ValueError], what: str):
-    """The root element of an XML file (parsed safely), or ``error_type`` naming the file and the problem."""
-    try:
-        return ElementTree.parse(path).getroot()
-    except FileNotFoundError:
-        raise error_type(f"{path}: no such {what} file") from None
-    except ElementTree.ParseError as error:
-        raise error_type(f"{path}: not valid XML ({error})") from None
 
 
 def load_tsai(path: str | Path) -> TsaiCalibration:
     """Read a PETS 2009 Tsai calibration XML (``<Geometry>``, ``<Intrinsic>``, ``<Extrinsic>``)."""
     path = Path(path)
-    root = read_xml_root(path, CalibrationError, "calibration")
+    root = read_xml_root(path, "calibration", CALIBRATION_MAX_BYTES, CalibrationError)
     geometry = _attributes(root, "Geometry", ("width", "height", "dy", "dpx"), path)
     intrinsic = _attributes(root, "Intrinsic", ("focal", "kappa1", "cx", "cy", "sx"), path)
     extrinsic = _attributes(root, "Extrinsic", ("tx", "ty", "tz", "rx", "ry", "rz"), path)
+    for tag, values, positive in (
+        ("Geometry", geometry, ("width", "height", "dy", "dpx")),
+        ("Intrinsic", intrinsic, ("focal", "sx")),
+    ):
+        for name in positive:
+            if values[name] <= 0:
+                raise CalibrationError(f"{path}: <{tag} {name}={values[name]:g}> must be positive")
+    for name in ("width", "height"):
+        if geometry[name] != round(geometry[name]) or geometry[name] > MAX_IMAGE_SIDE_PX:
+            raise CalibrationError(
+                f"{path}: <Geometry {name}={geometry[name]:g}> must be a whole number of pixels, at most "
+                f"{MAX_IMAGE_SIDE_PX}"
+            )
     return TsaiCalibration(
         image_size_px=(int(geometry["width"]), int(geometry["height"])),
         dpx_mm=geometry["dpx"],
@@ -191,14 +199,9 @@ def load_tsai(path: str | Path) -> TsaiCalibration:
 def load_pinhole(path: str | Path, view: str = "View_001") -> PinholeCalibration:
     """Read one view of a pinhole calibration JSON (``{view: {K, dist, R, t}}``)."""
     path = Path(path)
-    try:
-        views = json.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise CalibrationError(f"{path}: no such calibration file") from None
-    except json.JSONDecodeError as error:
-        raise CalibrationError(f"{path}: not valid JSON ({error.msg} at line {error.lineno})") from None
+    views = read_json(path, "calibration", CALIBRATION_MAX_BYTES, CalibrationError)
     if not isinstance(views, dict) or view not in views:
-        raise CalibrationError(f"{path}: no view {view!r}")
+        raise CalibrationError(f"{path}: no view {shown(view)}")
     shapes = {"K": (3, 3), "dist": (5,), "R": (3, 3), "t": (3,)}
     arrays = {}
     for name, shape in shapes.items():
@@ -208,4 +211,11 @@ def load_pinhole(path: str | Path, view: str = "View_001") -> PinholeCalibration
             raise CalibrationError(f"{path}: {view}.{name} is missing or not numeric") from None
         if arrays[name].shape != shape:
             raise CalibrationError(f"{path}: {view}.{name} has shape {arrays[name].shape}, expected {shape}")
+        if not np.all(np.isfinite(arrays[name])):
+            raise CalibrationError(f"{path}: {view}.{name} has a NaN or infinite entry, expected finite numbers")
+    K, R = arrays["K"], arrays["R"]
+    if K[0, 0] <= 0 or K[1, 1] <= 0 or not np.allclose(K[2], [0, 0, 1]):
+        raise CalibrationError(f"{path}: {view}.K must have positive focal lengths and a last row [0, 0, 1]")
+    if not np.allclose(R @ R.T, np.eye(3), atol=1e-4) or np.linalg.det(R) < 0:
+        raise CalibrationError(f"{path}: {view}.R is not a rotation matrix (orthonormal, determinant 1)")
     return PinholeCalibration(**arrays)

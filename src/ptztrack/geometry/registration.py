@@ -35,6 +35,8 @@ is the composition of equation 1. The reading chosen:
 """
 
 import io
+import zipfile
+import zlib
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -44,7 +46,7 @@ import numpy as np
 from scipy.optimize import least_squares
 from scipy.sparse import lil_matrix
 
-from ptztrack.files import write_atomically
+from ptztrack.files import InputError, shown, write_atomically
 from ptztrack.geometry.lens import Lens, corner_radius2, pixel_directions, project_directions
 from ptztrack.geometry.ptz import PTZCamera, inside_image, intrinsics, rotation_world_to_camera
 
@@ -93,7 +95,7 @@ CORNER_DISTORTION_SIGMA = 0.03
 BUNDLE_POINTS_PER_PAIR = 40
 
 
-class RegistrationIndexError(ValueError):
+class RegistrationIndexError(InputError):
     """A reference index file that cannot be read; the message names the file."""
 
 
@@ -297,7 +299,7 @@ def load_index(path: str | Path) -> ReferenceIndex:
     :class:`RegistrationIndexError` naming it."""
     try:
         with np.load(path) as data:
-            return ReferenceIndex(
+            index = ReferenceIndex(
                 poses=data["poses"],
                 keypoints_px=data["keypoints_px"],
                 descriptors=data["descriptors"],
@@ -306,8 +308,24 @@ def load_index(path: str | Path) -> ReferenceIndex:
             )
     except FileNotFoundError:
         raise RegistrationIndexError(f"{path}: no such registration index") from None
-    except (KeyError, ValueError, OSError) as error:
-        raise RegistrationIndexError(f"{path}: not a registration index ({error})") from None
+    except (KeyError, ValueError, OSError, IndexError, TypeError, EOFError, zipfile.BadZipFile, zlib.error) as error:
+        raise RegistrationIndexError(f"{path}: not a registration index ({shown(str(error))})") from None
+    features = len(index.keypoints_px)
+    consistent = (
+        index.poses.ndim == 2
+        and index.poses.shape[1] == 3
+        and index.keypoints_px.shape == (features, 2)
+        and index.descriptors.shape == (features, 128)
+        and index.view.shape == (features,)
+        and np.issubdtype(index.view.dtype, np.integer)
+        and np.all((index.view >= 0) & (index.view < len(index.poses)))
+    )
+    finite = all(np.all(np.isfinite(array)) for array in (index.poses, index.keypoints_px, index.descriptors))
+    if not (consistent and finite and min(index.image_size_px) > 0):
+        raise RegistrationIndexError(
+            f"{path}: not a registration index (its arrays' shapes, view numbers or values are inconsistent)"
+        )
+    return index
 
 
 def focal_from_homography(H_reference_to_live: np.ndarray, reference_focal_px: float) -> float:

@@ -12,13 +12,15 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from ptztrack.geometry.calibration import read_xml_root
+from ptztrack.files import InputError, read_text, read_xml_root, shown
 from ptztrack.scene.synthetic import GroundTruth
 
 MOT_COLUMNS = 10
+GROUND_TRUTH_MAX_BYTES = 200_000_000
+"""An annotation file's size limit: 4 million MOTChallenge rows, far beyond any public benchmark."""
 
 
-class DatasetError(ValueError):
+class DatasetError(InputError):
     """A dataset file that cannot be used; the message names the file and the problem."""
 
 
@@ -46,59 +48,81 @@ class Annotations:
 
 
 def load_mot_ground_truth(path: str | Path) -> Annotations:
-    """Read MOTChallenge ground truth with world coordinates (frames from 1 become 0-based)."""
+    """Read MOTChallenge ground truth with world coordinates (frames from 1 become 0-based).
+
+    Frames and ids must be whole numbers, each (frame, id) appear once, and every number be finite.
+    """
     path = Path(path)
-    try:
-        lines = path.read_text(encoding="utf-8").splitlines()
-    except FileNotFoundError:
-        raise DatasetError(f"{path}: no such ground-truth file") from None
     rows = []
-    for number, line in enumerate(lines, start=1):
+    for number, line in enumerate(
+        read_text(path, "ground-truth", GROUND_TRUTH_MAX_BYTES, DatasetError).splitlines(), 1
+    ):
         if not line.strip():
             continue
         fields = line.split(",")
         if len(fields) != MOT_COLUMNS:
             raise DatasetError(f"{path}: line {number} has {len(fields)} fields, expected {MOT_COLUMNS}")
         try:
-            rows.append([float(field) for field in fields])
+            values = [float(field) for field in fields]
         except ValueError:
             raise DatasetError(f"{path}: line {number} has a field that is not a number") from None
+        if not all(np.isfinite(values)):
+            raise DatasetError(f"{path}: line {number} has a NaN or infinite field, expected finite numbers")
+        if values[0] != round(values[0]) or values[1] != round(values[1]):
+            raise DatasetError(
+                f"{path}: line {number}: frame and id must be whole numbers "
+                f"(got {shown(fields[0])}, {shown(fields[1])})"
+            )
+        if values[0] < 1:
+            raise DatasetError(
+                f"{path}: line {number}: frame {shown(fields[0])}; frames are numbered from 1 in MOTChallenge files"
+            )
+        rows.append(values)
     if not rows:
         raise DatasetError(f"{path}: no ground-truth rows")
     table = np.asarray(rows)
-    if np.any(table[:, 0] < 1):
-        raise DatasetError(f"{path}: frames are numbered from 1 in MOTChallenge files")
-    return Annotations(
-        frame=table[:, 0].astype(int) - 1,
-        person_id=table[:, 1].astype(int),
-        box_px=table[:, 2:6],
-        ground_m=table[:, 7:9],
-    )
+    frame, person_id = table[:, 0].astype(np.int64), table[:, 1].astype(np.int64)
+    _refuse_repeated_annotations(path, frame, person_id)
+    return Annotations(frame=frame - 1, person_id=person_id, box_px=table[:, 2:6], ground_m=table[:, 7:9])
+
+
+def _refuse_repeated_annotations(path: Path, frame: np.ndarray, person_id: np.ndarray) -> None:
+    """A DatasetError if a person is annotated twice in a frame (numbered as in the file)."""
+    pairs, counts = np.unique(np.c_[frame, person_id], axis=0, return_counts=True)
+    if np.any(counts > 1):
+        repeated_frame, repeated_id = pairs[np.argmax(counts > 1)]
+        raise DatasetError(
+            f"{path}: person {repeated_id} is annotated {counts.max()} times in frame {repeated_frame}, expected once"
+        )
 
 
 def load_cvml(path: str | Path) -> Annotations:
     """Read CVML XML boxes (``<frame number><objectlist><object id><box h w xc yc>``)."""
     path = Path(path)
-    root = read_xml_root(path, DatasetError, "annotation")
+    root = read_xml_root(path, "annotation", GROUND_TRUTH_MAX_BYTES, DatasetError)
     rows = []
-    for frame in root.iter("frame"):
-        for person in frame.iter("object"):
+    for frame_element in root.iter("frame"):
+        for person in frame_element.iter("object"):
             box = person.find("box")
             try:
-                values = [float(box.get(name)) for name in ("xc", "yc", "w", "h")]
-                rows.append([int(frame.get("number")), int(person.get("id")), *values])
-            except (AttributeError, TypeError, ValueError):
+                values = [float(box.get(name, "")) for name in ("xc", "yc", "w", "h")]  # type: ignore[union-attr]
+                rows.append([int(frame_element.get("number", "")), int(person.get("id", "")), *values])
+            except (AttributeError, ValueError):
                 raise DatasetError(
-                    f"{path}: frame {frame.get('number')!r} object {person.get('id')!r} needs "
+                    f"{path}: frame {shown(frame_element.get('number'))} object {shown(person.get('id'))} needs "
                     "integer number and id and a <box> with numeric xc, yc, w, h"
                 ) from None
     if not rows:
         raise DatasetError(f"{path}: no annotated objects")
     table = np.asarray(rows)
+    if not np.all(np.isfinite(table)) or np.any(table[:, 0] < 0):
+        raise DatasetError(f"{path}: a frame number below 0 or a NaN or infinite box; expected finite boxes")
+    frame, person_id = table[:, 0].astype(np.int64), table[:, 1].astype(np.int64)
+    _refuse_repeated_annotations(path, frame, person_id)
     centre, size = table[:, 2:4], table[:, 4:6]
     return Annotations(
-        frame=table[:, 0].astype(int),
-        person_id=table[:, 1].astype(int),
+        frame=frame,
+        person_id=person_id,
         box_px=np.concatenate([centre - size / 2, size], axis=1),
         ground_m=np.full((len(table), 2), np.nan),
     )
@@ -186,12 +210,20 @@ class RecordedVideo:
     an earlier frame reopens the video.
     """
 
-    def __init__(self, path: str | Path, expected_size_px=None):
+    def __init__(self, path: str | Path, expected_size_px=None, frames_needed: int | None = None):
+        """Checks at once that the video is one OpenCV reads, of ``expected_size_px`` (width, height),
+        with at least ``frames_needed`` frames (by its header), so that a run fails before its first step."""
         self.path = Path(path)
         if not self.path.is_file():
             raise DatasetError(f"{self.path}: no such video file")
         self.expected_size_px = expected_size_px
         self._open()
+        if not self._capture.isOpened():
+            raise DatasetError(f"{self.path}: not a video OpenCV can read")
+        self.frame(0)
+        frame_count = int(self._capture.get(cv2.CAP_PROP_FRAME_COUNT))
+        if frames_needed is not None and frame_count < frames_needed:
+            raise DatasetError(f"{self.path}: {frame_count} frames, the run needs {frames_needed}")
 
     def _open(self) -> None:
         self._capture = cv2.VideoCapture(str(self.path))
@@ -211,7 +243,7 @@ class RecordedVideo:
             self._next += 1
         ok, image = self._capture.read()
         if not ok:
-            raise DatasetError(f"{self.path}: the video ends before frame {index}")
+            raise DatasetError(f"{self.path}: no frame {index}: the video ends or cannot be decoded there")
         self._next += 1
         if self.expected_size_px is not None and tuple(image.shape[1::-1]) != tuple(self.expected_size_px):
             raise DatasetError(

@@ -1,0 +1,72 @@
+"""What a run will need in memory, estimated from its scenario before it starts, and a refusal when
+the machine does not have it.
+
+The terms are the arrays that grow with the scenario's sizes, with coefficients measured on this
+code (peak resident memory of ``run_episode`` at growing sizes, 2 steps unless said):
+
+* the interpreter and libraries: 280 MB (a 2-step synthetic run of ``fix``);
+* the history of a run: 105 kB a step (2000 steps of ``fix``: 490 MB);
+* the simulated detector's occlusion, each person measured in the view centred on them: 4 N^5
+  bytes for N people (30 people: +85 MB, 45: +720 MB);
+* ``smpl``'s occlusion, once per sample: 4 M N^4 bytes for M samples;
+* the exploration map (``control.beta`` > 0): 160 bytes per action and cell (a 300 m square at
+  1 m cells and 280 actions: 4.1 GB; 600 m: 15.7 GB);
+* a view and its upsampled copy for HOG: 12 bytes per pixel, times the upsampling squared.
+"""
+
+import math
+
+import psutil
+
+from ptztrack.config import Scenario, ScenarioError
+
+INTERPRETER_BYTES = 280e6
+HISTORY_BYTES_PER_STEP = 105e3
+EXPLORATION_BYTES_PER_ACTION_CELL = 160.0
+IMAGE_BYTES_PER_PIXEL = 12.0
+# The ground of a recording is known only once its calibration is read: a 100 m square bounds
+# what one camera's view covers in the recordings we know (PETS's View_001 sees about 40 x 30 m).
+RECORDING_AREA_M2 = 100.0 * 100.0
+RECORDING_PEOPLE = 20
+"""More than PETS 2009 S2.L1 ever shows in one frame (its crowd peaks at 8 annotated people)."""
+INFORMATION_POLICIES = ("intg", "smpl")
+
+
+def estimated_memory_bytes(scenario: Scenario, policies: tuple[str, ...]) -> dict[str, float]:
+    """The estimated peak memory of one episode of ``scenario`` under the worst of ``policies``, by term."""
+    # A recording's people are its annotations', not yet read: tracks of up to RECORDING_PEOPLE at once.
+    people = scenario.people.count if scenario.recording is None else RECORDING_PEOPLE
+    actions = scenario.actions.pan_deg.count * scenario.actions.tilt_deg.count * len(scenario.actions.zoom)
+    terms = {
+        "interpreter": INTERPRETER_BYTES,
+        "history": HISTORY_BYTES_PER_STEP * scenario.frames,
+        "detector occlusion": 4.0 * people**5 if scenario.recording is None else 0.0,
+    }
+    if "smpl" in policies:
+        terms["smpl occlusion"] = 4.0 * scenario.control.samples * people**4
+    if scenario.control.beta > 0 and set(policies) & set(INFORMATION_POLICIES):
+        area_m2 = scenario.area_m[0] * scenario.area_m[1] if scenario.recording is None else RECORDING_AREA_M2
+        cells = math.ceil(area_m2 / scenario.control.exploration_cell_m**2)
+        terms["exploration map"] = EXPLORATION_BYTES_PER_ACTION_CELL * actions * cells
+    width_px, height_px = scenario.camera.image_size_px
+    upsample = scenario.detector.hog_upsample if scenario.detector.kind == "hog" else 1.0
+    terms["views"] = IMAGE_BYTES_PER_PIXEL * width_px * height_px * (1.0 + upsample**2)
+    return terms
+
+
+def refuse_if_too_large(
+    scenario: Scenario, policies: tuple[str, ...], runs_at_once: int = 1, available_bytes: float | None = None
+) -> None:
+    """A :class:`ScenarioError` before any work if ``runs_at_once`` episodes would need more memory than
+    is available (``available_bytes``, by default what the machine has free now)."""
+    terms = estimated_memory_bytes(scenario, policies)
+    needed = runs_at_once * sum(terms.values())
+    available = psutil.virtual_memory().available if available_bytes is None else available_bytes
+    if needed > available:
+        largest = max(terms, key=lambda name: terms[name])
+        at_once = f" x {runs_at_once} runs at once" if runs_at_once > 1 else ""
+        raise ScenarioError(
+            f"scenario: a run needs an estimated {needed / 1e9:.3g} GB{at_once} (most of it {largest}, "
+            f"{terms[largest] / 1e9:.3g} GB), more than the {available / 1e9:.3g} GB available; "
+            "make the scene, the action grid or control.samples smaller"
+        )

@@ -1,0 +1,221 @@
+"""A regression corpus of bad and near-miss inputs to the ``ptztrack`` command.
+
+Each case is the files it needs (written into a scratch directory), the command line
+(``{dir}`` is the scratch directory, ``{data}`` the built-in PETS folder) and the exit status
+expected: 2 for a clean one-line error, 0 where the input is legitimate.
+Used by tests/test_bad_inputs.py and benchmarks/bad_inputs.py.
+"""
+
+import os
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+from dataclasses import dataclass, field
+from importlib import resources
+from pathlib import Path
+
+import cv2
+import numpy as np
+
+PETS = resources.files("ptztrack.data") / "pets2009_s2l1"
+PINHOLE = (PETS / "pinhole.json").read_text()
+TSAI = (PETS / "View_001.xml").read_text()
+GROUND_TRUTH_ROWS = (PETS / "gt_mot15.txt").read_text().splitlines()[:40]
+A_FEW_STEPS = ["--frames", "2"]
+
+
+@dataclass(frozen=True)
+class Case:
+    name: str
+    argv: tuple[str, ...]
+    files: dict[str, bytes | str] = field(default_factory=dict)
+    exit_status: int = 2
+
+
+def _scenario(name: str, text: str | bytes, *extra: str, exit_status: int = 2) -> Case:
+    """A scenario file run for a few steps, unless it sets ``frames`` itself."""
+    steps = () if isinstance(text, str) and text.startswith("frames") else A_FEW_STEPS
+    return Case(name, ("run", "--scenario", "{dir}/s.yaml", *steps, *extra), {"s.yaml": text}, exit_status)
+
+
+def _recording(name: str, option: str, filename: str, content: bytes | str, *extra: str) -> Case:
+    argv = ("run", "--scenario", "pets", *A_FEW_STEPS, option, f"{{dir}}/{filename}", *extra)
+    return Case(name, argv, {filename: content})
+
+
+def _ground_truth(rows: list[str]) -> str:
+    return "\n".join(rows) + "\n"
+
+
+def _with_field(row: str, index: int, value: str) -> str:
+    fields = row.split(",")
+    fields[index] = value
+    return ",".join(fields)
+
+
+def _xml_with_entity(declaration: str, reference: str) -> str:
+    body = TSAI.split("\n", 1)[1].replace('name="View_001"', f'name="{reference}"')
+    return f'<?xml version="1.0"?>\n<!DOCTYPE Camera [{declaration}]>\n{body}'
+
+
+def video_bytes(frames: int, size_px: tuple[int, int], directory: Path | None) -> bytes:
+    """A small MJPG AVI of ``frames`` grey frames of ``size_px`` (width, height); made in
+    ``directory``, or in a temporary one."""
+    if directory is None:
+        with tempfile.TemporaryDirectory() as scratch:
+            return video_bytes(frames, size_px, Path(scratch))
+    path = directory / f"video_{frames}_{size_px[0]}.avi"
+    writer = cv2.VideoWriter(str(path), cv2.VideoWriter_fourcc(*"MJPG"), 7.0, size_px)
+    for _ in range(frames):
+        writer.write(np.full((size_px[1], size_px[0], 3), 128, np.uint8))
+    writer.release()
+    return path.read_bytes()
+
+
+YAML_LAUGHS = "a: &a [x, x, x, x, x, x, x, x, x]\n" + "".join(
+    f"{chr(98 + level)}: &{chr(98 + level)} [{', '.join(['*' + chr(97 + level)] * 9)}]\n" for level in range(8)
+)
+YAML_DEEP_LAUGHS = (
+    "a: &a ["
+    + ", ".join(["xxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxx"] * 20)
+    + "]\n"
+    + "".join(
+        f"{chr(98 + level)}: &{chr(98 + level)} [{', '.join(['*' + chr(97 + level)] * 20)}]\n" for level in range(6)
+    )
+)
+XML_LAUGHS = '<!ENTITY a "aaaaaaaaaa">' + "".join(
+    f'<!ENTITY {chr(98 + level)} "{("&" + chr(97 + level) + ";") * 10}">' for level in range(8)
+)
+
+
+def cases(scratch: Path | None) -> list[Case]:
+    """Every case; ``scratch`` is where video files are made (None: a temporary folder)."""
+    truth = GROUND_TRUTH_ROWS
+    return [
+        _scenario("binary scenario", b"\x89PNG\r\n\x1a\n\xff\xfe\x00\x01" * 40),
+        _recording("binary ground truth", "--gt", "gt.txt", b"\xff\xfe\x00\x81" * 100),
+        _scenario("people.count 1e20", "people: {count: 1e20}\n"),
+        _scenario("people.count 1e6", "people: {count: 1000000}\n"),
+        _scenario("frames 1e9", "frames: 1000000000\n"),
+        _scenario("frames 1e13", "frames: 1e13\n"),
+        _scenario("control.samples 1e9", "control: {samples: 1000000000}\n"),
+        _scenario("image_size_px 1e8", "camera: {image_size_px: [100000000, 100000000]}\n"),
+        _scenario("area_m 1e308", "area_m: [1e308, 1e308]\n"),
+        _scenario("area_m inf", "area_m: [.inf, 15]\n"),
+        Case("--seed -5", ("run", *A_FEW_STEPS, "--seed", "-5")),
+        _recording(
+            "XML external entity",
+            "--calibration",
+            "c.xml",
+            _xml_with_entity('<!ENTITY e SYSTEM "file:///etc/passwd">', "&e;"),
+        ),
+        _recording(
+            "XML entity over HTTP",
+            "--calibration",
+            "c.xml",
+            _xml_with_entity('<!ENTITY e SYSTEM "http://127.0.0.1:9/e">', "&e;"),
+        ),
+        _recording("XML entity bomb", "--calibration", "c.xml", _xml_with_entity(XML_LAUGHS, "&i;")),
+        _recording("Tsai focal nan", "--calibration", "c.xml", TSAI.replace('focal="5.5549183034e+00"', 'focal="nan"')),
+        _recording(
+            "ground truth NaN position", "--gt", "gt.txt", _ground_truth([_with_field(truth[0], 7, "nan"), *truth[1:]])
+        ),
+        _recording(
+            "ground truth inf position", "--gt", "gt.txt", _ground_truth([_with_field(truth[0], 8, "inf"), *truth[1:]])
+        ),
+        _scenario("YAML billion laughs", YAML_LAUGHS),
+        _scenario("YAML deeper anchor bomb", YAML_DEEP_LAUGHS),
+        _recording("pinhole fx NaN", "--calibration", "c.json", PINHOLE.replace("1125.8236906695045", "NaN")),
+        _recording(
+            "pinhole K all NaN",
+            "--calibration",
+            "c.json",
+            '{"View_001": {"K": [[NaN, NaN, NaN], [NaN, NaN, NaN], [NaN, NaN, NaN]], '
+            '"dist": [0, 0, 0, 0, 0], "R": [[1, 0, 0], [0, 1, 0], [0, 0, 1]], "t": [0, 0, 0]}}',
+        ),
+        _scenario("pixel_noise_px inf", "detector: {pixel_noise_px: .inf}\n"),
+        Case("--beta nan", ("experiment", "pets", "--beta", "nan", *A_FEW_STEPS)),
+        Case("--beta -3", ("experiment", "pets", "--beta", "-3", *A_FEW_STEPS)),
+        Case("--beta inf", ("experiment", "pets", "--beta", "inf", *A_FEW_STEPS)),
+        _scenario("duplicate YAML keys", "frames: 5\npeople: {count: 3}\nframes: 6\n"),
+        _recording("duplicate ground-truth rows", "--gt", "gt.txt", _ground_truth([truth[0], *truth])),
+        _recording(
+            "fractional ground-truth frame", "--gt", "gt.txt", _ground_truth([_with_field(truth[0], 0, "1.5"), *truth])
+        ),
+        _recording("a text file as the video", "--video", "text.avi", "not a video\n"),
+        _recording(
+            "a video too short for HOG",
+            "--video",
+            "short.avi",
+            video_bytes(3, (768, 576), scratch),
+            "--detector",
+            "hog",
+            "--frames",
+            "10",
+        ),
+        _recording(
+            "a video of the wrong size",
+            "--video",
+            "small.avi",
+            video_bytes(3, (320, 240), scratch),
+            "--detector",
+            "hog",
+        ),
+        Case("--out names a file", ("run", *A_FEW_STEPS, "--out", "{dir}/file"), {"file": "keep me\n"}),
+        Case("--out in a missing folder", ("run", *A_FEW_STEPS, "--out", "{dir}/missing/out")),
+        Case("--out not empty", ("run", *A_FEW_STEPS, "--out", "{dir}/out"), {"out/metrics.json": "{}\n"}),
+        Case(
+            "--json in a missing folder",
+            ("experiment", "synthetic", "--sequences", "1", *A_FEW_STEPS, "--json", "{dir}/missing/x.json"),
+        ),
+        Case("--json names a folder", ("experiment", "synthetic", "--sequences", "1", *A_FEW_STEPS, "--json", "{dir}")),
+        Case("--plot in a missing folder", ("experiment", "msg", "--runs", "1", "--plot", "{dir}/missing/x.png")),
+        Case("--trails in a missing folder", ("experiment", "msg", "--runs", "1", "--trails", "{dir}/missing/x.png")),
+        Case("scenario missing", ("run", "--scenario", "{dir}/missing.yaml")),
+        _scenario("scenario a list", "- 1\n- 2\n"),
+        _scenario("scenario a huge value", "frames: [" + ", ".join(["123456789"] * 20000) + "]\n"),
+        _scenario("scenario empty", "", exit_status=0),
+        _scenario("negative frame rate", "frame_rate_hz: -5\n"),
+        _scenario("NaN frame rate", "frame_rate_hz: .nan\n"),
+        _scenario("bad pose error", "camera: {pose_error: {pan_tilt_sigma_deg: .inf}}\n"),
+        _recording("ground truth empty", "--gt", "gt.txt", ""),
+        _recording("ground truth negative frame", "--gt", "gt.txt", _ground_truth([_with_field(truth[0], 0, "-3")])),
+        _recording("calibration empty", "--calibration", "c.json", ""),
+        _recording("calibration binary", "--calibration", "c.xml", b"\x00\xff" * 50),
+    ]
+
+
+@dataclass(frozen=True)
+class Outcome:
+    exit_status: int
+    stderr: str
+    seconds: float
+    peak_memory_mb: float
+
+
+def run_case(case: Case, directory: Path, timeout_s: float = 60.0) -> Outcome:
+    """Write the case's files into ``directory`` and run the command in a fresh process, measuring its
+    wall time and peak resident memory."""
+    for name, content in case.files.items():
+        path = directory / name
+        path.parent.mkdir(parents=True, exist_ok=True)
+        if isinstance(content, bytes):
+            path.write_bytes(content)
+        else:
+            path.write_text(content)
+    argv = [part.replace("{dir}", str(directory)) for part in case.argv]
+    with tempfile.TemporaryFile("w+") as stderr:
+        start = time.perf_counter()
+        process = subprocess.Popen(
+            [sys.executable, "-m", "ptztrack.cli", *argv], stdout=subprocess.DEVNULL, stderr=stderr
+        )
+        timer = threading.Timer(timeout_s, process.kill)
+        timer.start()
+        _, status, usage = os.wait4(process.pid, 0)
+        timer.cancel()
+        seconds = time.perf_counter() - start
+        process.returncode = os.waitstatus_to_exitcode(status)
+        stderr.seek(0)
+        return Outcome(process.returncode, stderr.read(), seconds, usage.ru_maxrss / 1024)

@@ -1,0 +1,232 @@
+"""Fuzzing every reader: generated scenario documents, valid and near-valid, and mutations of every
+file format. Whatever the input, the result is a value or one clean :class:`InputError` line,
+never another exception. Derandomised, so that a run is repeatable; the examples per test are in
+``EXAMPLES``.
+"""
+
+import math
+import re
+from importlib import resources
+from pathlib import Path
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from bad_inputs import video_bytes
+from ptztrack.builders.budget import refuse_if_too_large
+from ptztrack.builders.episode import run_episode
+from ptztrack.config import Scenario, ScenarioError, load_scenario, scenario_from_dict
+from ptztrack.files import InputError
+from ptztrack.geometry.calibration import load_calibration
+from ptztrack.geometry.registration import ReferenceIndex, load_index, save_index
+from ptztrack.scene.pets import RecordedVideo, load_cvml, load_mot_ground_truth
+
+EXAMPLES = 200
+RUN_EXAMPLES = 20
+"""Valid small scenarios run for a few steps each: fewer examples, each a closed-loop episode."""
+FUZZ = settings(
+    max_examples=EXAMPLES,
+    derandomize=True,
+    deadline=None,
+    suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow],
+)
+PETS = resources.files("ptztrack.data") / "pets2009_s2l1"
+EXAMPLE_SCENARIO = Path(__file__).parents[1] / "examples" / "scenario.yaml"
+
+# Values a user might write by mistake: near the edges of every range, and of the wrong kind.
+NEAR_MISSES = st.one_of(
+    st.sampled_from([0, -1, 1, 2, 0.5, -0.0, 1e308, -1e308, 10**20, math.nan, math.inf, -math.inf]),
+    st.sampled_from(["", "abc", "1e3", "nan", None, True, [], {}, [1], [1, 2, 3], {"a": 1}]),
+    st.integers(-(10**12), 10**12),
+    st.floats(allow_nan=True, allow_infinity=True),
+    st.lists(st.floats(-1e3, 1e3), max_size=4),
+)
+
+
+def _fields(model) -> dict:
+    """{field: sub-model or None} of a pydantic model class, for generating documents like it."""
+    fields = {}
+    for name, info in model.model_fields.items():
+        annotation = info.annotation
+        fields[name] = annotation if isinstance(annotation, type) and hasattr(annotation, "model_fields") else None
+    return fields
+
+
+def documents(model=Scenario, depth: int = 0) -> st.SearchStrategy:
+    """Mappings of some of ``model``'s fields (nested sections as mappings) to near-miss values,
+    plus now and then an unknown key."""
+    fields = _fields(model)
+
+    def value(name):
+        section = fields[name]
+        if section is not None and depth < 2:
+            return st.one_of(documents(section, depth + 1), NEAR_MISSES)
+        return NEAR_MISSES
+
+    keys = st.sampled_from([*fields, "unknown_key"])
+    return st.dictionaries(keys, st.none(), max_size=4).flatmap(
+        lambda chosen: st.fixed_dictionaries({key: value(key) if key in fields else NEAR_MISSES for key in chosen})
+    )
+
+
+def one_clean_line(error: InputError) -> None:
+    message = str(error)
+    assert "\n" not in message and len(message) <= 300, message
+
+
+@FUZZ
+@given(documents())
+def test_a_scenario_document_is_a_scenario_or_one_clean_error(document):
+    try:
+        scenario = scenario_from_dict(document, "fuzz")
+    except ScenarioError as error:
+        one_clean_line(error)
+        return
+    try:
+        refuse_if_too_large(scenario, ("fix", "intg", "smpl"), available_bytes=64e9)
+    except ScenarioError as error:
+        one_clean_line(error)
+
+
+SMALL_VALID = st.fixed_dictionaries(
+    {
+        "frames": st.integers(1, 3),
+        "area_m": st.tuples(st.floats(1.0, 60.0), st.floats(1.0, 60.0)),
+        "people": st.fixed_dictionaries(
+            {"count": st.integers(0, 9), "speed_m_s": st.just((0.5, 2.0)), "enter_leave": st.booleans()}
+        ),
+        "camera": st.fixed_dictionaries(
+            {"image_size_px": st.tuples(st.integers(16, 320), st.integers(16, 240)), "f_min_px": st.floats(20, 2000)}
+        ),
+        "control": st.fixed_dictionaries({"samples": st.integers(1, 30), "beta": st.floats(0, 10)}),
+        "detector": st.fixed_dictionaries(
+            {"kind": st.sampled_from(["ideal", "realistic"]), "false_positives_per_frame": st.floats(0, 3)}
+        ),
+    }
+)
+
+
+@settings(FUZZ, max_examples=RUN_EXAMPLES)
+@given(SMALL_VALID, st.sampled_from(["fix", "patrol", "random", "intg", "smpl"]))
+def test_a_valid_small_scenario_runs(document, policy):
+    episode = run_episode(scenario_from_dict(document, "fuzz"), policy, 0)
+    assert len(episode.actions) == document["frames"]
+
+
+def mutations(original: bytes) -> st.SearchStrategy:
+    """``original`` with one or a few edits: a number replaced by a near miss, a byte range replaced
+    by random bytes, a span deleted, or a line repeated."""
+    numbers = [match.span() for match in re.finditer(rb"-?\d+(\.\d+)?(e[-+]?\d+)?", original)]
+    tokens = st.sampled_from([b"nan", b"inf", b"-inf", b"-1", b"0", b"1e400", b"", b"x", b"1.5", b"99999999999"])
+
+    @st.composite
+    def edit(draw, data: bytes) -> bytes:
+        kind = draw(st.sampled_from(["number", "bytes", "delete", "repeat"]))
+        if kind == "number" and numbers:
+            start, stop = draw(st.sampled_from(numbers))
+            return data[:start] + draw(tokens) + data[stop:]
+        start = draw(st.integers(0, len(data)))
+        stop = draw(st.integers(start, min(len(data), start + 64)))
+        if kind == "bytes":
+            return data[:start] + draw(st.binary(max_size=16)) + data[stop:]
+        if kind == "delete":
+            return data[:start] + data[stop:]
+        lines = data.splitlines(keepends=True)
+        index = draw(st.integers(0, max(0, len(lines) - 1)))
+        return b"".join(lines[: index + 1] + lines[index:])
+
+    return edit(original)
+
+
+def _read_mutated(tmp_path: Path, name: str, data: bytes, reader) -> None:
+    path = tmp_path / name
+    path.write_bytes(data)
+    try:
+        reader(path)
+    except InputError as error:
+        one_clean_line(error)
+
+
+@FUZZ
+@given(data=mutations(EXAMPLE_SCENARIO.read_bytes()))
+def test_a_mutated_scenario_file_is_read_or_refused_in_one_line(tmp_path, data):
+    _read_mutated(tmp_path, "scenario.yaml", data, load_scenario)
+
+
+GROUND_TRUTH_HEAD = b"".join((PETS / "gt_mot15.txt").read_bytes().splitlines(keepends=True)[:30])
+
+
+@FUZZ
+@given(data=mutations(GROUND_TRUTH_HEAD))
+def test_a_mutated_ground_truth_is_read_or_refused_in_one_line(tmp_path, data):
+    _read_mutated(tmp_path, "gt.txt", data, load_mot_ground_truth)
+
+
+CVML = b"""<?xml version="1.0"?>
+<dataset><frame number="0"><objectlist>
+<object id="1"><box h="80.5" w="30.25" xc="100.0" yc="200.0"/></object>
+<object id="2"><box h="70" w="28" xc="300" yc="220"/></object>
+</objectlist></frame><frame number="1"><objectlist>
+<object id="1"><box h="81" w="30" xc="102" yc="201"/></object>
+</objectlist></frame></dataset>
+"""
+
+
+@FUZZ
+@given(data=mutations(CVML))
+def test_mutated_cvml_annotations_are_read_or_refused_in_one_line(tmp_path, data):
+    _read_mutated(tmp_path, "annotations.xml", data, load_cvml)
+
+
+@FUZZ
+@given(data=mutations((PETS / "View_001.xml").read_bytes()))
+def test_a_mutated_tsai_calibration_is_read_or_refused_in_one_line(tmp_path, data):
+    _read_mutated(tmp_path, "calibration.xml", data, load_calibration)
+
+
+@FUZZ
+@given(data=mutations((PETS / "pinhole.json").read_bytes()))
+def test_a_mutated_pinhole_calibration_is_read_or_refused_in_one_line(tmp_path, data):
+    _read_mutated(tmp_path, "calibration.json", data, load_calibration)
+
+
+def _small_index_bytes(tmp_path: Path) -> bytes:
+    rng = np.random.default_rng(0)
+    index = ReferenceIndex(
+        poses=rng.uniform(-10, 10, (3, 3)),
+        keypoints_px=rng.uniform(0, 100, (12, 2)),
+        descriptors=rng.random((12, 128)).astype(np.float32),
+        view=np.repeat(np.arange(3), 4),
+        image_size_px=(160, 120),
+    )
+    save_index(tmp_path / "index.npz", index)
+    return (tmp_path / "index.npz").read_bytes()
+
+
+@pytest.fixture(scope="module")
+def index_bytes(tmp_path_factory):
+    return _small_index_bytes(tmp_path_factory.mktemp("index"))
+
+
+@FUZZ
+@given(data=st.data())
+def test_a_mutated_registration_index_is_read_or_refused_in_one_line(tmp_path, index_bytes, data):
+    _read_mutated(tmp_path, "index.npz", data.draw(mutations(index_bytes)), load_index)
+
+
+@pytest.fixture(scope="module")
+def small_video_bytes():
+    return video_bytes(4, (64, 48), None)
+
+
+@FUZZ
+@given(data=st.data())
+def test_a_mutated_video_is_read_or_refused_in_one_line(tmp_path, small_video_bytes, data):
+    def read(path):
+        video = RecordedVideo(path, (64, 48), frames_needed=4)
+        for frame in range(4):
+            assert video.frame(frame).shape == (48, 64, 3)
+
+    _read_mutated(tmp_path, "video.avi", data.draw(mutations(small_video_bytes)), read)
