@@ -20,7 +20,6 @@ for variable in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ[variable] = "1"  # before NumPy loads its BLAS
 
 import argparse  # noqa: E402
-import json  # noqa: E402
 import time  # noqa: E402
 from pathlib import Path  # noqa: E402
 
@@ -30,7 +29,7 @@ import numpy as np  # noqa: E402
 from ptztrack.builders.follow import initial_box, target_scenario, target_source  # noqa: E402
 from ptztrack.builders.follow_experiment import FollowCell, follow_run  # noqa: E402
 from ptztrack.config import pets_follow_scenario  # noqa: E402
-from ptztrack.files import write_atomically  # noqa: E402
+from ptztrack.files import strict_json, write_atomically  # noqa: E402
 from ptztrack.geometry.ptz import rotation_homography  # noqa: E402
 from ptztrack.track.target import box_corners_carried  # noqa: E402
 
@@ -73,7 +72,10 @@ def best_rates(scenario, tracker: str, views, homographies, first_box, repeats: 
         # A step searches when the step before it ended lost.
         searching = [np.r_[False, lost[:-1]] for _, lost in runs]
         rates["tracking"] = max((~s).sum() / t[~s].sum() for (t, _), s in zip(runs, searching, strict=True))
-        rates["searching"] = max(s.sum() / t[s].sum() for (t, _), s in zip(runs, searching, strict=True) if s.any())
+        # None when no run lost the person (no step searched).
+        rates["searching"] = max(
+            (s.sum() / t[s].sum() for (t, _), s in zip(runs, searching, strict=True) if s.any()), default=None
+        )
         rates["tracking_steps"] = int((~searching[0]).sum())
     return rates
 
@@ -106,7 +108,7 @@ def main() -> None:
     for name, value in results.items():
         print(f"{name:>18}  {value:.1f}" if isinstance(value, float) else f"{name:>18}  {value}")
     if args.json is not None:
-        write_atomically(args.json, (json.dumps(results, indent=2) + "\n").encode())
+        write_atomically(args.json, strict_json(results))
 
 
 if __name__ == "__main__":
