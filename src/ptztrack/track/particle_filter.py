@@ -56,15 +56,7 @@ from typing import NamedTuple
 import numpy as np
 
 from ptztrack.geometry.ptz import apply_homography
-from ptztrack.track.colour_model import (
-    bhattacharyya_distance,
-    bin_count,
-    box_of_states,
-    colour_bins,
-    colour_log_likelihood,
-    patch_boxes,
-    patch_histograms,
-)
+from ptztrack.track import colour_model
 from ptztrack.track.motion_image import MotionImage, first_motion_image, next_motion_image, non_motion_fraction
 
 # A box is never smaller than this many pixels high: the random walk would otherwise shrink one
@@ -139,7 +131,7 @@ class ParticleFilter:
 
     def box_px(self) -> np.ndarray:
         """(4,) (left, top, width, height) of the estimate."""
-        return box_of_states(self.estimate, self.aspect)
+        return colour_model.box_of_states(self.estimate, self.aspect)
 
     def centre_covariance_px2(self) -> np.ndarray:
         """(2, 2) px^2: the weighted covariance of the particles' box centres."""
@@ -170,10 +162,10 @@ def start_filter(image_bgr, box_px, parameters: ParticleFilterParameters) -> Par
     """
     left, top, width, height = (float(value) for value in box_px)
     state = np.array([left + width / 2, top + height / 2, height])
-    bins = colour_bins(image_bgr, parameters.bins, parameters.achromatic)
-    patches = patch_boxes(np.asarray(box_px, dtype=float), parameters.patches)
-    total_bins = bin_count(parameters.bins, parameters.achromatic)
-    reference = patch_histograms(bins, patches, total_bins, REFERENCE_OVERSAMPLING * parameters.samples)
+    bins = colour_model.colour_bins(image_bgr, parameters.bins, parameters.achromatic)
+    patches = colour_model.patch_boxes(np.asarray(box_px, dtype=float), parameters.patches)
+    total_bins = colour_model.bin_count(parameters.bins, parameters.achromatic)
+    reference = colour_model.patch_histograms(bins, patches, total_bins, REFERENCE_OVERSAMPLING * parameters.samples)
     return ParticleFilter(
         particles=np.tile(state, (parameters.particles, 1)),
         weights=np.full(parameters.particles, 1.0 / parameters.particles),
@@ -268,27 +260,34 @@ class _ColourRegion(NamedTuple):
 
     @classmethod
     def of(cls, image_bgr, states, aspect: float, parameters) -> "_ColourRegion":
-        boxes = patch_boxes(box_of_states(states, aspect), parameters.patches)
+        boxes = colour_model.patch_boxes(colour_model.box_of_states(states, aspect), parameters.patches)
         image_height, image_width = image_bgr.shape[:2]
         low = np.floor(boxes[..., :2].min(axis=(0, 1)))
         high = np.ceil((boxes[..., :2] + boxes[..., 2:]).max(axis=(0, 1)))
         (col0, row0), (col1, row1) = (np.clip(c, 0, [image_width, image_height]).astype(int) for c in (low, high))
         region = image_bgr[row0 : max(row0, row1), col0 : max(col0, col1)]
-        bins = colour_bins(region, parameters.bins, parameters.achromatic) if region.size else np.zeros((0, 0), int)
+        bins = (
+            colour_model.colour_bins(region, parameters.bins, parameters.achromatic)
+            if region.size
+            else np.zeros((0, 0), int)
+        )
         return cls(bins, np.array([col0, row0]))
 
     def log_likelihood(self, states, reference, aspect: float, parameters) -> np.ndarray:
         """Log colour likelihoods (n,) of states (n, 3) whose patches lie within the region."""
-        boxes = patch_boxes(box_of_states(states, aspect), parameters.patches) - [*self.origin, 0, 0]
-        total_bins = bin_count(parameters.bins, parameters.achromatic)
+        boxes = colour_model.box_of_states(states, aspect)
+        boxes = colour_model.patch_boxes(boxes, parameters.patches) - [*self.origin, 0, 0]
+        total_bins = colour_model.bin_count(parameters.bins, parameters.achromatic)
         if self.bins.size:
-            histograms = patch_histograms(self.bins, boxes, total_bins, parameters.samples)
+            histograms = colour_model.patch_histograms(self.bins, boxes, total_bins, parameters.samples)
         else:
             histograms = np.zeros(boxes.shape[:-1] + (total_bins,))
-        return colour_log_likelihood(bhattacharyya_distance(reference, histograms), parameters.lambda_colour)
+        return colour_model.colour_log_likelihood(
+            colour_model.bhattacharyya_distance(reference, histograms), parameters.lambda_colour
+        )
 
 
 def _motion_log_likelihood(motion: MotionImage, states, aspect: float, parameters) -> np.ndarray:
     """Log of equation 4, ``-E^2 / lambda_mot``, (n,) for states (n, 3)."""
-    boxes = patch_boxes(box_of_states(states, aspect), parameters.patches)
+    boxes = colour_model.patch_boxes(colour_model.box_of_states(states, aspect), parameters.patches)
     return -(non_motion_fraction(motion, boxes) ** 2) / parameters.lambda_motion
