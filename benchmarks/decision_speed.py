@@ -24,7 +24,6 @@ import os
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 
 import argparse  # noqa: E402  (the thread count must be set before NumPy loads)
-import json  # noqa: E402
 import sys  # noqa: E402
 import time  # noqa: E402
 from pathlib import Path  # noqa: E402
@@ -34,6 +33,7 @@ import numpy as np  # noqa: E402
 from ptztrack.builders.episode import make_policy, run_episode  # noqa: E402
 from ptztrack.builders.world import action_grid, build_world  # noqa: E402
 from ptztrack.config import scenario_from_dict  # noqa: E402
+from ptztrack.files import write_json  # noqa: E402
 from ptztrack.types import Tracks  # noqa: E402
 
 SIZES = {
@@ -112,17 +112,14 @@ def main() -> None:
         figures[size] = {"intg": rates["intg"], "smpl": rates["smpl"], "stonesoup_ratio": ratios["intg"]}
     if args.json:
         main_size = figures["7x280"]
-        args.json.write_text(
-            json.dumps(
-                {
-                    "intg_decisions_per_s": main_size["intg"],
-                    "smpl_decisions_per_s": main_size["smpl"],
-                    "stonesoup_ratio": main_size["stonesoup_ratio"],
-                    "sizes": figures,
-                },
-                indent=2,
-            )
-            + "\n"
+        write_json(
+            args.json,
+            {
+                "intg_decisions_per_s": main_size["intg"],
+                "smpl_decisions_per_s": main_size["smpl"],
+                "stonesoup_ratio": main_size["stonesoup_ratio"],
+                "sizes": figures,
+            },
         )
 
 

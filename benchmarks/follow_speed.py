@@ -29,7 +29,7 @@ import numpy as np  # noqa: E402
 from ptztrack.builders.follow import initial_box, target_scenario, target_source  # noqa: E402
 from ptztrack.builders.follow_experiment import FollowCell, follow_run  # noqa: E402
 from ptztrack.config import pets_follow_scenario  # noqa: E402
-from ptztrack.files import strict_json, write_atomically  # noqa: E402
+from ptztrack.files import write_json  # noqa: E402
 from ptztrack.geometry.ptz import rotation_homography  # noqa: E402
 from ptztrack.track.target import box_corners_carried  # noqa: E402
 
@@ -108,7 +108,7 @@ def main() -> None:
     for name, value in results.items():
         print(f"{name:>18}  {value:.1f}" if isinstance(value, float) else f"{name:>18}  {value}")
     if args.json is not None:
-        write_atomically(args.json, strict_json(results))
+        write_json(args.json, results)
 
 
 if __name__ == "__main__":

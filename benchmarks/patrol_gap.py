@@ -20,7 +20,6 @@ this changes a default; it only says which difference matters.
 """
 
 import argparse
-import json
 from pathlib import Path
 
 import numpy as np
@@ -29,6 +28,7 @@ from ptztrack.builders.episode import run_episode
 from ptztrack.config import scenario_from_dict
 from ptztrack.evaluate.executors import run_cells
 from ptztrack.evaluate.metrics import clear_metrics
+from ptztrack.files import write_json
 from ptztrack.geometry.ptz import inside_image, person_in_view, project_people
 from ptztrack.track.tracker import predicted_feet_px
 
@@ -101,7 +101,7 @@ def main() -> None:
             line += f"{100 * mota:>9.1f} / {100 * in_view:4.1f}"
         print(line)
     if args.json:
-        args.json.write_text(json.dumps(table, indent=2) + "\n")
+        write_json(args.json, table)
 
 
 if __name__ == "__main__":

@@ -12,7 +12,6 @@ halved, low-contrast detection.
 """
 
 import argparse
-import json
 import time
 from pathlib import Path
 
@@ -24,7 +23,7 @@ from ptztrack.builders.registration import live_view_model, reference_index, reg
 from ptztrack.builders.world import action_grid
 from ptztrack.camera.live_view import render_view
 from ptztrack.config import pets_scenario
-from ptztrack.files import write_atomically
+from ptztrack.files import write_json
 from ptztrack.geometry.registration import LIVE_FEATURES, register, sift_features, within_view_ratio_matches
 from ptztrack.scene.pets import RecordedVideo
 
@@ -98,7 +97,7 @@ def main() -> None:
             "matching_ms_median": matching,
             "full_size_sift_ms_median": full_size_sift,
         }
-        write_atomically(args.json, (json.dumps(figures, indent=2) + "\n").encode())
+        write_json(args.json, figures)
 
 
 if __name__ == "__main__":

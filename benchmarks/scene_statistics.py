@@ -13,11 +13,11 @@ mounting and crowd were chosen with them (see the README).
 """
 
 import argparse
-import json
 from pathlib import Path
 
 from ptztrack.builders.experiments import scene_statistics
 from ptztrack.config import load_scenario, scenario_from_dict
+from ptztrack.files import write_json
 
 
 def main() -> None:
@@ -35,7 +35,7 @@ def main() -> None:
         f"{figures['hidden_fraction']:.1%} hidden by nearer people, {figures['out_of_view_fraction']:.1%} out of view"
     )
     if args.json:
-        args.json.write_text(json.dumps(figures, indent=2) + "\n")
+        write_json(args.json, figures)
 
 
 if __name__ == "__main__":

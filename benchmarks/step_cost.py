@@ -41,7 +41,6 @@ for _variable in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", 
     os.environ[_variable] = "1"
 
 import argparse  # noqa: E402  (the thread counts must be set before NumPy, Numba and OpenCV load)
-import json  # noqa: E402
 import time  # noqa: E402
 from functools import partial  # noqa: E402
 from pathlib import Path  # noqa: E402
@@ -53,6 +52,7 @@ from ptztrack.builders.episode import make_policy, make_tracker  # noqa: E402
 from ptztrack.builders.world import build_world  # noqa: E402
 from ptztrack.config import pets_scenario  # noqa: E402
 from ptztrack.detect.hog import HogPeopleDetector, feet_and_height_px  # noqa: E402
+from ptztrack.files import write_json  # noqa: E402
 from ptztrack.loop import episode_seeds  # noqa: E402
 from ptztrack.types import DecisionContext, Detections  # noqa: E402
 
@@ -163,7 +163,7 @@ def main() -> None:
     if busy:
         print(f"warning: CPU time below 95 % of the wall time for {', '.join(busy)}: the machine was busy")
     if args.json:
-        args.json.write_text(json.dumps(rows, indent=2) + "\n")
+        write_json(args.json, rows)
 
 
 if __name__ == "__main__":

@@ -71,7 +71,7 @@ from ptztrack.evaluate.registration import summarise_registration
 from ptztrack.evaluate.report import RUN_FILES, write_figure, write_outputs
 from ptztrack.evaluate.tables import format_table, paired_difference, summarise
 from ptztrack.evaluate.video import view_renderer
-from ptztrack.files import InputError, check_output_file, check_output_folder, run_folder, strict_json, write_atomically
+from ptztrack.files import InputError, check_output_file, check_output_folder, run_folder, write_json
 from ptztrack.scene.roads import walk_roads
 
 RUN_FIGURES = ("mota", "motp_m", "idf1", "height_px", "detections", "zoom", "switches")
@@ -148,7 +148,7 @@ def msg_experiment_command(args: argparse.Namespace) -> int:
     print(format_paired_differences(rows))
     written = []
     if args.json is not None:
-        write_atomically(args.json, strict_json(rows))
+        write_json(args.json, rows)
         written.append(args.json)
     if args.plot is not None:
         write_figure(args.plot, ambiguity_figure(rows))
@@ -223,7 +223,7 @@ def registration_experiment_command(args: argparse.Namespace) -> int:
         )
     if args.json is not None:
         document = {**summary, "live_view_model": settings, "closed_loop": closed_loop, "views_detail": views}
-        write_atomically(args.json, strict_json(document))
+        write_json(args.json, document)
         print(f"wrote {args.json}")
     return 0
 
@@ -299,7 +299,7 @@ def _run_table(
         paired = f"paired over {count} sequences, standard error"
         print(f"smpl - intg: {100 * mean:+.1f} +- {100 * error:.1f} MOTA points ({paired})")
     if args.json is not None:
-        write_atomically(args.json, strict_json(summary))
+        write_json(args.json, summary)
         print(f"wrote {args.json}")
     return 0
 
@@ -356,7 +356,7 @@ def follow_experiment_command(args: argparse.Namespace) -> int:
     print(format_follow_table(otb, OTB_FIGURES, f"\nOne-pass (OTB) on the still recording, people {tracks}:"))
     if args.json is not None:
         document = {"closed_loop": closed_loop, "otb": otb, "people": people, "otb_people": otb_people}
-        write_atomically(args.json, strict_json(document))
+        write_json(args.json, document)
         print(f"wrote {args.json}")
     return 0
 

@@ -121,6 +121,11 @@ def _finite_or_null(value: object) -> object:
     return value
 
 
+def write_json(path: str | Path, document: object) -> None:
+    """``document`` as strict JSON (:func:`strict_json`), written atomically (:func:`write_atomically`)."""
+    write_atomically(Path(path), strict_json(document))
+
+
 def write_atomically(path: Path, data: bytes) -> None:
     """Write ``data`` to ``path`` through a temporary file and a rename, so that
     a reader never sees a half-written file and an old file survives a failure."""
