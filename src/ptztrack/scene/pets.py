@@ -6,6 +6,7 @@ and CVML XML with pixel boxes (``<frame number>`` from 0). Any problem gets a
 :class:`DatasetError` naming the file and what is wrong.
 """
 
+import gzip
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -47,11 +48,27 @@ class Annotations:
 
 def load_mot_ground_truth(path: str | Path) -> Annotations:
     """Read MOTChallenge ground truth with world coordinates (frames from 1 become 0-based)."""
+    table = read_mot_rows(path, "ground-truth")
+    return Annotations(
+        frame=table[:, 0].astype(int) - 1,
+        person_id=table[:, 1].astype(int),
+        box_px=table[:, 2:6],
+        ground_m=table[:, 7:9],
+    )
+
+
+def read_mot_rows(path: str | Path, what: str) -> np.ndarray:
+    """The rows (K, 10) of a MOTChallenge file (ground truth or detections; ``.gz`` compressed or not),
+    checked: ten numeric fields a line, frames from 1. ``what`` names the kind of file in errors."""
     path = Path(path)
     try:
-        lines = path.read_text(encoding="utf-8").splitlines()
+        data = path.read_bytes()
     except FileNotFoundError:
-        raise DatasetError(f"{path}: no such ground-truth file") from None
+        raise DatasetError(f"{path}: no such {what} file") from None
+    try:
+        lines = (gzip.decompress(data) if path.suffix == ".gz" else data).decode("utf-8").splitlines()
+    except (OSError, UnicodeDecodeError):
+        raise DatasetError(f"{path}: not a text file (or not gzip-compressed text)") from None
     rows = []
     for number, line in enumerate(lines, start=1):
         if not line.strip():
@@ -64,16 +81,11 @@ def load_mot_ground_truth(path: str | Path) -> Annotations:
         except ValueError:
             raise DatasetError(f"{path}: line {number} has a field that is not a number") from None
     if not rows:
-        raise DatasetError(f"{path}: no ground-truth rows")
+        raise DatasetError(f"{path}: no {what} rows")
     table = np.asarray(rows)
     if np.any(table[:, 0] < 1):
         raise DatasetError(f"{path}: frames are numbered from 1 in MOTChallenge files")
-    return Annotations(
-        frame=table[:, 0].astype(int) - 1,
-        person_id=table[:, 1].astype(int),
-        box_px=table[:, 2:6],
-        ground_m=table[:, 7:9],
-    )
+    return table
 
 
 def load_cvml(path: str | Path) -> Annotations:
