@@ -225,15 +225,15 @@ class Modes:
 def map_modes(pom, grid: GroundGrid, separation_m: float, window_m: float, min_strength: float) -> Modes:
     """The modes of ``pom`` (rows, columns) at least ``min_strength`` times its largest value.
 
-    A mode is a cell that holds the largest value within ``separation_m`` (a square neighbourhood
-    of that side: two people stand no closer). Its position and covariance are the mean and
+    A mode is a cell that holds the largest value within ``separation_m`` of it (in a square
+    neighbourhood reaching that far each way: two people stand no closer). Its position and covariance are the mean and
     covariance of the map over the disc of radius ``window_m`` around it (sub-cell position; the
     covariance is the measurement noise the tracker gets), with at least a cell's uniform variance.
     """
     peak = pom.max(initial=0.0)
     if peak <= 0:
         return Modes.empty()
-    size = max(1, int(round(separation_m / grid.cell_m)) | 1)
+    size = 2 * int(round(separation_m / grid.cell_m)) + 1
     is_mode = (pom == ndimage.maximum_filter(pom, size=size, mode="constant")) & (pom >= min_strength * peak)
     rows, columns = np.nonzero(is_mode)
     reach = int(np.ceil(window_m / grid.cell_m))

@@ -47,7 +47,7 @@ def detection_metrics(truth_m, detections_m, radius_m: float = MATCH_RADIUS_M) -
     """MODA, MODP, precision, recall and the mean error of matched detections over frames.
 
     truth_m : (T, N, 2) m, NaN where absent; detections_m : per frame, (K_t, 2) m.
-    Also returns the counts: ``matches``, ``false_positives``, ``misses``, ``people``.
+    Also returns the counts: ``matches``, ``false_positives``, ``misses``, ``objects`` (people to find).
     """
     distances, false_positives, misses = [], 0, 0
     for truth, found in zip(truth_m, detections_m, strict=True):
@@ -60,18 +60,18 @@ def detection_metrics(truth_m, detections_m, radius_m: float = MATCH_RADIUS_M) -
         false_positives += len(found) - len(matched)
         misses += len(truth) - len(matched)
     matched_m = np.concatenate(distances) if distances else np.zeros(0)
-    people = len(matched_m) + misses
+    objects = len(matched_m) + misses
     found = len(matched_m) + false_positives
     return {
-        "moda": 1 - (false_positives + misses) / people if people else float("nan"),
+        "moda": 1 - (false_positives + misses) / objects if objects else float("nan"),
         "modp": float(np.mean(1 - matched_m / radius_m)) if len(matched_m) else float("nan"),
         "precision": len(matched_m) / found if found else float("nan"),
-        "recall": len(matched_m) / people if people else float("nan"),
+        "recall": len(matched_m) / objects if objects else float("nan"),
         "error_m": float(np.mean(matched_m)) if len(matched_m) else float("nan"),
         "matches": len(matched_m),
         "false_positives": false_positives,
         "misses": misses,
-        "people": people,
+        "objects": objects,
     }
 
 
@@ -163,6 +163,7 @@ class OccupancyRun:
     """One recording's experiment: the rows (one per method), what each frame kept, the tracks."""
 
     rows: list[dict]
+    frame_rate_hz: float
     grid: GroundGrid
     frames: Frames
     lpom: list[Modes]
@@ -214,4 +215,4 @@ def score_recording(
             "fitted_min_views": [int(value) for value in min_views],
         },
     ]
-    return OccupancyRun(rows, grid, frames, lpom, clustering, tracks, truth_m)
+    return OccupancyRun(rows, recording.frame_rate_hz, grid, frames, lpom, clustering, tracks, truth_m)

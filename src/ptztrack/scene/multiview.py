@@ -31,14 +31,15 @@ class CameraView:
     """One fixed calibrated camera of a recording.
 
     name : how the view is called; calibration : its pinhole model (world in mm);
-    image_size_px : (width, height); frames : its images, or None where there is no video;
+    image_size_px : (width, height), None where nothing needs it (a view with boxes only and a
+    calibration that does not say); frames : its images, or None where there is no video;
     boxes : per frame, a detector's boxes (K, 5) as (left, top, width, height, score) px, or None;
     weight : its weight ``w_c`` in the occupancy map.
     """
 
     name: str
     calibration: PinholeCalibration
-    image_size_px: tuple[int, int]
+    image_size_px: tuple[int, int] | None
     frames: FrameSource | None
     boxes: list[np.ndarray] | None
     weight: float = 1.0
@@ -61,11 +62,12 @@ class MultiViewRecording:
     truth: GroundTruth | None
 
 
-def load_mot_detections(path: str | Path, frames: int) -> list[np.ndarray]:
+def load_mot_detections(path: str | Path) -> list[np.ndarray]:
     """A MOTChallenge detection file (``frame,-1,left,top,width,height,score,...``, frames from 1)
-    as per-frame boxes (K, 5) ``(left, top, width, height, score)`` for frames 0 .. frames - 1."""
+    as per-frame boxes (K, 5) ``(left, top, width, height, score)``, from frame 0 to the file's last."""
     table = read_mot_rows(path, "detection")
     frame = table[:, 0].astype(int) - 1
+    frames = frame.max() + 1
     if np.any((table[:, 4] <= 0) | (table[:, 5] <= 0)):
         raise DatasetError(f"{path}: a box has a width or height that is not positive")
     order = np.argsort(frame, kind="stable")
@@ -75,16 +77,17 @@ def load_mot_detections(path: str | Path, frames: int) -> list[np.ndarray]:
 
 
 class ImageFolder:
-    """The images of a folder as frames, in the order of their sorted file names (``frame(index)``)."""
+    """The images of a folder as frames, in the order of their sorted file names (``frame(index)``),
+    each checked to be ``expected_size_px`` (width, height) when given."""
 
-    def __init__(self, path: str | Path, expected_size_px):
+    def __init__(self, path: str | Path, expected_size_px: tuple[int, int] | None = None):
         self.path = Path(path)
         if not self.path.is_dir():
             raise DatasetError(f"{self.path}: no such image folder")
         self.files = sorted(file for file in self.path.iterdir() if file.suffix.lower() in IMAGE_SUFFIXES)
         if not self.files:
             raise DatasetError(f"{self.path}: no images ({', '.join(IMAGE_SUFFIXES)})")
-        self.expected_size_px = tuple(expected_size_px)
+        self.expected_size_px = expected_size_px
 
     def __len__(self) -> int:
         return len(self.files)
@@ -93,7 +96,7 @@ class ImageFolder:
         image = cv2.imread(str(self.files[index]), cv2.IMREAD_COLOR)
         if image is None:
             raise DatasetError(f"{self.files[index]}: OpenCV cannot read this image")
-        if image.shape[1::-1] != self.expected_size_px:
+        if self.expected_size_px is not None and image.shape[1::-1] != tuple(self.expected_size_px):
             raise DatasetError(
                 f"{self.files[index]}: {image.shape[1]}x{image.shape[0]} px, expected "
                 f"{self.expected_size_px[0]}x{self.expected_size_px[1]} (the calibration's image size)"
