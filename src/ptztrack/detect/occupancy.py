@@ -225,21 +225,19 @@ class Modes:
 def map_modes(pom, grid: GroundGrid, separation_m: float, window_m: float, min_strength: float) -> Modes:
     """The modes of ``pom`` (rows, columns) at least ``min_strength`` times its largest value.
 
-    A mode is a cell that holds the largest value within ``separation_m`` of it (in a square
-    neighbourhood reaching that far each way: two people stand no closer). Its position and covariance are the mean and
+    A mode is a cell that holds the largest value within ``separation_m`` of it (two people stand
+    no closer). Its position and covariance are the mean and
     covariance of the map over the disc of radius ``window_m`` around it (sub-cell position; the
     covariance is the measurement noise the tracker gets), with at least a cell's uniform variance.
     """
     peak = pom.max(initial=0.0)
     if peak <= 0:
         return Modes.empty()
-    size = 2 * int(round(separation_m / grid.cell_m)) + 1
-    is_mode = (pom == ndimage.maximum_filter(pom, size=size, mode="constant")) & (pom >= min_strength * peak)
-    rows, columns = np.nonzero(is_mode)
-    reach = int(np.ceil(window_m / grid.cell_m))
-    d_row, d_column = np.mgrid[-reach : reach + 1, -reach : reach + 1]
-    in_disc = np.hypot(d_row, d_column) * grid.cell_m <= window_m
-    d_row, d_column = d_row[in_disc], d_column[in_disc]
+    neighbourhood = _disc(separation_m, grid.cell_m)
+    largest = ndimage.maximum_filter(pom, footprint=neighbourhood, mode="constant")
+    rows, columns = np.nonzero((pom == largest) & (pom >= min_strength * peak))
+    d_row, d_column = np.nonzero(_disc(window_m, grid.cell_m))
+    d_row, d_column = d_row - d_row.max() // 2, d_column - d_column.max() // 2
     window_rows, window_columns = rows[:, None] + d_row, columns[:, None] + d_column
     on_grid = (
         (window_rows >= 0) & (window_rows < pom.shape[0]) & (window_columns >= 0) & (window_columns < pom.shape[1])
@@ -253,3 +251,10 @@ def map_modes(pom, grid: GroundGrid, separation_m: float, window_m: float, min_s
     offset_m = points_m - mean_m[:, None, :]
     covariance_m2 = np.einsum("kw,kwd,kwe->kde", mass, offset_m, offset_m) + grid.cell_m**2 / 12 * np.eye(2)
     return Modes(mean_m, covariance_m2, pom[rows, columns] / peak)
+
+
+def _disc(radius_m: float, cell_m: float) -> np.ndarray:
+    """(2r + 1, 2r + 1) bool: the cells whose centres lie within ``radius_m`` of the middle one."""
+    reach = int(np.floor(radius_m / cell_m))
+    d_row, d_column = np.mgrid[-reach : reach + 1, -reach : reach + 1]
+    return np.hypot(d_row, d_column) * cell_m <= radius_m
