@@ -31,7 +31,9 @@ def test_the_locus_of_a_sphere_is_the_papers_ellipse(height_m, radius_m, elevati
     points = sphere_locus(height_m, radius_m, a)
     x0, y0 = points[:, 0], points[:, 1]
     assert len(points) > 1000
-    np.testing.assert_allclose((x0 * np.sin(a) + (height_m - radius_m) * np.cos(a)) ** 2 + y0**2, radius_m**2, atol=1e-9)
+    np.testing.assert_allclose(
+        (x0 * np.sin(a) + (height_m - radius_m) * np.cos(a)) ** 2 + y0**2, radius_m**2, atol=1e-9
+    )
     # The whole ellipse: from the nearest position B to the farthest A, and +-R across the ray.
     near_m, far_m = (((height_m - radius_m) * np.cos(a) + side * radius_m) / -np.sin(a) for side in (-1, 1))
     assert x0.min() == pytest.approx(near_m, abs=2e-3) and x0.max() == pytest.approx(far_m, abs=2e-3)

@@ -204,7 +204,8 @@ class Modes:
     """Local maxima of an occupancy map: candidate people on the ground.
 
     position_m : (K, 2) the map's mean around each maximum; covariance_m2 : (K, 2, 2) its spread there;
-    strength : (K,) the map's value at the maximum divided by the map's largest value (in (0, 1]).
+    strength : (K,) the map's value at the maximum divided by the map's largest value (in (0, 1]),
+    strongest first.
     """
 
     position_m: np.ndarray
@@ -236,6 +237,8 @@ def map_modes(pom, grid: GroundGrid, separation_m: float, window_m: float, min_s
     neighbourhood = _disc(separation_m, grid.cell_m)
     largest = ndimage.maximum_filter(pom, footprint=neighbourhood, mode="constant")
     rows, columns = np.nonzero((pom == largest) & (pom >= min_strength * peak))
+    strongest_first = np.argsort(-pom[rows, columns], kind="stable")
+    rows, columns = rows[strongest_first], columns[strongest_first]
     d_row, d_column = np.nonzero(_disc(window_m, grid.cell_m))
     d_row, d_column = d_row - d_row.max() // 2, d_column - d_column.max() // 2
     window_rows, window_columns = rows[:, None] + d_row, columns[:, None] + d_column
