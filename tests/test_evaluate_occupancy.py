@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from ptztrack.cli import main
+from ptztrack.config import load_dataset, pets_dataset
 from ptztrack.evaluate.occupancy import detection_metrics, fitted_selection, halves
 from ptztrack.geometry.calibration import project_pinhole
 from ptztrack.scene.room import RoomLayout, RoomRenderer, room_truth
@@ -190,3 +191,18 @@ def test_pets_runs_with_seven_views(tmp_path):
     rows = json.loads(rows_path.read_text())
     assert [row["method"] for row in rows] == ["lpom", "clustering"]
     assert all(row["views"] == 7 and row["frames"] == 60 for row in rows) and "mota" in rows[0]
+
+
+def test_the_example_dataset_file_is_the_built_in_pets_dataset():
+    example = load_dataset(Path(__file__).resolve().parents[1] / "examples" / "pets_occupancy.yaml")
+    built_in = pets_dataset()
+    resolved = [
+        view.model_copy(update={k: str(Path(getattr(view, k)).resolve()) for k in ("calibration", "detections")})
+        for view in example.views
+    ]
+    assert [(v.name, Path(v.calibration).name, Path(v.detections).name, v.video is not None) for v in resolved] == [
+        (v.name, Path(v.calibration).name, Path(str(v.detections)).name, v.video is not None) for v in built_in.views
+    ]
+    assert all(Path(v.calibration).is_file() and Path(str(v.detections)).is_file() for v in resolved)
+    assert example.occupancy == built_in.occupancy and example.area_m == built_in.area_m
+    assert example.frame_rate_hz == built_in.frame_rate_hz and example.tracker == built_in.tracker
