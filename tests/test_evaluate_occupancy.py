@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from ptztrack.cli import main
-from ptztrack.config import load_dataset, pets_dataset
+from ptztrack.config import dataset_from_dict, load_dataset, pets_dataset
 from ptztrack.evaluate.occupancy import detection_metrics, fitted_selection, halves
 from ptztrack.geometry.calibration import project_pinhole
 from ptztrack.scene.room import RoomLayout, RoomRenderer, room_truth
@@ -206,3 +206,14 @@ def test_the_example_dataset_file_is_the_built_in_pets_dataset():
     assert all(Path(v.calibration).is_file() and Path(str(v.detections)).is_file() for v in resolved)
     assert example.occupancy == built_in.occupancy and example.area_m == built_in.area_m
     assert example.frame_rate_hz == built_in.frame_rate_hz and example.tracker == built_in.tracker
+
+
+def test_a_partial_tracker_section_keeps_the_occupancy_trackers_confirmation():
+    data = {
+        "frame_rate_hz": 10,
+        "area_m": [[0, 0], [1, 1]],
+        "views": [{"name": "a", "calibration": "c.xml", "video": "v"}],
+    }
+    assert dataset_from_dict(data).tracker.confirmation_hits == 2
+    assert dataset_from_dict({**data, "tracker": {"gate_probability": 0.95}}).tracker.confirmation_hits == 2
+    assert dataset_from_dict({**data, "tracker": {"confirmation_hits": 1}}).tracker.confirmation_hits == 1

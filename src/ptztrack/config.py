@@ -449,9 +449,12 @@ class Occupancy(_Strict):
         return self
 
 
-# A track is reported from its second detection on: the map's one-off ghosts (loci of two views
-# crossing by chance) rarely repeat at the same place, as HOG's false positives (PETS_HOG_TRACKER).
-OCCUPANCY_TRACKER = Tracker(confirmation_hits=2)
+class OccupancyTracker(Tracker):
+    """The ground tracker fed by the occupancy map: the scenario's tracker section, but a track is
+    reported from its second detection on (the map's one-off ghosts, loci of two views crossing by
+    chance, rarely repeat at the same place, as HOG's false positives: ``PETS_HOG_TRACKER``)."""
+
+    confirmation_hits: int = Field(2, ge=1)
 
 
 class MultiViewDataset(_Strict):
@@ -470,7 +473,7 @@ class MultiViewDataset(_Strict):
     ground_truth: str | None = None
     views: list[DatasetView] = Field(min_length=1)
     occupancy: Occupancy = Occupancy()
-    tracker: Tracker = OCCUPANCY_TRACKER
+    tracker: OccupancyTracker = OccupancyTracker()
 
     @model_validator(mode="after")
     def _area_and_names(self):

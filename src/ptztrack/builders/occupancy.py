@@ -1,6 +1,7 @@
 """The occupancy-map experiment's inputs: a dataset file or the synthetic room made into a
 :class:`~ptztrack.scene.multiview.MultiViewRecording`, and the detectors' parameters from the configuration."""
 
+import functools
 from collections.abc import Callable
 from pathlib import Path
 
@@ -8,7 +9,7 @@ import cv2
 import numpy as np
 
 from ptztrack.builders.factories import TRACKER_FIELDS
-from ptztrack.config import OCCUPANCY_TRACKER, DatasetView, MultiViewDataset, Occupancy, Tracker
+from ptztrack.config import DatasetView, MultiViewDataset, Occupancy, OccupancyTracker, Tracker
 from ptztrack.detect.lpom import ClusteringDetector, LpomDetector, LpomParameters
 from ptztrack.detect.motion import MotionEdgeParameters
 from ptztrack.detect.occupancy import LocusSampling, sampled_heights
@@ -82,9 +83,11 @@ def _frames(view: DatasetView, size_px: tuple[int, int] | None, field: str):
             f"{view.calibration}: {field}'s calibration is for {size_px[0]}x{size_px[1]} px images, "
             f"but {path} is {actual_px[0]}x{actual_px[1]} px"
         )
-    if view.images is not None:
-        return ImageFolder(view.images, actual_px).frame, count, actual_px
-    return RecordedVideo(path, actual_px).frame, count, actual_px
+    source = (
+        ImageFolder(view.images, actual_px).frame if view.images is not None else RecordedVideo(path, actual_px).frame
+    )
+    # Both detectors ask for each frame: keep the last two decoded.
+    return functools.lru_cache(maxsize=2)(source), count, actual_px
 
 
 def recording_from_dataset(dataset: MultiViewDataset, frames: int | None = None) -> MultiViewRecording:
@@ -136,7 +139,8 @@ def room_recording(people: int, frames: int, seed: int, layout: RoomLayout = ROO
 
 
 def _view_frames(renderer: RoomRenderer, view: int) -> Callable[[int], np.ndarray]:
-    return lambda frame: renderer.image(view, frame)
+    """The view's frames, the last two kept: both detectors ask for each frame, LPOM for the one before too."""
+    return functools.lru_cache(maxsize=2)(functools.partial(renderer.image, view))
 
 
 def run_recording(
@@ -166,7 +170,7 @@ def room_runs(frames: int, seed: int, progress=None) -> list[OccupancyRun]:
     """The synthetic room with 1 and with 3 people (seeds ``seed`` and ``seed + 1``), default parameters."""
     return [
         run_recording(
-            room_recording(people, frames, seed + index), Occupancy(), OCCUPANCY_TRACKER, {"people": people}, progress
+            room_recording(people, frames, seed + index), Occupancy(), OccupancyTracker(), {"people": people}, progress
         )
         for index, people in enumerate(ROOM_PEOPLE)
     ]
