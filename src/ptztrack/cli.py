@@ -35,6 +35,7 @@ from ptztrack.builders.follow_experiment import (
     run_follow_cell,
     run_otb_cell,
 )
+from ptztrack.builders.occupancy import ROOM_FRAMES, dataset_runs, room_runs
 from ptztrack.builders.pets import PROTOCOLS, protocol_folds
 from ptztrack.builders.registration import reference_index
 from ptztrack.config import (
@@ -42,7 +43,9 @@ from ptztrack.config import (
     PoseError,
     Scenario,
     ScenarioError,
+    load_dataset,
     load_scenario,
+    pets_dataset,
     pets_follow_scenario,
     pets_scenario,
     scenario_from_dict,
@@ -67,6 +70,7 @@ from ptztrack.evaluate.msg import (
     summarise_by_ambiguity,
     trails_figure,
 )
+from ptztrack.evaluate.occupancy_output import write_occupancy_outputs
 from ptztrack.evaluate.registration import summarise_registration
 from ptztrack.evaluate.report import RUN_FILES, write_figure, write_outputs
 from ptztrack.evaluate.tables import format_table, paired_difference, summarise
@@ -361,6 +365,50 @@ def follow_experiment_command(args: argparse.Namespace) -> int:
     return 0
 
 
+OCCUPANCY_COLUMNS = (
+    ("method", "{}"),
+    ("people", "{}"),
+    ("moda", "{:.1%}"),
+    ("modp", "{:.1%}"),
+    ("precision", "{:.1%}"),
+    ("recall", "{:.1%}"),
+    ("error_m", "{:.3f}"),
+    ("mota", "{:.1%}"),
+    ("motp_m", "{:.3f}"),
+    ("idf1", "{:.1%}"),
+)
+
+
+def occupancy_experiment_command(args: argparse.Namespace) -> int:
+    progress = partial(print_progress, noun="frames")
+    if args.dataset == "synthetic-room":
+        runs = room_runs(args.frames or ROOM_FRAMES, args.seed, progress)
+    else:
+        dataset = pets_dataset() if args.dataset == "pets" else load_dataset(args.dataset)
+        runs = dataset_runs(dataset, args.frames, progress)
+    rows = [row for run in runs for row in run.rows]
+    columns = [(key, form) for key, form in OCCUPANCY_COLUMNS if any(key in row for row in rows)]
+    print(f"Occupancy-map detection on {args.dataset}: MODA, MODP, precision, recall within 0.5 m; tracker fed by LPOM")
+    print("  ".join(f"{key:>10}" for key, _ in columns))
+    for row in rows:
+        print("  ".join(f"{form.format(row[key]) if key in row else '':>10}" for key, form in columns))
+    for row in rows:
+        fitted = {key: value for key, value in row.items() if key.startswith("fitted_")}
+        print(f"{row['dataset']} {row['method']}: {fitted} (each half of the frames scored with the other's fit)")
+    written = []
+    if args.out is not None:
+        with run_folder(args.out, args.overwrite) as folder:
+            for run in runs:
+                write_occupancy_outputs(folder / str(run.rows[0]["dataset"]), run, args.images_every)
+        written.append(args.out)
+    if args.json is not None:
+        write_json(args.json, rows)
+        written.append(args.json)
+    if written:
+        print(f"wrote {', '.join(str(path) for path in written)}")
+    return 0
+
+
 class OneLineParser(argparse.ArgumentParser):
     """Command-line mistakes end in one line on stderr and exit status 2, like every other bad input."""
 
@@ -388,7 +436,7 @@ def parser() -> argparse.ArgumentParser:
 
     experiment = commands.add_parser("experiment", help="run one of the papers' experiments and print its table")
     experiments = experiment.add_subparsers(
-        dest="name", required=True, metavar="{synthetic,pets,msg,registration,follow}"
+        dest="name", required=True, metavar="{synthetic,pets,msg,registration,follow,occupancy}"
     )
 
     synthetic = experiments.add_parser("synthetic", help="the PTZ paper's Tables 1-2 on the synthetic scene")
@@ -469,6 +517,7 @@ def parser() -> argparse.ArgumentParser:
     _add_recording_arguments(registration)
     registration.set_defaults(handler=registration_experiment_command)
     _add_follow_commands(commands, experiments)
+    _add_occupancy_parser(experiments)
     return root
 
 
@@ -519,6 +568,26 @@ def _add_follow_scenario_arguments(command: argparse.ArgumentParser) -> None:
         help="the particle filter bins greys by value (Perez et al.) besides the paper's hue-saturation bins",
     )
     _add_recording_arguments(command)
+
+
+def _add_occupancy_parser(experiments) -> None:
+    occupancy = experiments.add_parser(
+        "occupancy", help="the LPOM paper: people on the ground from several calibrated views, against clustering"
+    )
+    occupancy.add_argument("dataset", help="'synthetic-room' or 'pets' (built in), or a multi-view dataset YAML file")
+    occupancy.add_argument(
+        "--frames", type=_positive_int, help=f"frames to use (synthetic-room: {ROOM_FRAMES} per sequence; else all)"
+    )
+    occupancy.add_argument(
+        "--seed", type=_non_negative_int, default=0, help="synthetic-room: draws people and textures"
+    )
+    occupancy.add_argument(
+        "--out", type=Path, help="directory for maps, video, detections and tracks per recording; written whole"
+    )
+    occupancy.add_argument("--overwrite", action="store_true", help="replace a non-empty --out folder")
+    occupancy.add_argument("--images-every", type=_positive_int, default=10, help="a map picture every N frames")
+    occupancy.add_argument("--json", type=Path, help="write one row per method (and people count) here")
+    occupancy.set_defaults(handler=occupancy_experiment_command)
 
 
 def _strategies(policies: list[str]) -> list[str]:

@@ -688,3 +688,183 @@ def _resolved_paths(recording: dict, base: Path) -> dict:
         for key, value in recording.items()
         if key in ("ground_truth", "calibration", "video") and isinstance(value, str)
     }
+
+
+# ---------------------------------------------------------------------------
+# Multi-view datasets and the occupancy-map detector (the LPOM paper).
+# ---------------------------------------------------------------------------
+
+
+class DatasetView(_Strict):
+    """One fixed camera of a multi-view dataset.
+
+    calibration : a Tsai XML (PETS 2009) or a pinhole JSON (``{view: {K, dist, R, t}}``, world in mm);
+    calibration_view : the view's key in a pinhole JSON (default: ``name``).
+    image_size_px : (width, height); read from a Tsai XML, checked against it when given; needed with
+    a pinhole JSON. video (a file) or images (a folder, frames in sorted name order) : the frames,
+    for motion edges; detections : a MOTChallenge detection file (``frame,-1,left,top,width,height,score,...``,
+    frames from 1), for views without frames and for the clustering baseline. weight : ``w_c``.
+    """
+
+    name: str
+    calibration: str
+    calibration_view: str | None = None
+    image_size_px: tuple[Annotated[int, Field(gt=0)], Annotated[int, Field(gt=0)]] | None = None
+    video: str | None = None
+    images: str | None = None
+    detections: str | None = None
+    weight: PositiveFloat = 1.0
+
+    @model_validator(mode="after")
+    def _has_evidence(self):
+        if self.video is not None and self.images is not None:
+            raise ValueError("give video or images, not both")
+        if self.video is None and self.images is None and self.detections is None:
+            raise ValueError("a view needs video, images or detections")
+        return self
+
+
+class Occupancy(_Strict):
+    """The occupancy-map detector, its baseline and where their parameters come from (README).
+
+    Person model (equation 4, Algorithm 1): heights from min_height_m up to max_height_m in steps of
+    height_step_m (at the steps' midpoints), width_m, samples_per_height tangent points per height.
+    Map: cell_m, kernel_sigma_m (the Gaussian kernel), block_px (locus tables per block of pixels).
+    Modes: separation_m (closest two people), window_m (their mean and covariance), min_strength
+    (fraction of the frame's strongest mode; None: fitted on the other half of the frames).
+    Motion edges: canny_low, canny_high, difference_threshold (grey levels), dilation_px.
+    Boxes: outline_points_per_box, min_box_score. Baseline: linkage_m (complete-linkage cut),
+    min_views (None: fitted like min_strength), blob_min_area_px (blob boxes of views without detections).
+    """
+
+    min_height_m: PositiveFloat = 1.6
+    max_height_m: PositiveFloat = 1.9
+    height_step_m: PositiveFloat = 0.1
+    width_m: PositiveFloat = 0.5
+    samples_per_height: int = Field(32, ge=1)
+    cell_m: PositiveFloat = 0.05
+    kernel_sigma_m: PositiveFloat = 0.1
+    block_px: int = Field(4, ge=1)
+    separation_m: PositiveFloat = 0.5
+    window_m: PositiveFloat = 0.25
+    canny_low: NonNegativeFloat = 50.0
+    canny_high: NonNegativeFloat = 150.0
+    difference_threshold: NonNegativeFloat = 15.0
+    dilation_px: int = Field(2, ge=0)
+    outline_points_per_box: int = Field(64, ge=4)
+    min_box_score: float = Field(0.5, ge=0, le=1)
+    linkage_m: PositiveFloat = 1.0
+    blob_min_area_px: int = Field(400, ge=1)
+
+    @model_validator(mode="after")
+    def _heights_ordered(self):
+        if self.max_height_m < self.min_height_m:
+            raise ValueError(f"max_height_m must be at least min_height_m ({self.min_height_m})")
+        return self
+
+
+class OccupancyTracker(Tracker):
+    """The ground tracker fed by the occupancy map: the scenario's tracker section, but a track is
+    reported from its second detection on (the map's one-off ghosts, loci of two views crossing by
+    chance, rarely repeat at the same place, as HOG's false positives: ``PETS_HOG_TRACKER``)."""
+
+    confirmation_hits: int = Field(2, ge=1)
+
+
+class MultiViewDataset(_Strict):
+    """A calibrated multi-view recording (README, "The occupancy-map detector"). Relative paths in a
+    dataset file are relative to it.
+
+    area_m : [[x0, y0], [x1, y1]] the ground the map covers, metres (people outside it are not scored);
+    frames : how many frames to use (default: all that every view and the ground truth have);
+    ground_truth : MOTChallenge rows with world x, y in metres in columns 8-9 (frames from 1).
+    """
+
+    name: str = "dataset"
+    frame_rate_hz: PositiveFloat
+    frames: int | None = Field(None, ge=1)
+    area_m: tuple[tuple[float, float], tuple[float, float]]
+    ground_truth: str | None = None
+    views: list[DatasetView] = Field(min_length=1)
+    occupancy: Occupancy = Occupancy()
+    tracker: OccupancyTracker = OccupancyTracker()
+
+    @model_validator(mode="after")
+    def _area_and_names(self):
+        (x0, y0), (x1, y1) = self.area_m
+        if not (x1 > x0 and y1 > y0):
+            raise ValueError("area_m must be [[x0, y0], [x1, y1]] with x1 > x0 and y1 > y0")
+        names = [view.name for view in self.views]
+        if len(set(names)) != len(names):
+            raise ValueError(f"view names must differ (got {names})")
+        if self.tracker.association != "hungarian":
+            raise ValueError("the occupancy map's modes are associated by the Hungarian assignment only")
+        return self
+
+
+DATASET_PATH_FIELDS = ("calibration", "video", "images", "detections")
+
+
+def dataset_from_dict(data: Any, source: str = "dataset") -> MultiViewDataset:
+    """Validate a multi-view dataset mapping; a :class:`ScenarioError` of one line naming the field."""
+    if not isinstance(data, dict):
+        raise ScenarioError(f"{source}: expected a mapping of dataset fields (got {type(data).__name__})")
+    try:
+        return MultiViewDataset.model_validate(data)
+    except pydantic.ValidationError as error:
+        raise ScenarioError(_first_error_line(error, source)) from None
+
+
+def load_dataset(path: str | Path) -> MultiViewDataset:
+    """Read and validate a multi-view dataset YAML file, its relative paths made relative to it."""
+    path = Path(path)
+    data = read_yaml(path, "dataset", ScenarioError)
+    if isinstance(data, dict):
+        base = path.parent
+        if isinstance(data.get("ground_truth"), str):
+            data = {**data, "ground_truth": str(base / data["ground_truth"])}
+        if isinstance(data.get("views"), list):
+            views = [
+                {
+                    **view,
+                    **{key: str(base / view[key]) for key in DATASET_PATH_FIELDS if isinstance(view.get(key), str)},
+                }
+                if isinstance(view, dict)
+                else view
+                for view in data["views"]
+            ]
+            data = {**data, "views": views}
+    return dataset_from_dict(data, str(path))
+
+
+# PETS 2009 S2.L1 as a multi-view dataset: the seven views with published detections (View_002 has
+# none), their official Tsai calibrations, View_001's video. The area holds every annotated
+# position with a margin of about a metre. A person in these views is 0.1-0.4 m on the ground per
+# 4-15 px of feet error (the detections' median, README of the data), hence the wider kernel and
+# cells than in the room; 10 fps as in the PETS scenario.
+PETS_VIEWS = ("View_001", "View_003", "View_004", "View_005", "View_006", "View_007", "View_008")
+PETS_OCCUPANCY = {"cell_m": 0.1, "kernel_sigma_m": 0.25}
+
+
+def pets_dataset(**overrides) -> MultiViewDataset:
+    """The built-in PETS 2009 S2.L1 dataset (seven views), from the files shipped with ptztrack."""
+    data_dir = resources.files("ptztrack.data") / "pets2009_s2l1"
+    views = [
+        {
+            "name": view,
+            "calibration": str(data_dir / f"{view}.xml"),
+            "detections": str(data_dir / f"{view}_det.txt.gz"),
+            **({"video": str(data_dir / "View_001.avi")} if view == "View_001" else {}),
+        }
+        for view in PETS_VIEWS
+    ]
+    data = {
+        "name": "pets",
+        "frame_rate_hz": 10.0,
+        "area_m": ((-21.0, -17.5), (8.5, 9.0)),
+        "ground_truth": str(data_dir / "gt_mot15.txt"),
+        "views": views,
+        "occupancy": PETS_OCCUPANCY,
+        **overrides,
+    }
+    return dataset_from_dict(data, "pets")

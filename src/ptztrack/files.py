@@ -10,6 +10,7 @@ import math
 import os
 import shutil
 import tempfile
+import zlib
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -62,8 +63,11 @@ def read_bytes(path: str | Path, what: str, max_bytes: int, error_type: type[Inp
 
 
 def read_text(path: str | Path, what: str, max_bytes: int, error_type: type[InputError] = InputError) -> str:
-    """A user's UTF-8 text file of at most ``max_bytes`` (see :func:`read_bytes`)."""
+    """A user's UTF-8 text file of at most ``max_bytes`` (see :func:`read_bytes`); a ``.gz`` file is
+    decompressed, to at most ``max_bytes`` too."""
     data = read_bytes(path, what, max_bytes, error_type)
+    if Path(path).suffix == ".gz":
+        data = _gunzip(path, data, what, max_bytes, error_type)
     try:
         return data.decode("utf-8")
     except UnicodeDecodeError as error:
@@ -71,6 +75,20 @@ def read_text(path: str | Path, what: str, max_bytes: int, error_type: type[Inpu
         raise error_type(
             f"{path}: not UTF-8 text (byte 0x{data[error.start]:02x} on line {line}); expected a {what} file"
         ) from None
+
+
+def _gunzip(path, data: bytes, what: str, max_bytes: int, error_type: type[InputError]) -> bytes:
+    """The content of one gzip member, refused beyond ``max_bytes`` before it is all inflated."""
+    inflater = zlib.decompressobj(16 + zlib.MAX_WBITS)
+    try:
+        content = inflater.decompress(data, max_bytes + 1)
+    except zlib.error as error:
+        raise error_type(f"{path}: not gzip-compressed ({error}); expected a gzip-compressed {what} file") from None
+    if len(content) > max_bytes:
+        raise error_type(f"{path}: decompresses to more than {max_bytes} bytes, the limit for a {what} file")
+    if not inflater.eof or inflater.unused_data:
+        raise error_type(f"{path}: a truncated gzip file, or more than one member; expected one whole member")
+    return content
 
 
 def read_json(path: str | Path, what: str, max_bytes: int, error_type: type[InputError] = InputError) -> object:

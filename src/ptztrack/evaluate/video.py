@@ -20,7 +20,7 @@ not in the pip wheels).
 
 import os
 import tempfile
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -153,15 +153,21 @@ def write_episode_video(path: str | Path, episode: Episode, render_view: RenderV
     One frame (FRAME_SIZE_PX) per step. Written to a temporary file beside
     ``path`` and renamed, so a failure leaves no partial file and keeps an old one.
     """
+    write_video(path, episode_frames(episode, render_view, label), episode.truth.frame_rate_hz, FRAME_SIZE_PX)
+
+
+def write_video(path: str | Path, frames: Iterable[np.ndarray], frame_rate_hz: float, size_px) -> None:
+    """Write ``frames`` ((height, width, 3) uint8 BGR of ``size_px`` (width, height)) to ``path`` (.mp4,
+    MPEG-4 Part 2) through a temporary file beside it and a rename."""
     path = Path(path)
     handle, temporary = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".mp4")
     os.close(handle)
     try:
-        writer = cv2.VideoWriter(temporary, cv2.VideoWriter.fourcc(*"mp4v"), episode.truth.frame_rate_hz, FRAME_SIZE_PX)
+        writer = cv2.VideoWriter(temporary, cv2.VideoWriter.fourcc(*"mp4v"), frame_rate_hz, tuple(size_px))
         try:
             if not writer.isOpened():
                 raise RuntimeError(f"{path}: OpenCV cannot write MPEG-4 video here")
-            for frame in episode_frames(episode, render_view, label):
+            for frame in frames:
                 writer.write(frame)
         finally:
             writer.release()

@@ -104,6 +104,21 @@ def project_pinhole(calibration: PinholeCalibration, points_mm) -> np.ndarray:
     return pixels[:, 0, :]
 
 
+def pixel_rays(calibration: PinholeCalibration, pixels_px) -> tuple[np.ndarray, np.ndarray]:
+    """The rays through pixels: the camera centre (3,) and unit directions (N, 3), in metres.
+
+    pixels_px : (N, 2) distorted image coordinates (the centre of pixel (i, j) at (i + 0.5, j + 0.5),
+    as the calibrations map world points). ``cv2.undistortPoints`` inverts the distortion; the
+    calibration's millimetres become ptztrack's metres.
+    """
+    pixels = np.asarray(pixels_px, dtype=float).reshape(-1, 1, 2)
+    normalised = cv2.undistortPoints(pixels, calibration.K, calibration.dist)[:, 0, :]
+    in_camera = np.concatenate([normalised, np.ones((len(normalised), 1))], axis=-1)
+    direction = in_camera @ calibration.R  # R^T d for each row d
+    centre_m = -calibration.R.T @ calibration.t / 1000.0
+    return centre_m, direction / np.linalg.norm(direction, axis=-1, keepdims=True)
+
+
 def pinhole_from_tsai(calibration: TsaiCalibration) -> PinholeCalibration:
     """The pinhole camera with OpenCV distortion that projects like a Tsai camera.
 

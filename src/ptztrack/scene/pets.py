@@ -52,11 +52,19 @@ def load_mot_ground_truth(path: str | Path) -> Annotations:
 
     Frames and ids must be whole numbers, each (frame, id) appear once, and every number be finite.
     """
+    table = read_mot_rows(path, "ground-truth")
+    frame, person_id = table[:, 0].astype(np.int64), table[:, 1].astype(np.int64)
+    _refuse_repeated_annotations(Path(path), frame, person_id)
+    return Annotations(frame=frame - 1, person_id=person_id, box_px=table[:, 2:6], ground_m=table[:, 7:9])
+
+
+def read_mot_rows(path: str | Path, what: str) -> np.ndarray:
+    """The rows (K, 10) of a MOTChallenge file (ground truth or detections; ``.gz`` compressed or not),
+    checked: ten finite numbers a line, whole frames and ids, frames from 1. ``what`` names the kind
+    of file in errors."""
     path = Path(path)
     rows = []
-    for number, line in enumerate(
-        read_text(path, "ground-truth", GROUND_TRUTH_MAX_BYTES, DatasetError).splitlines(), 1
-    ):
+    for number, line in enumerate(read_text(path, what, GROUND_TRUTH_MAX_BYTES, DatasetError).splitlines(), 1):
         if not line.strip():
             continue
         fields = line.split(",")
@@ -79,11 +87,8 @@ def load_mot_ground_truth(path: str | Path) -> Annotations:
             )
         rows.append(values)
     if not rows:
-        raise DatasetError(f"{path}: no ground-truth rows")
-    table = np.asarray(rows)
-    frame, person_id = table[:, 0].astype(np.int64), table[:, 1].astype(np.int64)
-    _refuse_repeated_annotations(path, frame, person_id)
-    return Annotations(frame=frame - 1, person_id=person_id, box_px=table[:, 2:6], ground_m=table[:, 7:9])
+        raise DatasetError(f"{path}: no {what} rows")
+    return np.asarray(rows)
 
 
 def _refuse_repeated_annotations(path: Path, frame: np.ndarray, person_id: np.ndarray) -> None:

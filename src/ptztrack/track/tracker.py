@@ -138,6 +138,12 @@ def associate(predicted_px, in_front, S, feet_px, gate_probability: float) -> tu
     if len(predicted_px) == 0 or len(feet_px) == 0:
         return np.zeros(0, dtype=int), np.zeros(0, dtype=int)
     _, distance2, allowed = gated_innovations(predicted_px, in_front, S, feet_px, gate_probability)
+    return assign_gated(distance2, allowed, gate_probability)
+
+
+def assign_gated(distance2, allowed, gate_probability: float) -> tuple[np.ndarray, np.ndarray]:
+    """The Hungarian assignment on squared Mahalanobis distances (n, K) among the ``allowed`` (n, K)
+    pairs; returns matched (track_index, measurement_index) arrays."""
     cost = np.where(allowed, distance2, chi2.ppf(gate_probability, df=2) * 1e3)
     rows, cols = linear_sum_assignment(cost)
     keep = allowed[rows, cols]
@@ -166,14 +172,23 @@ def start_tracks(
     """
     ground_xy, ok = ground_points(feet_px, camera, pose)
     ground_xy = ground_xy[ok]
-    count = len(ground_xy)
     J_inv = np.linalg.inv(feet_jacobian(camera, pose, ground_xy))
+    covariance_m2 = J_inv @ V @ np.swapaxes(J_inv, -1, -2)
+    return start_ground_tracks(ground_xy, covariance_m2, initial_speed_sigma_m_s, first_id, existence)
+
+
+def start_ground_tracks(
+    position_m, covariance_m2, initial_speed_sigma_m_s: float, first_id: int, existence: float = 0.5
+) -> Tracks:
+    """New tracks at ground positions (K, 2) m with position covariances (K, 2, 2) m^2; velocity 0
+    with spread ``initial_speed_sigma_m_s`` per axis; the existence probability at ``existence``."""
+    count = len(position_m)
     covariance = np.zeros((count, 4, 4))
-    covariance[:, :2, :2] = J_inv @ V @ np.swapaxes(J_inv, -1, -2)
+    covariance[:, :2, :2] = covariance_m2
     covariance[:, 2:, 2:] = initial_speed_sigma_m_s**2 * np.eye(2)
     return Tracks(
         ids=first_id + np.arange(count),
-        mean=np.concatenate([ground_xy, np.zeros((count, 2))], axis=-1),
+        mean=np.concatenate([np.reshape(position_m, (count, 2)), np.zeros((count, 2))], axis=-1),
         covariance=covariance,
         existence=np.full(count, existence),
         hits=np.ones(count, dtype=int),
@@ -252,6 +267,57 @@ def update_tracks(
         tracks.next_id,
         parameters.existence_at_birth,
     )
+    return _with_births(tracks, survivors, keep, born, track_index, detection_index, starting)
+
+
+def update_tracks_on_ground(
+    tracks: Tracks, position_m, covariance_m2, parameters: TrackerParameters, detectable: float
+) -> TrackUpdate:
+    """Associate, update, start and delete with measurements of ground positions (a multi-camera
+    occupancy map's modes, :mod:`ptztrack.detect.occupancy`), the tracker's step after prediction.
+
+    position_m : (K, 2) measured positions; covariance_m2 : (K, 2, 2) their noise ``R``. The
+    observation is linear, ``z = [I 0] x + r``; association is the Hungarian assignment on the
+    Mahalanobis distance with innovation covariance ``P_xy + R_k`` per pair, gated as in
+    :func:`update_tracks`, and an unassigned measurement starts a track with ``R_k`` as its position
+    covariance and ``existence_at_birth``. Fixed cameras watch every track: an undetected track
+    loses existence as in :func:`update_tracks`, with ``detectable`` the probability that the map
+    finds a person who is there (its recall). Only the Hungarian association is available.
+    """
+    if parameters.association != "hungarian":
+        raise ValueError(
+            f"ground measurements are associated by the Hungarian assignment, not {parameters.association!r}"
+        )
+    position_m = np.asarray(position_m, dtype=float).reshape(-1, 2)
+    covariance_m2 = np.asarray(covariance_m2, dtype=float).reshape(-1, 2, 2)
+    C = np.broadcast_to(np.eye(2, 4), (len(tracks), 2, 4))
+    residual = position_m[None, :, :] - tracks.mean[:, None, :2]
+    S = tracks.covariance[:, None, :2, :2] + covariance_m2[None, :, :, :]
+    distance2 = np.einsum("tki,tkij,tkj->tk", residual, np.linalg.inv(S), residual)
+    allowed = distance2 <= chi2.ppf(parameters.gate_probability, df=2)
+    track_index, measurement_index = assign_gated(distance2, allowed, parameters.gate_probability)
+    mean, covariance = tracks.mean.copy(), tracks.covariance.copy()
+    mean[track_index], covariance[track_index] = kalman.update(
+        tracks.mean[track_index],
+        tracks.covariance[track_index],
+        residual[track_index, measurement_index],
+        C[track_index],
+        covariance_m2[measurement_index],
+    )
+    survivors, keep = _after_update(tracks, mean, covariance, track_index, np.full(len(tracks), detectable), parameters)
+    starting = np.setdiff1d(np.arange(len(position_m)), measurement_index)
+    born = start_ground_tracks(
+        position_m[starting],
+        covariance_m2[starting],
+        parameters.initial_speed_sigma_m_s,
+        tracks.next_id,
+        parameters.existence_at_birth,
+    )
+    return _with_births(tracks, survivors, keep, born, track_index, measurement_index, starting)
+
+
+def _with_births(tracks: Tracks, survivors: Tracks, keep, born: Tracks, track_index, measurement_index, starting):
+    """The update's result: the surviving tracks and the new ones, each paired with its measurement."""
     alive = keep[track_index]
     return TrackUpdate(
         tracks=Tracks(
@@ -263,7 +329,7 @@ def update_tracks(
             next_id=born.next_id,
         ),
         track_ids=np.concatenate([tracks.ids[track_index[alive]], born.ids]),
-        measurement_index=np.concatenate([detection_index[alive], starting]),
+        measurement_index=np.concatenate([measurement_index[alive], starting]),
     )
 
 

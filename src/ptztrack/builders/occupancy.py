@@ -1,0 +1,176 @@
+"""The occupancy-map experiment's inputs: a dataset file or the synthetic room made into a
+:class:`~ptztrack.scene.multiview.MultiViewRecording`, and the detectors' parameters from the configuration."""
+
+import functools
+from collections.abc import Callable
+from pathlib import Path
+
+import cv2
+import numpy as np
+
+from ptztrack.builders.factories import TRACKER_FIELDS
+from ptztrack.config import DatasetView, MultiViewDataset, Occupancy, OccupancyTracker, Tracker
+from ptztrack.detect.lpom import ClusteringDetector, LpomDetector, LpomParameters
+from ptztrack.detect.motion import MotionEdgeParameters
+from ptztrack.detect.occupancy import LocusSampling, sampled_heights
+from ptztrack.evaluate.occupancy import OccupancyRun, detect_frames, score_recording
+from ptztrack.geometry.calibration import PinholeCalibration, load_pinhole, load_tsai, pinhole_from_tsai
+from ptztrack.geometry.locus import PERSON, ConeModel
+from ptztrack.scene.multiview import CameraView, ImageFolder, MultiViewRecording, load_mot_detections, mot_truth
+from ptztrack.scene.pets import DatasetError, RecordedVideo
+from ptztrack.scene.room import RoomLayout, RoomRenderer, room_truth
+from ptztrack.track.tracker import TrackerParameters
+
+ROOM_AREA_M = ((0.0, 0.0), (5.0, 6.0))
+ROOM_PEOPLE = (1, 3)
+# 20 s at 15 Hz per sequence (the paper's were 3.5 and 7 minutes long).
+ROOM_FRAMES = 300
+ROOM = RoomLayout()
+
+
+def lpom_parameters(config: Occupancy) -> LpomParameters:
+    model = ConeModel(PERSON.height_fraction, PERSON.radius_fraction, config.width_m)
+    heights = sampled_heights(config.min_height_m, config.max_height_m, config.height_step_m)
+    return LpomParameters(
+        sampling=LocusSampling(model, heights, config.samples_per_height),
+        cell_m=config.cell_m,
+        kernel_sigma_m=config.kernel_sigma_m,
+        separation_m=config.separation_m,
+        window_m=config.window_m,
+        # Candidates well below any threshold the fit may choose (its smallest is 0.05).
+        candidate_strength=0.02,
+        block_px=config.block_px,
+        edges=MotionEdgeParameters(
+            config.canny_low, config.canny_high, config.difference_threshold, config.dilation_px
+        ),
+        outline_points_per_box=config.outline_points_per_box,
+        min_box_score=config.min_box_score,
+    )
+
+
+def _calibration(view: DatasetView, field: str) -> tuple[PinholeCalibration, tuple[int, int] | None]:
+    """A view's calibration and image size: from a Tsai XML (checked against ``image_size_px``) or a
+    pinhole JSON (with ``image_size_px``, if given)."""
+    path = Path(view.calibration)
+    if path.suffix.lower() != ".xml":
+        return load_pinhole(path, view.calibration_view or view.name), view.image_size_px
+    tsai = load_tsai(path)
+    if view.image_size_px is not None and tuple(view.image_size_px) != tsai.image_size_px:
+        width, height = tsai.image_size_px
+        raise DatasetError(
+            f"{path}: <Geometry width height> is {width}x{height} px, but {field}.image_size_px is "
+            f"{view.image_size_px[0]}x{view.image_size_px[1]}"
+        )
+    return pinhole_from_tsai(tsai), tsai.image_size_px
+
+
+def _frames(view: DatasetView, size_px: tuple[int, int] | None, field: str):
+    """The view's frame source, its frame count and its image size (checked against the calibration's)."""
+    if view.images is not None:
+        folder = ImageFolder(view.images)
+        first, count, path = folder.frame(0), len(folder), Path(folder.files[0])
+    else:
+        path = Path(str(view.video))
+        capture = cv2.VideoCapture(str(path))
+        count = int(capture.get(cv2.CAP_PROP_FRAME_COUNT))
+        ok, first = capture.read()
+        capture.release()
+        if not ok:
+            raise DatasetError(f"{path}: OpenCV could not read any frame")
+    actual_px = (int(first.shape[1]), int(first.shape[0]))
+    if size_px is not None and actual_px != tuple(size_px):
+        raise DatasetError(
+            f"{view.calibration}: {field}'s calibration is for {size_px[0]}x{size_px[1]} px images, "
+            f"but {path} is {actual_px[0]}x{actual_px[1]} px"
+        )
+    source = (
+        ImageFolder(view.images, actual_px).frame if view.images is not None else RecordedVideo(path, actual_px).frame
+    )
+    # Both detectors ask for each frame: keep the last two decoded.
+    return functools.lru_cache(maxsize=2)(source), count, actual_px
+
+
+def recording_from_dataset(dataset: MultiViewDataset, frames: int | None = None) -> MultiViewRecording:
+    """The recording a dataset describes; ``frames`` (or the dataset's) caps how many frames are used.
+
+    Without either, every frame that all views' videos or image folders have (or, without any, up to
+    the last frame of the detection files).
+    """
+    loaded = []
+    for index, view in enumerate(dataset.views):
+        field = f"views.{index}"
+        calibration, size_px = _calibration(view, field)
+        source, count = None, None
+        if view.video is not None or view.images is not None:
+            source, count, size_px = _frames(view, size_px, field)
+        boxes = None if view.detections is None else load_mot_detections(view.detections)
+        loaded.append((view, calibration, size_px, source, count, boxes))
+    counts = [count for *_, count, _ in loaded if count is not None]
+    available = min(counts) if counts else max(len(boxes) for *_, boxes in loaded if boxes is not None)
+    wanted = frames or dataset.frames or available
+    if wanted > available:
+        raise DatasetError(f"{dataset.name}: frames is {wanted}, but the views have only {available}")
+    views = tuple(
+        CameraView(
+            name=view.name,
+            calibration=calibration,
+            image_size_px=size_px,
+            frames=source,
+            boxes=None if boxes is None else (boxes + [np.zeros((0, 5))] * wanted)[:wanted],
+            weight=view.weight,
+        )
+        for view, calibration, size_px, source, count, boxes in loaded
+    )
+    truth = None
+    if dataset.ground_truth is not None:
+        truth = mot_truth(dataset.ground_truth, wanted, dataset.frame_rate_hz)
+    return MultiViewRecording(dataset.name, views, wanted, dataset.frame_rate_hz, np.asarray(dataset.area_m), truth)
+
+
+def room_recording(people: int, frames: int, seed: int, layout: RoomLayout = ROOM) -> MultiViewRecording:
+    """The synthetic room with ``people`` walking for ``frames`` frames, rendered on demand."""
+    truth = room_truth(layout, people, frames, seed)
+    renderer = RoomRenderer(layout, truth, seed)
+    views = tuple(
+        CameraView(f"camera_{index + 1}", camera, layout.image_size_px, _view_frames(renderer, index), None)
+        for index, camera in enumerate(renderer.cameras)
+    )
+    return MultiViewRecording(f"room-{people}", views, frames, layout.frame_rate_hz, np.asarray(ROOM_AREA_M), truth)
+
+
+def _view_frames(renderer: RoomRenderer, view: int) -> Callable[[int], np.ndarray]:
+    """The view's frames, the last two kept: both detectors ask for each frame, LPOM for the one before too."""
+    return functools.lru_cache(maxsize=2)(functools.partial(renderer.image, view))
+
+
+def run_recording(
+    recording: MultiViewRecording,
+    occupancy: Occupancy,
+    tracker: Tracker,
+    label: dict | None = None,
+    progress: Callable[[int, int], None] | None = None,
+) -> OccupancyRun:
+    """Both detectors over every frame of ``recording``, scored (the recording needs ground truth)."""
+    if recording.truth is None:
+        raise DatasetError(f"{recording.name}: the experiment needs ground truth (ground_truth)")
+    parameters = lpom_parameters(occupancy)
+    lpom = LpomDetector(recording, parameters)
+    clustering = ClusteringDetector(recording, occupancy.linkage_m, occupancy.min_box_score, occupancy.blob_min_area_px)
+    frames = detect_frames(recording, lpom, clustering, progress)
+    tracking = TrackerParameters(**{name: getattr(tracker, name) for name in TRACKER_FIELDS})
+    return score_recording(recording, lpom.grid, frames, tracker.acceleration_sigma_m_s2, tracking, label)
+
+
+def dataset_runs(dataset: MultiViewDataset, frames: int | None, progress=None) -> list[OccupancyRun]:
+    recording = recording_from_dataset(dataset, frames)
+    return [run_recording(recording, dataset.occupancy, dataset.tracker, None, progress)]
+
+
+def room_runs(frames: int, seed: int, progress=None) -> list[OccupancyRun]:
+    """The synthetic room with 1 and with 3 people (seeds ``seed`` and ``seed + 1``), default parameters."""
+    return [
+        run_recording(
+            room_recording(people, frames, seed + index), Occupancy(), OccupancyTracker(), {"people": people}, progress
+        )
+        for index, people in enumerate(ROOM_PEOPLE)
+    ]

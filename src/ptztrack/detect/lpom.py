@@ -1,0 +1,129 @@
+"""People on the ground of a multi-view recording, frame by frame: the LPOM detector and the clustering baseline.
+
+:class:`LpomDetector` builds each frame's occupancy map
+(:mod:`ptztrack.detect.occupancy`) from every view's motion pixels: motion
+edges where the view has video (:func:`ptztrack.detect.motion.motion_edges`,
+against the previous frame), else the outlines of its detector's boxes.
+:class:`ClusteringDetector` clusters the views' box feet on the ground
+(:mod:`ptztrack.detect.clustering`), with blob boxes for views that have
+only video. Both are fed the frames in order.
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ptztrack.detect.clustering import BlobBoxes, Clusters, cluster_feet, feet_on_ground
+from ptztrack.detect.motion import MotionEdgeParameters, box_outline_points, motion_edges
+from ptztrack.detect.occupancy import (
+    GroundGrid,
+    LocusSampling,
+    LocusTable,
+    Modes,
+    locus_table,
+    map_modes,
+    occupancy_map,
+    points_map,
+    table_map,
+)
+from ptztrack.scene.multiview import CameraView, MultiViewRecording
+
+
+@dataclass(frozen=True)
+class LpomParameters:
+    """sampling : the person model and its heights; cell_m : the ground grid's cells;
+    kernel_sigma_m : the density kernel; separation_m : the closest two modes may be;
+    window_m : radius of the disc a mode's mean and covariance are taken over;
+    candidate_strength : modes weaker than this fraction of the strongest are not even candidates;
+    block_px : pixels per side of the blocks the locus tables are kept for;
+    edges : the motion edges; outline_points_per_box : box outline points per box;
+    min_box_score : boxes of lower score are ignored (by the baseline too)."""
+
+    sampling: LocusSampling
+    cell_m: float
+    kernel_sigma_m: float
+    separation_m: float
+    window_m: float
+    candidate_strength: float
+    block_px: int
+    edges: MotionEdgeParameters
+    outline_points_per_box: int
+    min_box_score: float
+
+
+def scored_boxes(view: CameraView, frame: int, min_score: float) -> np.ndarray:
+    """The view's boxes (K, 5) at ``frame`` with a score of at least ``min_score``."""
+    assert view.boxes is not None
+    boxes = view.boxes[frame]
+    return boxes[boxes[:, 4] >= min_score]
+
+
+class LpomDetector:
+    """The occupancy map and its modes for each frame of ``recording``, in order (``detect(frame)``).
+
+    The locus tables of the views with video are computed on construction (``tables``).
+    """
+
+    def __init__(self, recording: MultiViewRecording, parameters: LpomParameters):
+        self.recording, self.parameters = recording, parameters
+        self.grid = GroundGrid.covering(recording.area_m, parameters.cell_m)
+        self.tables: dict[int, LocusTable] = {
+            index: locus_table(
+                view.calibration, view.image_size_px, self.grid, parameters.sampling, parameters.block_px
+            )
+            for index, view in enumerate(recording.views)
+            if view.frames is not None
+        }
+        self._previous: dict[int, tuple[int, np.ndarray]] = {}
+
+    def view_loci(self, index: int, frame: int) -> np.ndarray:
+        """The summed loci (cells,) of view ``index`` at ``frame``."""
+        view, parameters = self.recording.views[index], self.parameters
+        if view.frames is None:
+            outline = box_outline_points(
+                scored_boxes(view, frame, parameters.min_box_score)[:, :4], parameters.outline_points_per_box
+            )
+            return points_map(view.calibration, outline, self.grid, parameters.sampling)
+        image = view.frames(frame)
+        previous_frame, previous = self._previous.get(index, (-1, image))
+        self._previous[index] = (frame, image)
+        if previous_frame != frame - 1:
+            return np.zeros(self.grid.cells)  # the first frame, or after a jump: no motion to see
+        return table_map(self.tables[index], motion_edges(previous, image, parameters.edges))
+
+    def detect(self, frame: int) -> tuple[np.ndarray, Modes]:
+        """The occupancy map (rows, columns) at ``frame`` and its candidate modes."""
+        parameters = self.parameters
+        loci = [self.view_loci(index, frame) for index in range(len(self.recording.views))]
+        weights = [view.weight for view in self.recording.views]
+        pom = occupancy_map(loci, weights, self.grid, parameters.kernel_sigma_m)
+        modes = map_modes(pom, self.grid, parameters.separation_m, parameters.window_m, parameters.candidate_strength)
+        return pom, modes
+
+
+class ClusteringDetector:
+    """The baseline's clusters for each frame of ``recording``, in order (``detect(frame)``).
+
+    linkage_m : the clustering's cut; min_box_score : as LPOM's; blob_min_area_px : the blob
+    boxes' smallest region, for views without a detector's boxes.
+    """
+
+    def __init__(self, recording: MultiViewRecording, linkage_m: float, min_box_score: float, blob_min_area_px: int):
+        self.recording, self.linkage_m, self.min_box_score = recording, linkage_m, min_box_score
+        self.blobs = {
+            index: BlobBoxes(blob_min_area_px) for index, view in enumerate(recording.views) if view.boxes is None
+        }
+
+    def detect(self, frame: int) -> Clusters:
+        ground, views = [], []
+        for index, view in enumerate(self.recording.views):
+            if view.boxes is not None:
+                boxes = scored_boxes(view, frame, self.min_box_score)
+            else:
+                assert view.frames is not None
+                boxes = self.blobs[index].boxes(view.frames(frame))
+            feet_m = feet_on_ground(view.calibration, boxes)
+            feet_m = feet_m[~np.isnan(feet_m[:, 0])]
+            ground.append(feet_m)
+            views.append(np.full(len(feet_m), index))
+        return cluster_feet(np.concatenate(ground), np.concatenate(views), self.linkage_m)

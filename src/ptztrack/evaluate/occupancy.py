@@ -1,0 +1,234 @@
+"""The occupancy-map experiment: LPOM and the clustering baseline on a multi-view recording, scored.
+
+Every frame of the recording goes through both detectors
+(:mod:`ptztrack.detect.lpom`) in order. Each method has one threshold, which
+is fitted on disjoint frames: the frames are split into a first and a
+second half, each half is scored with the threshold that gives the best
+MODA on the other half (two-fold cross-validation; a recording too short to
+split is scored with the threshold fitted on itself, and the rows say so).
+LPOM's threshold is a mode's strength (its value over the frame's largest);
+the baseline's is the number of views that must support a cluster.
+
+Detection is scored as in the multi-view detection literature (MVDet,
+WILDTRACK): per frame, detections and people are matched one to one by the
+Hungarian assignment on ground distances within ``MATCH_RADIUS_M`` (0.5 m);
+MODA = 1 - (false positives + misses) / people, MODP = mean of
+(1 - d / 0.5 m) over the matches, precision, recall, and ``error_m`` the
+mean distance of the matches (the LPOM paper's "mean error"). People
+outside the recording's area are not scored. LPOM's modes also feed the
+ground-plane EKF tracker as measurements of position with the mode's
+covariance (:func:`ptztrack.track.tracker.update_tracks_on_ground`), scored
+by MOTA, MOTP and IDF1 (:func:`ptztrack.evaluate.metrics.clear_metrics`,
+1 m gate).
+"""
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import linear_sum_assignment
+from scipy.spatial.distance import cdist
+
+from ptztrack.detect.clustering import Clusters
+from ptztrack.detect.lpom import ClusteringDetector, LpomDetector
+from ptztrack.detect.occupancy import GroundGrid, Modes
+from ptztrack.evaluate.metrics import clear_metrics
+from ptztrack.scene.multiview import MultiViewRecording
+from ptztrack.track.kalman import constant_velocity_model
+from ptztrack.track.tracker import TrackerParameters, predict_tracks, update_tracks_on_ground
+from ptztrack.types import Tracks
+
+MATCH_RADIUS_M = 0.5
+STRENGTH_CHOICES = tuple(np.round(np.arange(0.05, 1.0, 0.05), 2))
+UNMATCHED_COST = 1e6
+
+
+def detection_metrics(truth_m, detections_m, radius_m: float = MATCH_RADIUS_M) -> dict:
+    """MODA, MODP, precision, recall and the mean error of matched detections over frames.
+
+    truth_m : (T, N, 2) m, NaN where absent; detections_m : per frame, (K_t, 2) m.
+    Also returns the counts: ``matches``, ``false_positives``, ``misses``, ``objects`` (people to find).
+    """
+    distances, false_positives, misses = [], 0, 0
+    for truth, found in zip(truth_m, detections_m, strict=True):
+        truth = truth[~np.isnan(truth[:, 0])]
+        distance_m = cdist(truth, np.asarray(found, dtype=float).reshape(-1, 2))
+        allowed = distance_m <= radius_m
+        rows, columns = linear_sum_assignment(np.where(allowed, distance_m, UNMATCHED_COST))
+        matched = distance_m[rows, columns][allowed[rows, columns]]
+        distances.append(matched)
+        false_positives += len(found) - len(matched)
+        misses += len(truth) - len(matched)
+    matched_m = np.concatenate(distances) if distances else np.zeros(0)
+    objects = len(matched_m) + misses
+    found = len(matched_m) + false_positives
+    return {
+        "moda": 1 - (false_positives + misses) / objects if objects else float("nan"),
+        "modp": float(np.mean(1 - matched_m / radius_m)) if len(matched_m) else float("nan"),
+        "precision": len(matched_m) / found if found else float("nan"),
+        "recall": len(matched_m) / objects if objects else float("nan"),
+        "error_m": float(np.mean(matched_m)) if len(matched_m) else float("nan"),
+        "matches": len(matched_m),
+        "false_positives": false_positives,
+        "misses": misses,
+        "objects": objects,
+    }
+
+
+def scored_truth(recording: MultiViewRecording) -> np.ndarray:
+    """The truth (T, N, 2) m of the recording's frames, NaN outside its area (not scored)."""
+    assert recording.truth is not None
+    truth = recording.truth.positions_m[: recording.frames].copy()
+    (x0, y0), (x1, y1) = recording.area_m
+    with np.errstate(invalid="ignore"):
+        outside = (truth[..., 0] < x0) | (truth[..., 0] > x1) | (truth[..., 1] < y0) | (truth[..., 1] > y1)
+    truth[outside] = np.nan
+    return truth
+
+
+@dataclass(frozen=True)
+class Frames:
+    """What the detectors found in every frame: occupancy maps as (rows, columns) uint8 (scaled to each
+    frame's largest value, for pictures), LPOM's candidate modes and the baseline's clusters."""
+
+    maps_u8: list[np.ndarray]
+    modes: list[Modes]
+    clusters: list[Clusters]
+
+
+def detect_frames(
+    recording: MultiViewRecording,
+    lpom: LpomDetector,
+    clustering: ClusteringDetector,
+    progress: Callable[[int, int], None] | None = None,
+) -> Frames:
+    """Run both detectors over every frame, in order."""
+    maps_u8, modes, clusters = [], [], []
+    for frame in range(recording.frames):
+        pom, found = lpom.detect(frame)
+        peak = pom.max(initial=0.0)
+        maps_u8.append(np.round(255 * pom / peak).astype(np.uint8) if peak > 0 else np.zeros(pom.shape, np.uint8))
+        modes.append(found)
+        clusters.append(clustering.detect(frame))
+        if progress is not None:
+            progress(frame + 1, recording.frames)
+    return Frames(maps_u8, modes, clusters)
+
+
+def halves(frames: int) -> list[tuple[np.ndarray, np.ndarray]]:
+    """(scored frames, fitting frames) pairs: each half fitted on the other, or the whole on itself when
+    there are fewer than 2 frames."""
+    every = np.arange(frames)
+    if frames < 2:
+        return [(every, every)]
+    first, second = every[: frames // 2], every[frames // 2 :]
+    return [(first, second), (second, first)]
+
+
+def fitted_selection(
+    truth_m, scores: list[np.ndarray], positions: list[np.ndarray], choices
+) -> tuple[list, list, np.ndarray]:
+    """Per frame, the detections whose score reaches the threshold fitted on the other half's frames.
+
+    scores, positions : per frame, (K_t,) and (K_t, 2). choices : thresholds to try (the first of the
+    best is taken). Returns the kept positions per frame, the fitted threshold of each half, and per
+    frame (T,) the recall at that threshold on the frames it was fitted on (what the tracker may
+    assume of the detector: it is not measured on the frames it is used for).
+    """
+    kept: list = [None] * len(scores)
+    fitted = []
+    recall = np.zeros(len(scores))
+    for scored, fitting in halves(len(scores)):
+        figures = [
+            detection_metrics(truth_m[fitting], [positions[f][scores[f] >= choice] for f in fitting])
+            for choice in choices
+        ]
+        best = int(np.nanargmax([figure["moda"] for figure in figures]))
+        fitted.append(choices[best])
+        recall[scored] = figures[best]["recall"]
+        for frame in scored:
+            kept[frame] = scores[frame] >= choices[best]
+    return kept, fitted, recall
+
+
+def track_on_ground(
+    modes: list[Modes],
+    recall,
+    frame_rate_hz: float,
+    acceleration_sigma_m_s2: float,
+    parameters: TrackerParameters,
+) -> list[Tracks]:
+    """The ground-plane EKF tracker fed by each frame's modes; the reported tracks per frame.
+
+    recall : (T,) per frame, the probability that the map finds a person who is there (an undetected
+    track's loss of existence; :func:`ptztrack.track.tracker.update_tracks_on_ground`).
+    """
+    F, U = constant_velocity_model(1.0 / frame_rate_hz, acceleration_sigma_m_s2)
+    tracks, reported = Tracks.empty(), []
+    for found, detectable in zip(modes, recall, strict=True):
+        tracks = predict_tracks(tracks, F, U)
+        tracks = update_tracks_on_ground(
+            tracks, found.position_m, found.covariance_m2, parameters, float(detectable)
+        ).tracks
+        reported.append(tracks.confirmed(parameters.confirmation_hits))
+    return reported
+
+
+@dataclass(frozen=True)
+class OccupancyRun:
+    """One recording's experiment: the rows (one per method), what each frame kept, the tracks."""
+
+    rows: list[dict]
+    frame_rate_hz: float
+    grid: GroundGrid
+    frames: Frames
+    lpom: list[Modes]
+    clustering: list[Clusters]
+    tracks: list[Tracks]
+    truth_m: np.ndarray
+
+
+def score_recording(
+    recording: MultiViewRecording,
+    grid: GroundGrid,
+    frames: Frames,
+    acceleration_sigma_m_s2: float,
+    tracker: TrackerParameters,
+    label: dict | None = None,
+) -> OccupancyRun:
+    """Fit each method's threshold on disjoint frames, score both, and track LPOM's modes.
+
+    label : keys added to both rows (e.g. ``{"people": 3}``).
+    """
+    truth_m = scored_truth(recording)
+    kept_modes, strengths, recall = fitted_selection(
+        truth_m, [m.strength for m in frames.modes], [m.position_m for m in frames.modes], STRENGTH_CHOICES
+    )
+    lpom = [found.select(keep) for found, keep in zip(frames.modes, kept_modes, strict=True)]
+    views = tuple(range(1, len(recording.views) + 1))
+    kept_clusters, min_views, _ = fitted_selection(
+        truth_m, [c.views for c in frames.clusters], [c.position_m for c in frames.clusters], views
+    )
+    clustering = [found.select(keep) for found, keep in zip(frames.clusters, kept_clusters, strict=True)]
+    tracks = track_on_ground(lpom, recall, recording.frame_rate_hz, acceleration_sigma_m_s2, tracker)
+    tracking = clear_metrics(truth_m, [t.ids for t in tracks], [t.mean[:, :2] for t in tracks])
+    common = {"dataset": recording.name, **(label or {}), "frames": recording.frames, "views": len(recording.views)}
+    rows = [
+        {
+            "method": "lpom",
+            **common,
+            **detection_metrics(truth_m, [m.position_m for m in lpom]),
+            "fitted_min_strength": [float(value) for value in strengths],
+            "mota": tracking["mota"],
+            "motp_m": tracking["motp_m"],
+            "idf1": tracking["idf1"],
+            "switches": tracking["switches"],
+        },
+        {
+            "method": "clustering",
+            **common,
+            **detection_metrics(truth_m, [c.position_m for c in clustering]),
+            "fitted_min_views": [int(value) for value in min_views],
+        },
+    ]
+    return OccupancyRun(rows, recording.frame_rate_hz, grid, frames, lpom, clustering, tracks, truth_m)

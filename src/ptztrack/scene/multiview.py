@@ -1,0 +1,115 @@
+"""Calibrated multi-view recordings: fixed cameras, their frames or detections, and the people on the ground.
+
+A :class:`MultiViewRecording` is what the occupancy-map experiment reads,
+whatever it came from: a video, a folder of images or a MOTChallenge
+detection file per view, and ground truth in the MOTChallenge layout with
+world metres (columns 8-9). The builders assemble one from a dataset file
+(:mod:`ptztrack.builders.occupancy`) or from the synthetic room
+(:mod:`ptztrack.scene.room`). Any problem with a file gets a
+:class:`~ptztrack.scene.pets.DatasetError` naming it.
+"""
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+import cv2
+import numpy as np
+
+from ptztrack.geometry.calibration import PinholeCalibration
+from ptztrack.scene.pets import DatasetError, load_mot_ground_truth, read_mot_rows, recorded_scene
+from ptztrack.types import GroundTruth
+
+FrameSource = Callable[[int], np.ndarray]
+"""``frame(index) -> (height, width, 3) uint8 BGR``: a view's image at a 0-based frame."""
+
+IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff")
+
+
+@dataclass(frozen=True)
+class CameraView:
+    """One fixed calibrated camera of a recording.
+
+    name : how the view is called; calibration : its pinhole model (world in mm);
+    image_size_px : (width, height), None where nothing needs it (a view with boxes only and a
+    calibration that does not say); frames : its images, or None where there is no video;
+    boxes : per frame, a detector's boxes (K, 5) as (left, top, width, height, score) px, or None;
+    weight : its weight ``w_c`` in the occupancy map.
+    """
+
+    name: str
+    calibration: PinholeCalibration
+    image_size_px: tuple[int, int] | None
+    frames: FrameSource | None
+    boxes: list[np.ndarray] | None
+    weight: float = 1.0
+
+
+@dataclass(frozen=True)
+class MultiViewRecording:
+    """Fixed cameras watching the same ground.
+
+    views : the cameras; frames : how many frames (0-based indices below this);
+    frame_rate_hz : frames per second; area_m : [[x0, y0], [x1, y1]] the ground the map covers
+    (people outside it are not scored); truth : the people, positions (frames, N, 2) m, or None.
+    """
+
+    name: str
+    views: tuple[CameraView, ...]
+    frames: int
+    frame_rate_hz: float
+    area_m: np.ndarray
+    truth: GroundTruth | None
+
+
+def load_mot_detections(path: str | Path) -> list[np.ndarray]:
+    """A MOTChallenge detection file (``frame,-1,left,top,width,height,score,...``, frames from 1)
+    as per-frame boxes (K, 5) ``(left, top, width, height, score)``, from frame 0 to the file's last."""
+    table = read_mot_rows(path, "detection")
+    frame = table[:, 0].astype(int) - 1
+    frames = frame.max() + 1
+    if np.any((table[:, 4] <= 0) | (table[:, 5] <= 0)):
+        raise DatasetError(f"{path}: a box has a width or height that is not positive")
+    order = np.argsort(frame, kind="stable")
+    boxes = table[order][:, 2:7]
+    bounds = np.searchsorted(frame[order], np.arange(frames + 1))
+    return [boxes[bounds[index] : bounds[index + 1]] for index in range(frames)]
+
+
+class ImageFolder:
+    """The images of a folder as frames, in the order of their sorted file names (``frame(index)``),
+    each checked to be ``expected_size_px`` (width, height) when given."""
+
+    def __init__(self, path: str | Path, expected_size_px: tuple[int, int] | None = None):
+        self.path = Path(path)
+        if not self.path.is_dir():
+            raise DatasetError(f"{self.path}: no such image folder")
+        self.files = sorted(file for file in self.path.iterdir() if file.suffix.lower() in IMAGE_SUFFIXES)
+        if not self.files:
+            raise DatasetError(f"{self.path}: no images ({', '.join(IMAGE_SUFFIXES)})")
+        self.expected_size_px = expected_size_px
+
+    def __len__(self) -> int:
+        return len(self.files)
+
+    def frame(self, index: int) -> np.ndarray:
+        image = cv2.imread(str(self.files[index]), cv2.IMREAD_COLOR)
+        if image is None:
+            raise DatasetError(f"{self.files[index]}: OpenCV cannot read this image")
+        if self.expected_size_px is not None and image.shape[1::-1] != tuple(self.expected_size_px):
+            raise DatasetError(
+                f"{self.files[index]}: {image.shape[1]}x{image.shape[0]} px, expected "
+                f"{self.expected_size_px[0]}x{self.expected_size_px[1]} (the calibration's image size)"
+            )
+        return image
+
+
+def mot_truth(path: str | Path, frames: int, frame_rate_hz: float) -> GroundTruth:
+    """Ground truth (frames, N, 2) m from a MOTChallenge file with world metres in columns 8-9."""
+    annotations = load_mot_ground_truth(path)
+    if np.any(np.isnan(annotations.ground_m)):
+        raise DatasetError(f"{path}: columns 8-9 (world x, y in metres) must be numbers")
+    scene = recorded_scene(annotations, 1, frames, frame_rate_hz)
+    positions_m = np.full((frames, scene.truth.positions_m.shape[1], 2), np.nan)
+    positions_m[scene.video_frame] = scene.truth.positions_m
+    return GroundTruth(positions_m, scene.truth.heights_m, scene.truth.widths_m, frame_rate_hz)

@@ -1,0 +1,220 @@
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pytest
+
+from ptztrack.cli import main
+from ptztrack.config import dataset_from_dict, load_dataset, pets_dataset
+from ptztrack.evaluate.occupancy import detection_metrics, fitted_selection, halves
+from ptztrack.geometry.calibration import project_pinhole
+from ptztrack.scene.room import RoomLayout, RoomRenderer, room_truth
+
+PETS = Path(__file__).resolve().parents[1] / "src" / "ptztrack" / "data" / "pets2009_s2l1"
+NAN = np.nan
+
+
+def test_detection_metrics_count_matches_within_the_radius_one_to_one():
+    truth = np.array([[[0.0, 0.0], [3.0, 0.0], [NAN, NAN]], [[0.0, 0.0], [NAN, NAN], [NAN, NAN]]])
+    found = [np.array([[0.1, 0.0], [0.0, 0.2], [3.6, 0.0]]), np.zeros((0, 2))]
+    metrics = detection_metrics(truth, found)
+    # Frame 0: (0,0) matched at 0.1 m, the other detection near it is a false positive, (3,0) is 0.6 m
+    # from its detection: a miss and a false positive. Frame 1: a miss.
+    assert (metrics["matches"], metrics["false_positives"], metrics["misses"], metrics["objects"]) == (1, 2, 2, 3)
+    assert metrics["moda"] == pytest.approx(1 - 4 / 3)
+    assert metrics["modp"] == pytest.approx(1 - 0.1 / 0.5)
+    assert metrics["precision"] == pytest.approx(1 / 3) and metrics["recall"] == pytest.approx(1 / 3)
+    assert metrics["error_m"] == pytest.approx(0.1)
+
+
+def test_each_half_is_scored_with_the_threshold_fitted_on_the_other():
+    truth = np.zeros((4, 1, 2))
+    positions = [np.array([[0.0, 0.0], [2.0, 2.0]])] * 4
+    # First half: the ghost is weaker than the person; second half: stronger. Fitting on the second half
+    # keeps everything up to its person's 0.3 (and the first half's ghost at 0.2 is kept too).
+    scores = [np.array([0.9, 0.2]), np.array([0.9, 0.2]), np.array([0.3, 0.5]), np.array([0.3, 0.5])]
+    kept, fitted, recall = fitted_selection(truth, scores, positions, (0.1, 0.25, 0.4, 0.6))
+    assert fitted == [0.1, 0.25]
+    np.testing.assert_array_equal(recall, [1.0, 1.0, 1.0, 1.0])  # each half's threshold finds the person
+    assert [k.tolist() for k in kept] == [[True, True], [True, True], [True, True], [True, True]]
+    assert [(scored.tolist(), fitting.tolist()) for scored, fitting in halves(5)] == [
+        ([0, 1], [2, 3, 4]),
+        ([2, 3, 4], [0, 1]),
+    ]
+
+
+def write_room_dataset(directory: Path, frames: int = 8, seed: int = 5) -> Path:
+    """A small synthetic room in the generic format: image folders, a pinhole JSON, ground truth, and one
+    view given only by boxes (the truth's, projected)."""
+    layout = RoomLayout(image_size_px=(320, 240), focal_px=156.0)
+    truth = room_truth(layout, 1, frames, seed)
+    renderer = RoomRenderer(layout, truth, seed)
+    calibrations = {}
+    for view, camera in enumerate(renderer.cameras):
+        name = f"camera_{view + 1}"
+        calibrations[name] = {
+            "K": camera.K.tolist(),
+            "dist": camera.dist.tolist(),
+            "R": camera.R.tolist(),
+            "t": camera.t.tolist(),
+        }
+        (directory / name).mkdir()
+        for frame in range(frames):
+            cv2.imwrite(str(directory / name / f"{frame:04d}.png"), renderer.image(view, frame))
+    (directory / "cameras.json").write_text(json.dumps(calibrations))
+    x, y = truth.positions_m[:, 0].T
+    rows = [f"{f + 1},1,-1,-1,-1,-1,1,{float(x[f])!r},{float(y[f])!r},0" for f in range(frames)]
+    (directory / "gt.txt").write_text("\n".join(rows) + "\n")
+    feet = project_pinhole(renderer.cameras[0], np.stack([x, y, 0 * x], -1) * 1000)
+    head = project_pinhole(renderer.cameras[0], np.stack([x, y, 0 * x + truth.heights_m[0]], -1) * 1000)
+    height = feet[:, 1] - head[:, 1]
+    boxes = [
+        f"{f + 1},-1,{feet[f, 0] - 0.15 * height[f]},{head[f, 1]},{0.3 * height[f]},{height[f]},0.9,-1,-1,-1"
+        for f in range(frames)
+    ]
+    (directory / "boxes.txt").write_text("\n".join(boxes) + "\n")
+    views = "".join(f"  - {{name: camera_{v}, calibration: cameras.json, images: camera_{v}}}\n" for v in (1, 2, 3, 4))
+    views += "  - {name: boxes, calibration: cameras.json, calibration_view: camera_1, detections: boxes.txt}\n"
+    path = directory / "room.yaml"
+    path.write_text(
+        f"name: small-room\nframe_rate_hz: 15\narea_m: [[0, 0], [5, 6]]\nground_truth: gt.txt\nviews:\n{views}"
+        "occupancy: {cell_m: 0.1, kernel_sigma_m: 0.15}\n"
+    )
+    return path
+
+
+def test_a_dataset_in_the_generic_format_runs_and_writes_its_outputs(tmp_path, capsys):
+    path = write_room_dataset(tmp_path)
+    out, rows_path = tmp_path / "out", tmp_path / "rows.json"
+    assert (
+        main(["experiment", "occupancy", str(path), "--json", str(rows_path), "--out", str(out), "--images-every", "4"])
+        == 0
+    )
+    rows = json.loads(rows_path.read_text())
+    assert [row["method"] for row in rows] == ["lpom", "clustering"]
+    for row in rows:
+        assert {"moda", "modp", "precision", "recall", "error_m"} <= set(row) and row["views"] == 5
+    assert {"mota", "motp_m", "idf1"} <= set(rows[0])
+    assert rows[0]["recall"] > 0.5
+    written = out / "small-room"
+    assert {p.name for p in written.iterdir()} >= {
+        "metrics.json",
+        "detections.csv",
+        "tracks.csv",
+        "maps",
+        "occupancy.mp4",
+    }
+    assert sorted(p.name for p in (written / "maps").iterdir()) == ["frame_00000.png", "frame_00004.png"]
+    assert "lpom" in capsys.readouterr().out
+
+
+def run_cli(*arguments) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "ptztrack.cli", *arguments], capture_output=True, text=True)
+
+
+def one_line_error(result: subprocess.CompletedProcess) -> str:
+    assert result.returncode == 2, result.stderr
+    assert "Traceback" not in result.stderr
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1, result.stderr
+    return lines[0]
+
+
+def test_a_malformed_dataset_file_exits_2_with_one_line_naming_file_and_field(tmp_path, capsys):
+    path = tmp_path / "bad.yaml"
+    path.write_text("frame_rate_hz: 10\nviews: [\n")
+    line = one_line_error(run_cli("experiment", "occupancy", str(path)))  # the command itself: no traceback
+    assert str(path) in line and "not valid YAML" in line, line
+    area = "frame_rate_hz: 10\narea_m: [[0, 0], [1, 1]]\n"
+    for text, expected in (
+        (area + "views: [{name: a, video: v.avi, calibration: c.xml}]\nviewz: 1\n", "viewz: unknown key"),
+        (area + "views: []\n", "views: List should have at least 1 item"),
+        (area + "views: [{name: a, video: v.avi}]\n", "views.0.calibration: Field required"),
+        (
+            area + "views: [{name: a, calibration: c.xml}]\n",
+            "views.0: a view needs video, images or detections",
+        ),
+    ):
+        path.write_text(text)
+        assert main(["experiment", "occupancy", str(path)]) == 2
+        lines = capsys.readouterr().err.strip().splitlines()
+        assert len(lines) == 1 and str(path) in lines[0] and expected in lines[0], lines
+
+
+def test_a_missing_view_exits_2_naming_the_file(tmp_path, capsys):
+    path = write_room_dataset(tmp_path, frames=2)
+    path.write_text(path.read_text().replace("calibration_view: camera_1", "calibration_view: camera_9"))
+    assert main(["experiment", "occupancy", str(path)]) == 2
+    line = capsys.readouterr().err.strip()
+    assert "cameras.json" in line and "no view 'camera_9'" in line
+    path.write_text(path.read_text().replace("images: camera_2", "images: camera_22"))
+    assert main(["experiment", "occupancy", str(path)]) == 2
+    assert "camera_22: no such image folder" in capsys.readouterr().err
+
+
+def test_a_calibration_of_the_wrong_size_exits_2_naming_file_and_field(tmp_path, capsys):
+    path = tmp_path / "pets.yaml"
+    path.write_text(
+        "frame_rate_hz: 10\narea_m: [[-20, -17], [8, 8]]\nviews:\n"
+        f"  - {{name: View_001, calibration: {PETS / 'View_001.xml'}, image_size_px: [720, 576], "
+        f"detections: {PETS / 'View_001_det.txt.gz'}}}\n"
+    )
+    assert main(["experiment", "occupancy", str(path)]) == 2
+    line = capsys.readouterr().err.strip()
+    assert "View_001.xml" in line and "views.0.image_size_px" in line and "768x576" in line
+    room = write_room_dataset(tmp_path / "room", frames=2) if (tmp_path / "room").mkdir() is None else None
+    assert room is not None
+    room.write_text(room.read_text().replace("images: camera_3}", "images: camera_3, image_size_px: [640, 480]}"))
+    assert main(["experiment", "occupancy", str(room)]) == 2
+    line = capsys.readouterr().err.strip()
+    assert "cameras.json" in line and "views.2" in line and "640x480" in line and "320x240" in line
+
+
+@pytest.mark.slow
+def test_the_synthetic_room_meets_the_papers_accuracy(tmp_path):
+    """Acceptance: mean position error <= 0.08 m with 1 and with 3 people, MODA >= 90 %."""
+    rows_path = tmp_path / "room.json"
+    assert main(["experiment", "occupancy", "synthetic-room", "--json", str(rows_path)]) == 0
+    rows = json.loads(rows_path.read_text())
+    lpom = {row["people"]: row for row in rows if row["method"] == "lpom"}
+    assert sorted(lpom) == [1, 3] and {row["people"] for row in rows if row["method"] == "clustering"} == {1, 3}
+    for row in lpom.values():
+        assert row["error_m"] <= 0.08 and row["moda"] >= 0.9, row
+
+
+@pytest.mark.slow
+def test_pets_runs_with_seven_views(tmp_path):
+    rows_path = tmp_path / "pets.json"
+    assert main(["experiment", "occupancy", "pets", "--frames", "60", "--json", str(rows_path)]) == 0
+    rows = json.loads(rows_path.read_text())
+    assert [row["method"] for row in rows] == ["lpom", "clustering"]
+    assert all(row["views"] == 7 and row["frames"] == 60 for row in rows) and "mota" in rows[0]
+
+
+def test_the_example_dataset_file_is_the_built_in_pets_dataset():
+    example = load_dataset(Path(__file__).resolve().parents[1] / "examples" / "pets_occupancy.yaml")
+    built_in = pets_dataset()
+    resolved = [
+        view.model_copy(update={k: str(Path(getattr(view, k)).resolve()) for k in ("calibration", "detections")})
+        for view in example.views
+    ]
+    assert [(v.name, Path(v.calibration).name, Path(v.detections).name, v.video is not None) for v in resolved] == [
+        (v.name, Path(v.calibration).name, Path(str(v.detections)).name, v.video is not None) for v in built_in.views
+    ]
+    assert all(Path(v.calibration).is_file() and Path(str(v.detections)).is_file() for v in resolved)
+    assert example.occupancy == built_in.occupancy and example.area_m == built_in.area_m
+    assert example.frame_rate_hz == built_in.frame_rate_hz and example.tracker == built_in.tracker
+
+
+def test_a_partial_tracker_section_keeps_the_occupancy_trackers_confirmation():
+    data = {
+        "frame_rate_hz": 10,
+        "area_m": [[0, 0], [1, 1]],
+        "views": [{"name": "a", "calibration": "c.xml", "video": "v"}],
+    }
+    assert dataset_from_dict(data).tracker.confirmation_hits == 2
+    assert dataset_from_dict({**data, "tracker": {"gate_probability": 0.95}}).tracker.confirmation_hits == 2
+    assert dataset_from_dict({**data, "tracker": {"confirmation_hits": 1}}).tracker.confirmation_hits == 1
