@@ -38,6 +38,7 @@ def particle_filter_parameters(scenario: Scenario) -> ParticleFilterParameters:
         lambda_motion=follow.lambda_motion,
         walk_sigma=follow.walk_heights_per_s * step_s,
         scale_sigma=follow.scale_change_per_s * step_s,
+        velocity_gain=1.0 - smoothing_pole(scenario) if follow.prediction == "constant_velocity" else 0.0,
         loss_fraction=follow.loss_fraction,
         adapt_fraction=follow.adapt_fraction,
         reference_rate=min(1.0, step_s / follow.reference_time_constant_s),

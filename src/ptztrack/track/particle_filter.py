@@ -15,7 +15,8 @@ Each step (:func:`step_filter`):
 1. resample the particles by their previous weights, deterministically
    (systematic resampling: one uniform draw, then evenly spaced);
 2. predict by a random walk (equation 1): Gaussian steps of ``walk_sigma``
-   box heights in x and y and a relative ``scale_sigma`` in h;
+   box heights in x and y and a relative ``scale_sigma`` in h, about the
+   particles moved by the person's image velocity (see below);
 3. weigh by the product of the colour and motion likelihoods (equations 3-5;
    :mod:`ptztrack.track.colour_model`, :mod:`ptztrack.track.motion_image`),
    computed in logarithms so that no weight underflows;
@@ -43,6 +44,14 @@ The diffuse prior is Gaussian in x and y around the last estimate,
 ``search_sigma`` box heights across plus ``walk_sigma`` for every step lost
 (the person walks on) up to the image's size, and log-normal in h with
 ``search_scale_sigma``.
+
+Velocity. The paper's walk has no drift: a person who walks past another of
+similar colours leaves the particles to whichever of the two the random
+walk favours. Here the random walk is centred on a constant-velocity
+prediction: every particle moves by the estimate's velocity (px per step),
+an exponential average, with weight ``velocity_gain``, of the estimate's
+steps. ``velocity_gain`` 0 is the paper's walk; while lost, and when the
+track is back, the velocity is 0.
 
 Likelihoods: colour from the patches' hue-saturation histograms, motion
 ``exp(-E^2 / lambda_mot)`` with E the fraction of non-moving pixels under the
@@ -78,6 +87,7 @@ class ParticleFilterParameters:
     lambda_colour, lambda_motion : equations 3 and 4.
     lambda_loss : the colour likelihood's lambda in the loss test (``likelihood``, ``P_ref``).
     walk_sigma : random-walk step of x and y in box heights; scale_sigma : relative step of h.
+    velocity_gain : the weight of the last step in the velocity's exponential average; 0: no velocity.
     loss_fraction, adapt_fraction, reference_rate : the loss test and the adaptation of ``P_ref``.
     search_sigma, search_scale_sigma : the diffuse prior after a loss (see the module).
     motion_threshold : grey levels; motion_decay : per step; motion_scale : resolution of the motion image.
@@ -94,6 +104,7 @@ class ParticleFilterParameters:
     lambda_loss: float
     walk_sigma: float
     scale_sigma: float
+    velocity_gain: float
     loss_fraction: float
     adapt_fraction: float
     reference_rate: float
@@ -112,7 +123,7 @@ class ParticleFilter:
     estimate : (3,) the weighted mean (equation 6); likelihood : its colour likelihood P(z_col | s_t).
     reference : (K, B) the patches' reference histograms (B bins); aspect : box width / height.
     reference_likelihood : P_ref (None before the first step); lost_steps : steps lost (0 while tracking).
-    motion : the motion history image.
+    motion : the motion history image; velocity_px : (2,) the estimate's velocity, px per step.
     """
 
     particles: np.ndarray
@@ -124,6 +135,7 @@ class ParticleFilter:
     reference_likelihood: float | None
     lost_steps: int
     motion: MotionImage
+    velocity_px: np.ndarray
 
     @property
     def lost(self) -> bool:
@@ -176,6 +188,7 @@ def start_filter(image_bgr, box_px, parameters: ParticleFilterParameters) -> Par
         reference_likelihood=None,
         lost_steps=0,
         motion=first_motion_image(image_bgr, parameters.motion_scale),
+        velocity_px=np.zeros(2),
     )
 
 
@@ -188,6 +201,8 @@ def step_filter(
     )
     last = carry_states(state.estimate, homography)
     carried = carry_states(state.particles, homography)
+    # The velocity carried into this view: where the estimate's next position maps, less where it maps.
+    velocity_px = carry_states(state.estimate + np.r_[state.velocity_px, 0.0], homography)[:2] - last[:2]
     if state.lost:
         kept = parameters.search_particles // 2
         chosen = carried[systematic_resample(state.weights, kept, rng)]
@@ -197,7 +212,7 @@ def step_filter(
         )
         particles = np.vstack([_random_walk(chosen, parameters.walk_sigma, parameters.scale_sigma, rng), fresh])
     else:
-        chosen = carried[systematic_resample(state.weights, parameters.particles, rng)]
+        chosen = carried[systematic_resample(state.weights, parameters.particles, rng)] + np.r_[velocity_px, 0.0]
         particles = _random_walk(chosen, parameters.walk_sigma, parameters.scale_sigma, rng)
     # The weighted mean's box lies within the particles' boxes' extent: one region of bins serves both.
     region = _ColourRegion.of(image_bgr, particles, state.aspect, parameters)
@@ -217,6 +232,11 @@ def step_filter(
         reference += parameters.reference_rate * (state.likelihood - reference)
     found = likelihood >= parameters.loss_fraction * reference
     lost_steps = 0 if found else state.lost_steps + 1
+    if state.lost or lost_steps:
+        velocity_px = np.zeros(2)
+    else:
+        gain = parameters.velocity_gain
+        velocity_px = gain * (estimate[:2] - last[:2]) + (1 - gain) * velocity_px
     if state.lost and found:
         survivors = systematic_resample(weights, parameters.particles, rng)
         particles, weights = particles[survivors], np.full(parameters.particles, 1.0 / parameters.particles)
@@ -229,6 +249,7 @@ def step_filter(
         reference_likelihood=reference,
         lost_steps=lost_steps,
         motion=motion,
+        velocity_px=velocity_px,
     )
 
 
