@@ -6,12 +6,15 @@ expected: 2 for a clean one-line error, 0 where the input is legitimate.
 Used by tests/test_bad_inputs.py and benchmarks/bad_inputs.py.
 """
 
+import functools
+import gzip
 import os
 import subprocess
 import sys
 import tempfile
 import threading
 import time
+import zlib
 from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
@@ -30,7 +33,7 @@ A_FEW_STEPS = ["--frames", "2"]
 class Case:
     name: str
     argv: tuple[str, ...]
-    files: dict[str, bytes | str] = field(default_factory=dict)
+    files: dict[str, bytes | str | None] = field(default_factory=dict)  # None: no such file
     exit_status: int = 2
 
 
@@ -88,6 +91,37 @@ YAML_DEEP_LAUGHS = (
 XML_LAUGHS = '<!ENTITY a "aaaaaaaaaa">' + "".join(
     f'<!ENTITY {chr(98 + level)} "{("&" + chr(97 + level) + ";") * 10}">' for level in range(8)
 )
+
+
+DETECTION_ROWS = ["1,-1,300,200,40,100,0.9,-1,-1,-1", "2,-1,302,201,40,100,0.9,-1,-1,-1"]
+
+
+def _dataset(
+    name: str,
+    view: str = "detections: det.txt",
+    top: str = "",
+    files: dict | None = None,
+    extra: tuple = (),
+    exit_status: int = 2,
+) -> Case:
+    """A one-view PETS dataset file (``view``: the view's fields besides its name and calibration;
+    ``top``: more top-level lines), its calibration, two frames of detections and the first
+    ground-truth rows; run by ``experiment occupancy``."""
+    document = (
+        "frame_rate_hz: 10\narea_m: [[-20, -15], [20, 25]]\nground_truth: gt.txt\n"
+        f"views:\n  - {{name: View_001, calibration: c.xml, {view}}}\n{top}"
+    )
+    given = {"d.yaml": document, "c.xml": TSAI, "det.txt": "\n".join(DETECTION_ROWS) + "\n"}
+    given["gt.txt"] = _ground_truth([row for row in GROUND_TRUTH_ROWS if row.split(",")[0] in ("1", "2")])
+    return Case(name, ("experiment", "occupancy", "{dir}/d.yaml", *extra), {**given, **(files or {})}, exit_status)
+
+
+@functools.cache
+def _gzip_bomb(uncompressed_bytes: int) -> bytes:
+    """A gzip file of ``uncompressed_bytes`` of commas, made in pieces (about 1000 times smaller)."""
+    compressor = zlib.compressobj(9, zlib.DEFLATED, 16 + zlib.MAX_WBITS)
+    piece = b"," * 1_000_000
+    return b"".join(compressor.compress(piece) for _ in range(uncompressed_bytes // len(piece))) + compressor.flush()
 
 
 def cases(scratch: Path | None) -> list[Case]:
@@ -184,6 +218,26 @@ def cases(scratch: Path | None) -> list[Case]:
         _recording("ground truth negative frame", "--gt", "gt.txt", _ground_truth([_with_field(truth[0], 0, "-3")])),
         _recording("calibration empty", "--calibration", "c.json", ""),
         _recording("calibration binary", "--calibration", "c.xml", b"\x00\xff" * 50),
+        _dataset("dataset: a good one", exit_status=0),
+        Case("dataset missing", ("experiment", "occupancy", "{dir}/missing.yaml")),
+        Case("dataset a list", ("experiment", "occupancy", "{dir}/d.yaml"), {"d.yaml": "- 1\n- 2\n"}),
+        _dataset("dataset duplicate keys", top="frame_rate_hz: 15\n"),
+        _dataset("dataset frames 1e9", top="frames: 1000000000\n"),
+        _dataset("dataset cell_m 1e-5", top="occupancy: {cell_m: 0.00001}\n"),
+        _dataset("dataset samples 1e9", top="occupancy: {samples_per_height: 1000000000}\n"),
+        _dataset("dataset view without evidence", view="weight: 1"),
+        _dataset("dataset view calibration missing", files={"c.xml": None}),
+        _dataset("dataset calibration of another size", view="detections: det.txt, image_size_px: [640, 480]"),
+        _dataset("detections frame 1e9", files={"det.txt": "1000000000,-1,300,200,40,100,0.9,-1,-1,-1\n"}),
+        _dataset("detections a box of width 0", files={"det.txt": "1,-1,300,200,0,100,0.9,-1,-1,-1\n"}),
+        _dataset("detections 9 fields", files={"det.txt": "1,-1,300,200,40,100,0.9,-1,-1\n"}),
+        _dataset("detections gzip bomb", view="detections: det.txt.gz", files={"det.txt.gz": _gzip_bomb(210_000_000)}),
+        _dataset(
+            "detections gzip truncated",
+            view="detections: det.txt.gz",
+            files={"det.txt.gz": gzip.compress(b"1,-1,300,200,40,100,0.9,-1,-1,-1\n" * 100)[:-8]},
+        ),
+        _dataset("occupancy --out not empty", files={"out/keep.txt": "keep me\n"}, extra=("--out", "{dir}/out")),
     ]
 
 
@@ -199,6 +253,8 @@ def run_case(case: Case, directory: Path, timeout_s: float = 60.0) -> Outcome:
     """Write the case's files into ``directory`` and run the command in a fresh process, measuring its
     wall time and peak resident memory."""
     for name, content in case.files.items():
+        if content is None:
+            continue
         path = directory / name
         path.parent.mkdir(parents=True, exist_ok=True)
         if isinstance(content, bytes):

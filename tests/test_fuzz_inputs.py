@@ -4,6 +4,7 @@ never another exception. Derandomised, so that a run is repeatable; the examples
 ``EXAMPLES``.
 """
 
+import gzip
 import math
 import re
 from importlib import resources
@@ -17,10 +18,19 @@ from hypothesis import strategies as st
 from bad_inputs import video_bytes
 from ptztrack.builders.budget import refuse_if_too_large
 from ptztrack.builders.episode import run_episode
-from ptztrack.config import Scenario, ScenarioError, load_scenario, scenario_from_dict
+from ptztrack.config import (
+    MultiViewDataset,
+    Scenario,
+    ScenarioError,
+    dataset_from_dict,
+    load_dataset,
+    load_scenario,
+    scenario_from_dict,
+)
 from ptztrack.files import InputError
 from ptztrack.geometry.calibration import load_calibration
 from ptztrack.geometry.registration import ReferenceIndex, load_index, save_index
+from ptztrack.scene.multiview import load_mot_detections
 from ptztrack.scene.pets import RecordedVideo, load_cvml, load_mot_ground_truth
 
 EXAMPLES = 200
@@ -34,6 +44,7 @@ FUZZ = settings(
 )
 PETS = resources.files("ptztrack.data") / "pets2009_s2l1"
 EXAMPLE_SCENARIO = Path(__file__).parents[1] / "examples" / "scenario.yaml"
+EXAMPLE_DATASET = Path(__file__).parents[1] / "examples" / "pets_occupancy.yaml"
 
 # Values a user might write by mistake: near the edges of every range, and of the wrong kind.
 NEAR_MISSES = st.one_of(
@@ -153,6 +164,37 @@ def _read_mutated(tmp_path: Path, name: str, data: bytes, reader) -> None:
 @given(data=mutations(EXAMPLE_SCENARIO.read_bytes()))
 def test_a_mutated_scenario_file_is_read_or_refused_in_one_line(tmp_path, data):
     _read_mutated(tmp_path, "scenario.yaml", data, load_scenario)
+
+
+@FUZZ
+@given(documents(MultiViewDataset))
+def test_a_dataset_document_is_a_dataset_or_one_clean_error(document):
+    try:
+        dataset_from_dict(document, "fuzz")
+    except ScenarioError as error:
+        one_clean_line(error)
+
+
+@FUZZ
+@given(data=mutations(EXAMPLE_DATASET.read_bytes()))
+def test_a_mutated_dataset_file_is_read_or_refused_in_one_line(tmp_path, data):
+    _read_mutated(tmp_path, "dataset.yaml", data, load_dataset)
+
+
+DETECTIONS_HEAD = b"".join(gzip.decompress((PETS / "View_003_det.txt.gz").read_bytes()).splitlines(keepends=True)[:30])
+
+
+@FUZZ
+@given(data=mutations(DETECTIONS_HEAD), compressed=st.booleans())
+def test_mutated_detections_are_read_or_refused_in_one_line(tmp_path, data, compressed):
+    name, content = ("det.txt.gz", gzip.compress(data)) if compressed else ("det.txt", data)
+    _read_mutated(tmp_path, name, content, lambda path: load_mot_detections(path, 100_000))
+
+
+@FUZZ
+@given(data=mutations(gzip.compress(DETECTIONS_HEAD)))
+def test_a_mutated_gzip_file_is_read_or_refused_in_one_line(tmp_path, data):
+    _read_mutated(tmp_path, "det.txt.gz", data, lambda path: load_mot_detections(path, 100_000))
 
 
 GROUND_TRUTH_HEAD = b"".join((PETS / "gt_mot15.txt").read_bytes().splitlines(keepends=True)[:30])

@@ -506,6 +506,8 @@ def _first_error_line(error: pydantic.ValidationError, source: str) -> str:
         message = "unknown key"
     elif first["type"] == "value_error":
         message = str(first["ctx"]["error"])
+    if isinstance(first["input"], dict):  # a section's own check, whose message names its fields
+        return f"{source}: {field}: {message}"
     return f"{source}: {field}: {message} (got {shown(first['input'])})"
 
 
@@ -712,11 +714,11 @@ class DatasetView(_Strict):
     name: str
     calibration: str
     calibration_view: str | None = None
-    image_size_px: tuple[Annotated[int, Field(gt=0)], Annotated[int, Field(gt=0)]] | None = None
+    image_size_px: tuple[Pixels, Pixels] | None = None
     video: str | None = None
     images: str | None = None
     detections: str | None = None
-    weight: PositiveFloat = 1.0
+    weight: Annotated[PositiveFloat, at_most(1e6, "a relative weight")] = 1.0
 
     @model_validator(mode="after")
     def _has_evidence(self):
@@ -725,6 +727,15 @@ class DatasetView(_Strict):
         if self.video is None and self.images is None and self.detections is None:
             raise ValueError("a view needs video, images or detections")
         return self
+
+
+_PersonHeight = Annotated[PositiveFloat, at_most(10, "metres: a person")]
+_GroundDistance = Annotated[PositiveFloat, at_most(1000, "metres")]
+_LOCUS_MEMORY = "memory: the locus tables hold every block's points for every height"
+MAX_PERSON_HEIGHTS = 100
+MAX_GROUND_CELLS = 10_000_000
+MAX_DATASET_FRAMES = _MAX_FRAMES
+"""Cells of an occupancy map: 80 MB a map in float64, several kept per frame."""
 
 
 class Occupancy(_Strict):
@@ -740,29 +751,35 @@ class Occupancy(_Strict):
     min_views (None: fitted like min_strength), blob_min_area_px (blob boxes of views without detections).
     """
 
-    min_height_m: PositiveFloat = 1.6
-    max_height_m: PositiveFloat = 1.9
-    height_step_m: PositiveFloat = 0.1
-    width_m: PositiveFloat = 0.5
-    samples_per_height: int = Field(32, ge=1)
+    min_height_m: _PersonHeight = 1.6
+    max_height_m: _PersonHeight = 1.9
+    height_step_m: _PersonHeight = 0.1
+    width_m: Annotated[PositiveFloat, at_most(10, "metres: a person")] = 0.5
+    samples_per_height: Annotated[int, Field(ge=1), at_most(1000, _LOCUS_MEMORY)] = 32
     cell_m: PositiveFloat = 0.05
-    kernel_sigma_m: PositiveFloat = 0.1
-    block_px: int = Field(4, ge=1)
-    separation_m: PositiveFloat = 0.5
-    window_m: PositiveFloat = 0.25
-    canny_low: NonNegativeFloat = 50.0
-    canny_high: NonNegativeFloat = 150.0
-    difference_threshold: NonNegativeFloat = 15.0
-    dilation_px: int = Field(2, ge=0)
-    outline_points_per_box: int = Field(64, ge=4)
+    kernel_sigma_m: _GroundDistance = 0.1
+    block_px: Annotated[int, Field(ge=1), at_most(256, "pixels")] = 4
+    separation_m: _GroundDistance = 0.5
+    window_m: _GroundDistance = 0.25
+    canny_low: Annotated[NonNegativeFloat, at_most(10_000, "a gradient magnitude")] = 50.0
+    canny_high: Annotated[NonNegativeFloat, at_most(10_000, "a gradient magnitude")] = 150.0
+    difference_threshold: Annotated[NonNegativeFloat, at_most(255, "grey levels")] = 15.0
+    dilation_px: Annotated[int, Field(ge=0), at_most(256, "pixels")] = 2
+    outline_points_per_box: Annotated[int, Field(ge=4), at_most(10_000, _LOCUS_MEMORY)] = 64
     min_box_score: float = Field(0.5, ge=0, le=1)
-    linkage_m: PositiveFloat = 1.0
-    blob_min_area_px: int = Field(400, ge=1)
+    linkage_m: _GroundDistance = 1.0
+    blob_min_area_px: Annotated[int, Field(ge=1), at_most(8192 * 8192, "an image's pixels")] = 400
 
     @model_validator(mode="after")
     def _heights_ordered(self):
         if self.max_height_m < self.min_height_m:
             raise ValueError(f"max_height_m must be at least min_height_m ({self.min_height_m})")
+        heights = (self.max_height_m - self.min_height_m) / self.height_step_m
+        if heights > MAX_PERSON_HEIGHTS:
+            raise ValueError(
+                f"height_step_m {self.height_step_m:g} gives {heights:.3g} heights; at most "
+                f"{MAX_PERSON_HEIGHTS} ({_LOCUS_MEMORY})"
+            )
         return self
 
 
@@ -784,11 +801,13 @@ class MultiViewDataset(_Strict):
     """
 
     name: str = "dataset"
-    frame_rate_hz: PositiveFloat
-    frames: int | None = Field(None, ge=1)
+    frame_rate_hz: Annotated[PositiveFloat, at_most(1000, "frames per second")]
+    frames: (
+        Annotated[int, Field(ge=1), at_most(MAX_DATASET_FRAMES, "memory: every frame's map and modes are kept")] | None
+    ) = None
     area_m: tuple[tuple[float, float], tuple[float, float]]
     ground_truth: str | None = None
-    views: list[DatasetView] = Field(min_length=1)
+    views: Annotated[list[DatasetView], Field(min_length=1), at_most_items(64, "time: every view's loci, every frame")]
     occupancy: Occupancy = Occupancy()
     tracker: OccupancyTracker = OccupancyTracker()
 
@@ -797,6 +816,12 @@ class MultiViewDataset(_Strict):
         (x0, y0), (x1, y1) = self.area_m
         if not (x1 > x0 and y1 > y0):
             raise ValueError("area_m must be [[x0, y0], [x1, y1]] with x1 > x0 and y1 > y0")
+        cells = (x1 - x0) * (y1 - y0) / self.occupancy.cell_m**2
+        if cells > MAX_GROUND_CELLS:
+            raise ValueError(
+                f"area_m at occupancy.cell_m {self.occupancy.cell_m:g} m makes {cells:.3g} cells; at most "
+                f"{MAX_GROUND_CELLS:g} (memory: a map of float64 cells per frame): make the cells larger"
+            )
         names = [view.name for view in self.views]
         if len(set(names)) != len(names):
             raise ValueError(f"view names must differ (got {names})")

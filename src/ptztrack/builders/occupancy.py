@@ -5,11 +5,18 @@ import functools
 from collections.abc import Callable
 from pathlib import Path
 
-import cv2
 import numpy as np
+import psutil
 
 from ptztrack.builders.factories import TRACKER_FIELDS
-from ptztrack.config import DatasetView, MultiViewDataset, Occupancy, OccupancyTracker, Tracker
+from ptztrack.config import (
+    MAX_DATASET_FRAMES,
+    DatasetView,
+    MultiViewDataset,
+    Occupancy,
+    OccupancyTracker,
+    Tracker,
+)
 from ptztrack.detect.lpom import ClusteringDetector, LpomDetector, LpomParameters
 from ptztrack.detect.motion import MotionEdgeParameters
 from ptztrack.detect.occupancy import LocusSampling, sampled_heights
@@ -48,6 +55,34 @@ def lpom_parameters(config: Occupancy) -> LpomParameters:
     )
 
 
+def locus_table_bytes(recording: MultiViewRecording, parameters: LpomParameters) -> float:
+    """An upper bound on the locus tables' memory: 8 bytes (a float32 value and its int32 column) for
+    each block's points, two per tangent height and person height (the room's four views: 300 MB
+    estimated, 78 MB measured, as points that fall in one cell are summed)."""
+    sampling = parameters.sampling
+    points_per_block = 2 * len(sampling.heights_m) * sampling.samples_per_height
+    blocks = sum(
+        (view.image_size_px[0] // parameters.block_px) * (view.image_size_px[1] // parameters.block_px)
+        for view in recording.views
+        if view.frames is not None and view.image_size_px is not None
+    )
+    return 8.0 * points_per_block * blocks
+
+
+def refuse_if_tables_too_large(
+    recording: MultiViewRecording, parameters: LpomParameters, available_bytes: float | None = None
+) -> None:
+    """A :class:`DatasetError` before the tables are built if they would not fit in the memory available
+    (``available_bytes``, by default what the machine has free now)."""
+    needed = locus_table_bytes(recording, parameters)
+    available = psutil.virtual_memory().available if available_bytes is None else available_bytes
+    if needed > available:
+        raise DatasetError(
+            f"{recording.name}: the locus tables need an estimated {needed / 1e9:.3g} GB, more than the "
+            f"{available / 1e9:.3g} GB available; make occupancy.block_px larger or samples_per_height smaller"
+        )
+
+
 def _calibration(view: DatasetView, field: str) -> tuple[PinholeCalibration, tuple[int, int] | None]:
     """A view's calibration and image size: from a Tsai XML (checked against ``image_size_px``) or a
     pinhole JSON (with ``image_size_px``, if given)."""
@@ -71,12 +106,8 @@ def _frames(view: DatasetView, size_px: tuple[int, int] | None, field: str):
         first, count, path = folder.frame(0), len(folder), Path(folder.files[0])
     else:
         path = Path(str(view.video))
-        capture = cv2.VideoCapture(str(path))
-        count = int(capture.get(cv2.CAP_PROP_FRAME_COUNT))
-        ok, first = capture.read()
-        capture.release()
-        if not ok:
-            raise DatasetError(f"{path}: OpenCV could not read any frame")
+        video = RecordedVideo(path)
+        first, count = video.frame(0), video.frame_count
     actual_px = (int(first.shape[1]), int(first.shape[0]))
     if size_px is not None and actual_px != tuple(size_px):
         raise DatasetError(
@@ -103,13 +134,18 @@ def recording_from_dataset(dataset: MultiViewDataset, frames: int | None = None)
         source, count = None, None
         if view.video is not None or view.images is not None:
             source, count, size_px = _frames(view, size_px, field)
-        boxes = None if view.detections is None else load_mot_detections(view.detections)
+        boxes = None if view.detections is None else load_mot_detections(view.detections, MAX_DATASET_FRAMES)
         loaded.append((view, calibration, size_px, source, count, boxes))
     counts = [count for *_, count, _ in loaded if count is not None]
     available = min(counts) if counts else max(len(boxes) for *_, boxes in loaded if boxes is not None)
     wanted = frames or dataset.frames or available
     if wanted > available:
         raise DatasetError(f"{dataset.name}: frames is {wanted}, but the views have only {available}")
+    if wanted > MAX_DATASET_FRAMES:
+        raise DatasetError(
+            f"{dataset.name}: {wanted} frames; at most {MAX_DATASET_FRAMES} (memory: every frame's map and "
+            "modes are kept): set frames"
+        )
     views = tuple(
         CameraView(
             name=view.name,
@@ -154,10 +190,14 @@ def run_recording(
     if recording.truth is None:
         raise DatasetError(f"{recording.name}: the experiment needs ground truth (ground_truth)")
     parameters = lpom_parameters(occupancy)
+    refuse_if_tables_too_large(recording, parameters)
     lpom = LpomDetector(recording, parameters)
     clustering = ClusteringDetector(recording, occupancy.linkage_m, occupancy.min_box_score, occupancy.blob_min_area_px)
     frames = detect_frames(recording, lpom, clustering, progress)
-    tracking = TrackerParameters(**{name: getattr(tracker, name) for name in TRACKER_FIELDS})
+    # People leave a dataset's area (and never the room's, whose tracks stay well localised).
+    tracking = TrackerParameters(
+        **{name: getattr(tracker, name) for name in TRACKER_FIELDS}, max_position_sigma_m=tracker.max_position_sigma_m
+    )
     return score_recording(recording, lpom.grid, frames, tracker.acceleration_sigma_m_s2, tracking, label)
 
 

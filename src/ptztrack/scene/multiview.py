@@ -62,12 +62,15 @@ class MultiViewRecording:
     truth: GroundTruth | None
 
 
-def load_mot_detections(path: str | Path) -> list[np.ndarray]:
+def load_mot_detections(path: str | Path, max_frames: int) -> list[np.ndarray]:
     """A MOTChallenge detection file (``frame,-1,left,top,width,height,score,...``, frames from 1)
-    as per-frame boxes (K, 5) ``(left, top, width, height, score)``, from frame 0 to the file's last."""
+    as per-frame boxes (K, 5) ``(left, top, width, height, score)``, from frame 0 to the file's last,
+    which may be at most ``max_frames``."""
     table = read_mot_rows(path, "detection")
-    frame = table[:, 0].astype(int) - 1
-    frames = frame.max() + 1
+    frame = table[:, 0].astype(np.int64) - 1
+    frames = int(frame.max()) + 1
+    if frames > max_frames:
+        raise DatasetError(f"{path}: a row of frame {frames}; at most {max_frames} frames (memory)")
     if np.any((table[:, 4] <= 0) | (table[:, 5] <= 0)):
         raise DatasetError(f"{path}: a box has a width or height that is not positive")
     order = np.argsort(frame, kind="stable")

@@ -226,9 +226,9 @@ class RecordedVideo:
         if not self._capture.isOpened():
             raise DatasetError(f"{self.path}: not a video OpenCV can read")
         self.frame(0)
-        frame_count = int(self._capture.get(cv2.CAP_PROP_FRAME_COUNT))
-        if frames_needed is not None and frame_count < frames_needed:
-            raise DatasetError(f"{self.path}: {frame_count} frames, the run needs {frames_needed}")
+        self.frame_count = int(self._capture.get(cv2.CAP_PROP_FRAME_COUNT))
+        if frames_needed is not None and self.frame_count < frames_needed:
+            raise DatasetError(f"{self.path}: {self.frame_count} frames, the run needs {frames_needed}")
 
     def _open(self) -> None:
         self._capture = cv2.VideoCapture(str(self.path))
