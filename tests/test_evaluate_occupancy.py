@@ -9,9 +9,11 @@ import pytest
 
 from ptztrack.cli import main
 from ptztrack.config import dataset_from_dict, load_dataset, pets_dataset
-from ptztrack.evaluate.occupancy import detection_metrics, fitted_selection, halves
+from ptztrack.detect.occupancy import Modes
+from ptztrack.evaluate.occupancy import detection_metrics, fitted_selection, halves, track_on_ground
 from ptztrack.geometry.calibration import project_pinhole
 from ptztrack.scene.room import RoomLayout, RoomRenderer, room_truth
+from ptztrack.track.tracker import TrackerParameters
 
 PETS = Path(__file__).resolve().parents[1] / "src" / "ptztrack" / "data" / "pets2009_s2l1"
 NAN = np.nan
@@ -218,3 +220,29 @@ def test_a_partial_tracker_section_keeps_the_occupancy_trackers_confirmation():
     assert dataset_from_dict(data).tracker.confirmation_hits == 2
     assert dataset_from_dict({**data, "tracker": {"gate_probability": 0.95}}).tracker.confirmation_hits == 2
     assert dataset_from_dict({**data, "tracker": {"confirmation_hits": 1}}).tracker.confirmation_hits == 1
+
+
+def test_a_track_beside_another_keeps_its_existence_through_misses_that_a_lone_track_dies_of():
+    """Two people 0.3 m apart (closer than the map's 0.5 m separation) and one 3 m away are seen for
+    two frames, then the map finds only the first: the lone one's misses delete it (recall 0.9: 0.99
+    falls to 0.908, 0.497, then 0.090, below 0.1), the one beside the first, which cannot have a mode
+    of its own, lives on."""
+    people_m = np.array([[0.0, 0.0], [0.3, 0.0], [3.0, 0.0]])
+    covariance = np.broadcast_to(0.01 * np.eye(2), (3, 2, 2))
+    seen = Modes(people_m, covariance, np.ones(3))
+    first = Modes(people_m[:1], covariance[:1], np.ones(1))
+    parameters = TrackerParameters(
+        initial_speed_sigma_m_s=0.1,
+        gate_probability=0.99,
+        existence_at_birth=0.5,
+        existence_when_detected=0.99,
+        existence_to_delete=0.1,
+        max_position_sigma_m=2.0,
+        confirmation_hits=1,
+        report_position_sigma_m=2.0,
+        association="hungarian",
+        clutter_density_per_px2=0.0,
+    )
+    frames = [seen, seen, first, first, first]
+    reported = track_on_ground(frames, np.full(5, 0.9), 0.5, 10.0, 0.5, parameters)
+    assert [sorted(tracks.ids.tolist()) for tracks in reported] == [[0, 1, 2]] * 4 + [[0, 1]]

@@ -198,7 +198,9 @@ def run_recording(
     tracking = TrackerParameters(
         **{name: getattr(tracker, name) for name in TRACKER_FIELDS}, max_position_sigma_m=tracker.max_position_sigma_m
     )
-    return score_recording(recording, lpom.grid, frames, tracker.acceleration_sigma_m_s2, tracking, label)
+    return score_recording(
+        recording, lpom.grid, frames, tracker.acceleration_sigma_m_s2, tracking, occupancy.separation_m, label
+    )
 
 
 def dataset_runs(dataset: MultiViewDataset, frames: int | None, progress=None) -> list[OccupancyRun]:

@@ -154,21 +154,27 @@ def fitted_selection(
 def track_on_ground(
     modes: list[Modes],
     recall,
+    separation_m: float,
     frame_rate_hz: float,
     acceleration_sigma_m_s2: float,
     parameters: TrackerParameters,
 ) -> list[Tracks]:
     """The ground-plane EKF tracker fed by each frame's modes; the reported tracks per frame.
 
-    recall : (T,) per frame, the probability that the map finds a person who is there (an undetected
-    track's loss of existence; :func:`ptztrack.track.tracker.update_tracks_on_ground`).
+    recall : (T,) per frame, the probability that the map finds a person who is there; separation_m :
+    the map's closest two modes. A track predicted within ``separation_m`` of another cannot have a
+    mode of its own, so its miss says nothing (detection probability 0); any other's is ``recall``
+    (an undetected track's loss of existence; :func:`ptztrack.track.tracker.update_tracks_on_ground`).
     """
     F, U = constant_velocity_model(1.0 / frame_rate_hz, acceleration_sigma_m_s2)
     tracks, reported = Tracks.empty(), []
-    for found, detectable in zip(modes, recall, strict=True):
+    for found, recall_now in zip(modes, recall, strict=True):
         tracks = predict_tracks(tracks, F, U)
+        distance_m = cdist(tracks.mean[:, :2], tracks.mean[:, :2])
+        np.fill_diagonal(distance_m, np.inf)
+        alone = distance_m.min(axis=1, initial=np.inf) >= separation_m
         tracks = update_tracks_on_ground(
-            tracks, found.position_m, found.covariance_m2, parameters, float(detectable)
+            tracks, found.position_m, found.covariance_m2, parameters, recall_now * alone
         ).tracks
         reported.append(tracks.confirmed(parameters.confirmation_hits))
     return reported
@@ -194,6 +200,7 @@ def score_recording(
     frames: Frames,
     acceleration_sigma_m_s2: float,
     tracker: TrackerParameters,
+    separation_m: float,
     label: dict | None = None,
 ) -> OccupancyRun:
     """Fit each method's threshold on disjoint frames, score both, and track LPOM's modes.
@@ -210,7 +217,7 @@ def score_recording(
         truth_m, [c.views for c in frames.clusters], [c.position_m for c in frames.clusters], views
     )
     clustering = [found.select(keep) for found, keep in zip(frames.clusters, kept_clusters, strict=True)]
-    tracks = track_on_ground(lpom, recall, recording.frame_rate_hz, acceleration_sigma_m_s2, tracker)
+    tracks = track_on_ground(lpom, recall, separation_m, recording.frame_rate_hz, acceleration_sigma_m_s2, tracker)
     tracking = clear_metrics(truth_m, [t.ids for t in tracks], [t.mean[:, :2] for t in tracks])
     common = {"dataset": recording.name, **(label or {}), "frames": recording.frames, "views": len(recording.views)}
     rows = [

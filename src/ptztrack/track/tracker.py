@@ -271,7 +271,7 @@ def update_tracks(
 
 
 def update_tracks_on_ground(
-    tracks: Tracks, position_m, covariance_m2, parameters: TrackerParameters, detectable: float
+    tracks: Tracks, position_m, covariance_m2, parameters: TrackerParameters, detectable
 ) -> TrackUpdate:
     """Associate, update, start and delete with measurements of ground positions (a multi-camera
     occupancy map's modes, :mod:`ptztrack.detect.occupancy`), the tracker's step after prediction.
@@ -281,8 +281,8 @@ def update_tracks_on_ground(
     Mahalanobis distance with innovation covariance ``P_xy + R_k`` per pair, gated as in
     :func:`update_tracks`, and an unassigned measurement starts a track with ``R_k`` as its position
     covariance and ``existence_at_birth``. Fixed cameras watch every track: an undetected track
-    loses existence as in :func:`update_tracks`, with ``detectable`` the probability that the map
-    finds a person who is there (its recall). Only the Hungarian association is available.
+    loses existence as in :func:`update_tracks`, with ``detectable`` (scalar or (n,)) the probability
+    that the map finds each track's person were it there. Only the Hungarian association is available.
     """
     if parameters.association != "hungarian":
         raise ValueError(
@@ -304,7 +304,9 @@ def update_tracks_on_ground(
         C[track_index],
         covariance_m2[measurement_index],
     )
-    survivors, keep = _after_update(tracks, mean, covariance, track_index, np.full(len(tracks), detectable), parameters)
+    survivors, keep = _after_update(
+        tracks, mean, covariance, track_index, np.broadcast_to(np.asarray(detectable, float), len(tracks)), parameters
+    )
     starting = np.setdiff1d(np.arange(len(position_m)), measurement_index)
     born = start_ground_tracks(
         position_m[starting],
