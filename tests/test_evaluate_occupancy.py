@@ -13,7 +13,7 @@ from ptztrack.detect.occupancy import Modes
 from ptztrack.evaluate.occupancy import detection_metrics, fitted_selection, halves, track_on_ground
 from ptztrack.geometry.calibration import project_pinhole
 from ptztrack.scene.room import RoomLayout, RoomRenderer, room_truth
-from ptztrack.track.tracker import TrackerParameters
+from test_track_ground import PARAMETERS as GROUND_TRACKER
 
 PETS = Path(__file__).resolve().parents[1] / "src" / "ptztrack" / "data" / "pets2009_s2l1"
 NAN = np.nan
@@ -231,18 +231,6 @@ def test_a_track_beside_another_keeps_its_existence_through_misses_that_a_lone_t
     covariance = np.broadcast_to(0.01 * np.eye(2), (3, 2, 2))
     seen = Modes(people_m, covariance, np.ones(3))
     first = Modes(people_m[:1], covariance[:1], np.ones(1))
-    parameters = TrackerParameters(
-        initial_speed_sigma_m_s=0.1,
-        gate_probability=0.99,
-        existence_at_birth=0.5,
-        existence_when_detected=0.99,
-        existence_to_delete=0.1,
-        max_position_sigma_m=2.0,
-        confirmation_hits=1,
-        report_position_sigma_m=2.0,
-        association="hungarian",
-        clutter_density_per_px2=0.0,
-    )
     frames = [seen, seen, first, first, first]
-    reported = track_on_ground(frames, np.full(5, 0.9), 0.5, 10.0, 0.5, parameters)
+    reported = track_on_ground(frames, np.full(5, 0.9), 0.5, 10.0, 0.5, GROUND_TRACKER)
     assert [sorted(tracks.ids.tolist()) for tracks in reported] == [[0, 1, 2]] * 4 + [[0, 1]]
