@@ -48,6 +48,9 @@ def test_ctrl_c_stops_a_run_in_one_line_and_leaves_no_folder(tmp_path):
         stdout=subprocess.DEVNULL,
         stderr=subprocess.PIPE,
         text=True,
+        # A test run in the background of a non-interactive shell inherits SIGINT ignored, which would
+        # keep Python from installing its handler: give the command the disposition a terminal gives.
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
     )
     time.sleep(8.0)
     assert process.poll() is None, "the run ended before it could be interrupted"
