@@ -1,0 +1,186 @@
+"""A real (or virtual) ONVIF PTZ camera driven from synchronous code, with a timeout on every call.
+
+The client is onvif-zeep-async (the ONVIF client of Home Assistant and
+Frigate), which is asynchronous; the closed loop is not. So the client runs
+its own event loop in a daemon thread and every call here waits for one
+coroutine there, at most ``timeout_s`` (the library's own timeouts are 30-90
+s). Its WSDL folder is passed explicitly, services are made with the
+``create_*_service()`` coroutines, and the client is closed at the end.
+
+Failures become :class:`CameraError`, one line that names the camera
+(``host:port``) and never its password: a refused connection, a wrong
+user name or password, no answer within the timeout, a fault from the
+camera, an image that does not decode.
+"""
+
+import asyncio
+import logging
+import os
+import threading
+from collections.abc import Coroutine
+from dataclasses import dataclass, field
+from typing import Any
+from urllib.parse import unquote, urlsplit
+
+import cv2
+import numpy as np
+
+PASSWORD_VARIABLE = "PTZTRACK_CAMERA_PASSWORD"
+USER_VARIABLE = "PTZTRACK_CAMERA_USER"
+DEFAULT_ONVIF_PORT = 80
+
+
+class CameraError(RuntimeError):
+    """A camera that cannot be reached, refuses the credentials, times out or answers with a fault."""
+
+
+@dataclass(frozen=True)
+class CameraAddress:
+    """Where a camera answers ONVIF, and as whom; the password never shows in a repr or a message."""
+
+    host: str
+    port: int
+    username: str = ""
+    password: str = field(default="", repr=False)
+
+    def __str__(self) -> str:
+        return f"{self.host}:{self.port}"
+
+
+def camera_address(url: str, credentials: dict | None = None, environ=os.environ) -> CameraAddress:
+    """The address in ``url`` (``onvif://[user[:password]@]host[:port]``, ``http://`` alike; the port
+    defaults to 80), the user name and password taken from the URL, else from ``credentials`` (a
+    mapping with ``username`` and ``password``, read from a file), else from the environment
+    variables ``PTZTRACK_CAMERA_USER`` and ``PTZTRACK_CAMERA_PASSWORD``."""
+    parts = urlsplit(url if "://" in url else f"onvif://{url}")
+    if parts.scheme not in ("onvif", "http") or not parts.hostname:
+        raise CameraError(f"--camera {_without_password(url)}: expected onvif://[user[:password]@]host[:port]")
+    try:
+        port = parts.port or DEFAULT_ONVIF_PORT
+    except ValueError:
+        raise CameraError(f"--camera {_without_password(url)}: the port is not a number from 0 to 65535") from None
+    credentials = credentials or {}
+    username = unquote(parts.username or "") or credentials.get("username") or environ.get(USER_VARIABLE, "")
+    password = unquote(parts.password or "") or credentials.get("password") or environ.get(PASSWORD_VARIABLE, "")
+    return CameraAddress(parts.hostname, port, str(username), str(password))
+
+
+def _without_password(url: str) -> str:
+    parts = urlsplit(url if "://" in url else f"onvif://{url}")
+    if parts.password is None:
+        return url
+    return url.replace(f":{parts.password}@", ":***@", 1)
+
+
+@dataclass(frozen=True)
+class CameraStatus:
+    """GetStatus: position (3,) in the normalised spaces (pan, tilt in [-1, 1], zoom in [0, 1]), and
+    whether any axis is still moving."""
+
+    position: np.ndarray
+    moving: bool
+
+
+class ONVIFClient:
+    """One ONVIF PTZ camera: its first media profile's PTZ and snapshot, each call within ``timeout_s``."""
+
+    def __init__(self, address: CameraAddress, timeout_s: float = 5.0):
+        self.address = address
+        self.timeout_s = timeout_s
+        self._loop = asyncio.new_event_loop()
+        self._thread = threading.Thread(target=self._loop.run_forever, name="onvif-client", daemon=True)
+        self._thread.start()
+        self._camera: Any = None
+        self._ptz: Any = None
+        self._profile = ""
+
+    def connect(self) -> None:
+        """Connect, read the services and the first profile; a :class:`CameraError` if the camera cannot be used."""
+        self._call(self._connect())
+
+    def status(self) -> CameraStatus:
+        status = self._call(self._ptz.GetStatus({"ProfileToken": self._profile}))
+        pan_tilt, zoom = status.Position.PanTilt, status.Position.Zoom
+        moving = any(str(getattr(status.MoveStatus, axis, "IDLE")) == "MOVING" for axis in ("PanTilt", "Zoom"))
+        return CameraStatus(np.array([pan_tilt.x, pan_tilt.y, zoom.x], dtype=float), moving)
+
+    def move_to(self, position) -> None:
+        """AbsoluteMove to ``position`` (3,) in the normalised spaces, at full speed."""
+        x, y, zoom = (float(value) for value in position)
+        request = {
+            "ProfileToken": self._profile,
+            "Position": {"PanTilt": {"x": x, "y": y}, "Zoom": {"x": zoom}},
+            "Speed": {"PanTilt": {"x": 1.0, "y": 1.0}, "Zoom": {"x": 1.0}},
+        }
+        self._call(self._ptz.AbsoluteMove(request))
+
+    def snapshot(self) -> np.ndarray:
+        """The camera's current image, (h, w, 3) uint8 BGR, from its snapshot URI (HTTP Basic)."""
+        data = self._call(self._camera.get_snapshot(self._profile, basic_auth=True))
+        image = None if not data else cv2.imdecode(np.frombuffer(data, np.uint8), cv2.IMREAD_COLOR)
+        if image is None:
+            raise CameraError(f"{self.address}: the snapshot is not an image")
+        return image
+
+    def close(self) -> None:
+        """Close the client and stop its thread; the camera stays where it is."""
+        if self._camera is not None:
+            try:
+                self._call(self._camera.close())
+            except CameraError:
+                pass  # a camera gone already has nothing to close
+            self._camera = None
+        self._loop.call_soon_threadsafe(self._loop.stop)
+        self._thread.join(timeout=self.timeout_s)
+        self._loop.close()
+
+    async def _connect(self) -> None:
+        import onvif  # a heavy import, and only where a camera is used
+
+        # onvif.client configures the root logger at import; ptztrack's own lines are what the user reads.
+        logging.getLogger("onvif").setLevel(logging.WARNING)
+        wsdl = os.path.join(os.path.dirname(onvif.__file__), "wsdl")
+        address = self.address
+        camera = onvif.ONVIFCamera(address.host, address.port, address.username, address.password, wsdl, no_cache=True)
+        try:
+            await camera.update_xaddrs()
+            media = await camera.create_media_service()
+            self._ptz = await camera.create_ptz_service()
+            profiles = await media.GetProfiles()
+        except BaseException:
+            await camera.close()
+            raise
+        if not profiles:
+            await camera.close()
+            raise CameraError(f"{address}: the camera has no media profile")
+        self._camera, self._profile = camera, profiles[0].token
+
+    def _call(self, coroutine: Coroutine) -> Any:
+        future = asyncio.run_coroutine_threadsafe(asyncio.wait_for(coroutine, self.timeout_s), self._loop)
+        try:
+            return future.result(self.timeout_s + 1.0)
+        except TimeoutError:
+            future.cancel()
+            raise CameraError(f"{self.address}: no answer within {self.timeout_s:g} s") from None
+        except CameraError:
+            raise
+        except Exception as error:
+            raise CameraError(f"{self.address}: {_reason(error)}") from None
+
+
+def _reason(error: Exception) -> str:
+    """What went wrong, in a few words, never with the request (which may carry credentials)."""
+    from zeep.exceptions import Fault
+
+    if isinstance(error, Fault):
+        message = str(error.message or "")
+        if "authori" in message.lower() or "auth" in message.lower():
+            return "the camera refused the user name or password"
+        return f"the camera answered with a fault ({message[:80]})"
+    if isinstance(error, OSError):
+        # aiohttp wraps the socket's error (ConnectionRefusedError, a timeout, no route) in its own.
+        cause = getattr(error, "os_error", None) or error
+        if isinstance(cause, ConnectionRefusedError):
+            return "cannot connect (connection refused)"
+        return f"cannot connect ({cause.strerror or type(cause).__name__})"
+    return f"{type(error).__name__}: {str(error)[:80]}"
