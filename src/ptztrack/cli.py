@@ -1,10 +1,12 @@
 """The ``ptztrack`` command: a thin layer over the Python API."""
 
 import argparse
+import logging
 import math
 import os
 import sys
 import tempfile
+import time
 from functools import partial
 from pathlib import Path
 
@@ -35,20 +37,33 @@ from ptztrack.builders.follow_experiment import (
     run_follow_cell,
     run_otb_cell,
 )
+from ptztrack.builders.live import (
+    TRUTH_LOG_HEADER,
+    camera_spaces,
+    live_as_episode,
+    run_live_episode,
+    virtual_calibration,
+    virtual_camera,
+)
 from ptztrack.builders.occupancy import ROOM_FRAMES, dataset_runs, room_runs
 from ptztrack.builders.pets import PROTOCOLS, protocol_folds
 from ptztrack.builders.registration import reference_index
+from ptztrack.camera.move_timing import measure_move_times
+from ptztrack.camera.onvif_client import PASSWORD_VARIABLE, ONVIFClient, camera_address
 from ptztrack.config import (
     LiveView,
     PoseError,
     Scenario,
     ScenarioError,
+    load_camera_calibration,
     load_dataset,
     load_scenario,
     pets_dataset,
     pets_follow_scenario,
     pets_scenario,
+    read_yaml,
     scenario_from_dict,
+    write_camera_calibration,
 )
 from ptztrack.control.msg_scheduler import SCHEDULERS
 from ptztrack.evaluate.executors import EXECUTORS, print_progress, run_cells
@@ -75,7 +90,7 @@ from ptztrack.evaluate.registration import summarise_registration
 from ptztrack.evaluate.report import RUN_FILES, write_figure, write_outputs
 from ptztrack.evaluate.tables import format_table, paired_difference, summarise
 from ptztrack.evaluate.video import view_renderer
-from ptztrack.files import InputError, check_output_file, check_output_folder, run_folder, write_json
+from ptztrack.files import InputError, check_output_file, check_output_folder, read_text, run_folder, write_json
 from ptztrack.scene.roads import walk_roads
 
 RUN_FIGURES = ("mota", "motp_m", "idf1", "height_px", "detections", "zoom", "switches")
@@ -140,6 +155,111 @@ def run_command(args: argparse.Namespace) -> int:
         with run_folder(args.out, args.overwrite) as folder:
             write_outputs(folder, episode, metrics, title, view_renderer(world))
         print(f"wrote {', '.join(RUN_FILES)} into {args.out}")
+    return 0
+
+
+def _credentials(args: argparse.Namespace) -> dict | None:
+    """The ``--credentials`` file's {username, password}, if given (a YAML or JSON mapping)."""
+    if args.credentials is None:
+        return None
+    data = read_yaml(args.credentials, "credentials", ScenarioError)
+    if not isinstance(data, dict) or not set(data) <= {"username", "password"}:
+        raise ScenarioError(f"{args.credentials}: expected a mapping with username and password")
+    return {key: str(value) for key, value in data.items()}
+
+
+def live_command(args: argparse.Namespace) -> int:
+    scenario = build_scenario(args.scenario, args.detector)
+    calibration = virtual_calibration() if args.calibration == "virtual" else load_camera_calibration(args.calibration)
+    address = camera_address(args.camera, _credentials(args))
+    steps = args.steps or scenario.frames
+    print(f"live: {args.policy} on {address}, up to {steps} steps at {scenario.frame_rate_hz * args.time_scale:g} Hz")
+    world, live = run_live_episode(
+        scenario, calibration, address, args.policy, steps, args.time_scale, args.seed, args.timeout_s
+    )
+    truth_log = None if args.truth is None else read_truth_log(args.truth)
+    episode = live_as_episode(world, live, truth_log)
+    captured = np.isfinite(live.capture_time_s)
+    elapsed_s = live.step_time_s[-1] - live.step_time_s[0] if len(live.step_time_s) > 1 else 0.0
+    print(
+        f"{len(live.commanded)} steps ({len(live.commanded) / max(elapsed_s, 1e-9):.2f} per second), "
+        f"{int(live.sent.sum())} decisions sent, {int(captured.sum())} images, "
+        f"decision {1e3 * np.mean(live.decision_s) if len(live.decision_s) else 0:.1f} ms"
+    )
+    metrics = episode_metrics(episode)
+    if truth_log is not None:
+        print(format_metrics(metrics))
+    if args.out is not None:
+        title = f"live {args.policy}, {scenario.detector.kind} detector: {len(live.commanded)} steps"
+        with run_folder(args.out, args.overwrite) as folder:
+            write_outputs(folder, episode, metrics, title, None)
+        print(f"wrote {', '.join(RUN_FILES)} into {args.out}")
+    return 0
+
+
+def read_truth_log(path: Path) -> np.ndarray:
+    """A virtual camera's truth log (``ptztrack serve-camera --truth-log``), (n, 5)."""
+    lines = read_text(path, "truth log", 1_000_000_000, ScenarioError).splitlines()
+    if not lines or lines[0] != TRUTH_LOG_HEADER:
+        raise ScenarioError(f"{path}: expected a truth log starting with the line {TRUTH_LOG_HEADER}")
+    try:
+        rows = np.array([[float(value) for value in line.split(",")] for line in lines[1:] if line], dtype=float)
+    except ValueError:
+        raise ScenarioError(f"{path}: a line of the truth log is not five numbers") from None
+    if rows.ndim != 2 or rows.shape[1:] != (5,) or not np.all(np.isfinite(rows)):
+        raise ScenarioError(f"{path}: expected rows of five finite numbers ({TRUTH_LOG_HEADER})")
+    return rows
+
+
+def calibrate_camera_command(args: argparse.Namespace) -> int:
+    calibration = load_camera_calibration(args.calibration)
+    client = ONVIFClient(camera_address(args.camera, _credentials(args)), args.timeout_s)
+    try:
+        client.connect()
+        move_times, samples = measure_move_times(client, camera_spaces(calibration))
+    finally:
+        client.close()
+    for axis, (distances, seconds) in samples.items():
+        intercept, slope = getattr(move_times, axis)
+        unit = "zoom" if axis == "zoom" else "deg"
+        print(
+            f"{axis}: {intercept:.3f} s + {slope:.4f} s/{unit} "
+            f"({len(seconds)} moves of {distances.max():.3g} {unit} at most)"
+        )
+    section = {axis: list(getattr(move_times, axis)) for axis in ("pan", "tilt", "zoom")}
+    write_camera_calibration(args.calibration, calibration.model_copy(update={"move_times": section}))
+    print(f"wrote move_times into {args.calibration}")
+    return 0
+
+
+def serve_camera_command(args: argparse.Namespace) -> int:
+    scenario = build_scenario(args.scenario)
+    credentials = _credentials(args) or {}
+    username = args.user or credentials.get("username", "")
+    password = credentials.get("password") or os.environ.get(PASSWORD_VARIABLE, "")
+    camera, feed = virtual_camera(scenario, args.time_scale, args.port, username, password)
+    log_file = None if args.truth_log is None else open(args.truth_log, "w", encoding="utf-8")  # noqa: SIM115
+    written = 0
+    camera.start()
+    try:
+        print(f"virtual ONVIF camera: onvif://127.0.0.1:{camera.onvif_port} (calibration: virtual)", flush=True)
+        if camera.rtsp_port is not None:
+            print(f"RTSP: rtsp://127.0.0.1:{camera.rtsp_port}/", flush=True)
+        if log_file is not None:
+            log_file.write(TRUTH_LOG_HEADER + "\n")
+        while True:
+            time.sleep(0.5)
+            if log_file is not None:
+                rows = feed.rows(written)
+                log_file.writelines(",".join(f"{value:.6f}" for value in row) + "\n" for row in rows)
+                log_file.flush()
+                written += len(rows)
+    except KeyboardInterrupt:
+        print("virtual ONVIF camera stopped", file=sys.stderr)
+    finally:
+        camera.stop()
+        if log_file is not None:
+            log_file.close()
     return 0
 
 
@@ -518,7 +638,50 @@ def parser() -> argparse.ArgumentParser:
     registration.set_defaults(handler=registration_experiment_command)
     _add_follow_commands(commands, experiments)
     _add_occupancy_parser(experiments)
+    _add_camera_commands(commands, policies)
     return root
+
+
+def _add_camera_commands(commands, policies: list[str]) -> None:
+    """``ptztrack live`` and ``ptztrack serve-camera``: real ONVIF cameras, and a virtual one to test with."""
+    live = commands.add_parser("live", help="drive an ONVIF PTZ camera in real time: capture, detect, track, decide")
+    live.add_argument("--camera", required=True, help="onvif://[user[:password]@]host[:port]")
+    live.add_argument("--credentials", type=Path, help="a YAML file with username and password")
+    live.add_argument(
+        "--calibration", required=True, help="the camera's calibration YAML, or 'virtual' for ptztrack serve-camera"
+    )
+    live.add_argument("--policy", choices=policies, default="smpl")
+    live.add_argument("--scenario", default="pets", help="'pets' (built in) or a scenario YAML file")
+    live.add_argument("--detector", default="hog", help="the scenario's detector (default hog)")
+    live.add_argument("--steps", type=_positive_int, help="at most this many steps (default: the scenario's frames)")
+    live.add_argument("--time-scale", type=_positive_float, default=1.0, help="steps at the scenario's rate times this")
+    live.add_argument("--timeout-s", type=_positive_float, default=5.0, help="the longest wait for any camera call")
+    live.add_argument(
+        "--truth", type=Path, help="score against a virtual camera's truth log (serve-camera --truth-log)"
+    )
+    live.add_argument("--seed", type=_non_negative_int, default=0)
+    live.add_argument("--out", type=Path, help=f"directory for {', '.join(RUN_FILES)}; written whole, Ctrl-C too")
+    live.add_argument("--overwrite", action="store_true", help="replace a non-empty --out folder")
+    live.set_defaults(handler=live_command)
+
+    camera = commands.add_parser("camera", help="tools for a real camera").add_subparsers(dest="tool", required=True)
+    calibrate = camera.add_parser("calibrate", help="time the camera's moves and write them into its calibration")
+    calibrate.add_argument("--camera", required=True, help="onvif://[user[:password]@]host[:port]")
+    calibrate.add_argument("--credentials", type=Path, help="a YAML file with username and password")
+    calibrate.add_argument("--calibration", type=Path, required=True, help="the camera's calibration YAML (updated)")
+    calibrate.add_argument(
+        "--timeout-s", type=_positive_float, default=5.0, help="the longest wait for any camera call"
+    )
+    calibrate.set_defaults(handler=calibrate_camera_command)
+
+    serve = commands.add_parser("serve-camera", help="serve the PETS virtual PTZ camera over ONVIF on 127.0.0.1")
+    serve.add_argument("--port", type=_port, default=8080)
+    serve.add_argument("--scenario", default="pets", help="'pets' (built in) or a recording scenario YAML file")
+    serve.add_argument("--time-scale", type=_positive_float, default=1.0, help="the recording's speed")
+    serve.add_argument("--user", help=f"require this user (password: --credentials or ${PASSWORD_VARIABLE})")
+    serve.add_argument("--credentials", type=Path, help="a YAML file with username and password to require")
+    serve.add_argument("--truth-log", type=Path, help="append every picture's time, step and pose here (CSV)")
+    serve.set_defaults(handler=serve_camera_command)
 
 
 def _add_follow_commands(commands, experiments) -> None:
@@ -648,9 +811,23 @@ def _positive_int(text: str) -> int:
     return value
 
 
+def _positive_float(text: str) -> float:
+    value = _non_negative_float(text)
+    if value == 0:
+        raise argparse.ArgumentTypeError(f"must be above 0 (got {text})")
+    return value
+
+
+def _port(text: str) -> int:
+    value = _non_negative_int(text)
+    if value > 65535:
+        raise argparse.ArgumentTypeError(f"must be a port from 0 to 65535 (got {value})")
+    return value
+
+
 def check_outputs(args: argparse.Namespace) -> None:
     """Refuse, before any work, output paths that could not be written."""
-    for option in ("json", "plot", "trails"):
+    for option in ("json", "plot", "trails", "truth_log"):
         if getattr(args, option, None) is not None:
             check_output_file(getattr(args, option), f"--{option}")
     if getattr(args, "index", None) is not None and not args.index.exists():
@@ -661,6 +838,9 @@ def check_outputs(args: argparse.Namespace) -> None:
 
 def main(argv: list[str] | None = None) -> int:
     """The command line: 0 when done, 2 with one line on stderr for any bad input, 130 on Ctrl-C."""
+    # Before any library configures the root logger (onvif-zeep-async does at import): warnings only,
+    # one line each (a camera lost, back, still unreachable).
+    logging.basicConfig(level=logging.WARNING, format="ptztrack: %(message)s")
     try:
         args = parser().parse_args(argv)
         check_outputs(args)

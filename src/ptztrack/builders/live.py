@@ -1,0 +1,215 @@
+"""Live cameras from the configuration: the calibration's spaces, the virtual ONVIF camera's pictures of
+a recording, and a live run turned into an episode that the run metrics score.
+
+The virtual camera (``ptztrack serve-camera``) shows a recording scenario's
+virtual PTZ view at the pose its mechanics have reached, the recording
+advancing in real time (times ``time_scale``, so that a slower client keeps
+the recording's rate). It logs, for every picture, the wall-clock time, the
+scenario step shown and the pose: the truth a live run is scored against,
+each step taking the truth of the step its image showed.
+"""
+
+import threading
+import time
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from ptztrack.builders.episode import episode_world, make_policy, make_tracker
+from ptztrack.camera.live_camera import ReconnectingCamera
+from ptztrack.camera.onvif_client import CameraAddress, CameraError, ONVIFClient
+from ptztrack.camera.onvif_server import AxisSpeeds, VirtualONVIFCamera
+from ptztrack.camera.onvif_spaces import CameraSpaces, MoveTimes
+from ptztrack.camera.recorded import RecordedPTZ
+from ptztrack.config import VIRTUAL_CAMERA_CALIBRATION, CameraCalibrationFile, Scenario
+from ptztrack.live import LiveEpisode, run_live
+from ptztrack.loop import Episode, World
+from ptztrack.types import GroundTruth
+
+
+def camera_spaces(calibration: CameraCalibrationFile) -> CameraSpaces:
+    return CameraSpaces(
+        calibration.pan_deg, calibration.tilt_deg, tuple((float(z), float(f)) for z, f in calibration.zoom_curve)
+    )
+
+
+def move_times(calibration: CameraCalibrationFile) -> MoveTimes:
+    section = calibration.move_times
+    return MoveTimes(section.pan, section.tilt, section.zoom)
+
+
+@dataclass
+class RecordingFeed:
+    """The pictures of the virtual ONVIF camera: ``world``'s view of its recording at a pose, the
+    recording's step advancing with the time since the first picture (``step_s`` apart, divided by
+    ``time_scale``), held at the last step; a camera restarted with the same feed goes on with the
+    recording. ``log`` holds (epoch s, step, pan, tilt, zoom) per picture."""
+
+    world: World
+    step_s: float
+    time_scale: float = 1.0
+    log: list[tuple[float, int, float, float, float]] = field(default_factory=list)
+    _lock: threading.Lock = field(default_factory=threading.Lock, repr=False)
+    _started_s: float | None = field(default=None, repr=False)
+
+    def render(self, pose, elapsed_s: float) -> np.ndarray:
+        """The picture at ``pose``; ``elapsed_s`` (the camera's own clock) is not used: the feed's is."""
+        now_s = time.time()
+        self._started_s = now_s if self._started_s is None else self._started_s
+        steps = self.world.truth.positions_m.shape[0]
+        step = min(int((now_s - self._started_s) * self.time_scale / self.step_s), steps - 1)
+        image = self.world.backend.image(step, np.asarray(pose, dtype=float))
+        if image is None:
+            raise RuntimeError("the virtual ONVIF camera needs a recording with a video")
+        with self._lock:
+            self.log.append((now_s, step, *(float(value) for value in pose)))
+        return image
+
+    def rows(self, start: int = 0) -> np.ndarray:
+        """The log from row ``start`` on, (n, 5): epoch s, step, pan_deg, tilt_deg, zoom."""
+        with self._lock:
+            return np.asarray(self.log[start:], dtype=float).reshape(-1, 5)
+
+
+TRUTH_LOG_HEADER = "time_s,step,pan_deg,tilt_deg,zoom"
+
+
+def shown_steps(truth_log, times_s) -> np.ndarray:
+    """The recording step (T,) a virtual camera showed at each epoch time (T,), from its truth log (n, 5)
+    (:meth:`RecordingFeed.rows`); -1 before its first picture."""
+    log = np.asarray(truth_log, dtype=float).reshape(-1, 5)
+    index = np.searchsorted(log[:, 0], np.asarray(times_s, dtype=float), side="right") - 1
+    return np.where(index >= 0, log[np.maximum(index, 0), 1], -1).astype(int)
+
+
+def live_as_episode(world: World, live: LiveEpisode, truth_log=None) -> Episode:
+    """A live run as an :class:`Episode`: with a virtual camera's ``truth_log`` (n, 5), step t is scored
+    against the truth of the recording step its image showed (where nothing was captured, the step shown
+    when it began); without, against nobody (a real camera's run: no truth). Poses not captured are
+    the commanded ones, and counted as not known."""
+    truth = world.truth
+    if truth_log is None:
+        positions_m = np.full((len(live.commanded), 0, 2), np.nan)
+        truth = GroundTruth(positions_m, np.zeros(0), np.zeros(0), truth.frame_rate_hz)
+        shown = np.arange(len(live.commanded))
+    else:
+        times_s = np.where(np.isfinite(live.capture_time_s), live.capture_time_s, live.step_time_s)
+        shown = np.clip(shown_steps(truth_log, times_s), 0, truth.positions_m.shape[0] - 1)
+    captured = np.all(np.isfinite(live.poses), axis=1)
+    poses = np.where(captured[:, None], live.poses, live.commanded)
+    return Episode(
+        GroundTruth(truth.positions_m[shown], truth.heights_m, truth.widths_m, truth.frame_rate_hz),
+        world.camera,
+        world.area_polygon_m,
+        actions=np.array([world.grid.nearest(pose) for pose in live.commanded], dtype=int).reshape(-1),
+        commanded=live.commanded.reshape(-1, 3),
+        poses=poses.reshape(-1, 3),
+        tracker_poses=poses.reshape(-1, 3),
+        pose_known=captured,
+        decision_s=live.decision_s,
+        tracks=live.tracks,
+        detections=live.detections,
+    )
+
+
+# The virtual camera's mechanics, a priori: an IP PTZ dome's preset moves (Axis and Sony domes turn at
+# 100-450 deg/s; 90 deg/s is a slow one) and a zoom through 1x-4x in a second.
+VIRTUAL_SPEEDS = AxisSpeeds(pan_deg_s=90.0, tilt_deg_s=90.0, zoom_per_s=3.0)
+VIRTUAL_FRAME_RATE_HZ = 10.0
+
+
+def virtual_calibration() -> CameraCalibrationFile:
+    """The calibration of ``ptztrack serve-camera``'s camera (``--calibration virtual``)."""
+    return CameraCalibrationFile.model_validate(VIRTUAL_CAMERA_CALIBRATION)
+
+
+def virtual_camera(
+    scenario: Scenario,
+    time_scale: float,
+    port: int,
+    username: str = "",
+    password: str = "",
+    feed: RecordingFeed | None = None,
+) -> tuple[VirtualONVIFCamera, RecordingFeed]:
+    """The virtual ONVIF camera over ``scenario``'s recording (not started) and the feed that logs its
+    truth (``feed``, to go on with one)."""
+    if feed is None:
+        feed = RecordingFeed(episode_world(scenario, 0), 1.0 / scenario.frame_rate_hz, time_scale)
+    world = feed.world
+    camera = VirtualONVIFCamera(
+        feed.render,
+        camera_spaces(virtual_calibration()),
+        VIRTUAL_SPEEDS,
+        world.grid.poses[world.start_action],
+        (world.camera.image_width_px, world.camera.image_height_px),
+        port=port,
+        username=username,
+        password=password,
+        # A picture every 0.1 s at least (a camera's stream at 10 fps), and twice per step of the recording.
+        frame_rate_hz=max(VIRTUAL_FRAME_RATE_HZ, 2.0 * scenario.frame_rate_hz * time_scale),
+    )
+    return camera, feed
+
+
+def live_world(scenario: Scenario, calibration: CameraCalibrationFile, seed: int) -> World:
+    """The world a live run decides in: the scenario's grid, detector and area, with the calibration's
+    camera position and focal length where it gives them."""
+    world = episode_world(scenario, seed)
+    camera = world.camera
+    if calibration.position_m is not None:
+        camera = replace(camera, position_m=calibration.position_m)
+    if calibration.f_min_px is not None:
+        camera = replace(camera, f_min_px=calibration.f_min_px)
+    return replace(world, camera=camera)
+
+
+def run_live_episode(
+    scenario: Scenario,
+    calibration: CameraCalibrationFile,
+    address: CameraAddress,
+    policy: str,
+    steps: int,
+    time_scale: float,
+    seed: int,
+    timeout_s: float = 5.0,
+) -> tuple[World, LiveEpisode]:
+    """Connect to the camera at ``address`` and run ``policy`` for ``steps`` steps at the scenario's rate
+    times ``time_scale``; the camera is released at the end (Ctrl-C included)."""
+    world = live_world(scenario, calibration, seed)
+
+    def connect() -> ONVIFClient:
+        client = ONVIFClient(address, timeout_s)
+        try:
+            client.connect()
+        except CameraError:
+            client.close()
+            raise
+        return client
+
+    camera = ReconnectingCamera(connect, camera_spaces(calibration), calibration.image_delay_s)
+    try:
+        live = run_live(
+            world,
+            make_policy(policy, scenario, world),
+            make_tracker(None, scenario, world),
+            camera,
+            steps,
+            1.0 / (scenario.frame_rate_hz * time_scale),
+            seed,
+        )
+    finally:
+        camera.close()
+    return world, live
+
+
+def offline_counterpart(scenario: Scenario, world: World, live: LiveEpisode, truth_log) -> Scenario:
+    """``scenario`` narrowed to the recording's frames a live run against the virtual camera saw (from
+    the first step its images showed, as many steps as it ran): the offline run to compare it with."""
+    recording = scenario.required_recording("the offline counterpart of a live run")
+    backend = world.backend
+    assert isinstance(backend, RecordedPTZ)
+    times_s = np.where(np.isfinite(live.capture_time_s), live.capture_time_s, live.step_time_s)
+    first = int(backend.scene.video_frame[max(int(shown_steps(truth_log, times_s)[0]), 0)])
+    frame_range = (first, first + len(live.commanded) * recording.frame_step)
+    narrowed = recording.model_copy(update={"frame_range": frame_range})
+    return scenario.model_copy(update={"recording": narrowed, "frames": len(live.commanded)})

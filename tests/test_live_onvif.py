@@ -1,0 +1,179 @@
+"""`ptztrack live` against the virtual ONVIF camera on 127.0.0.1: a scored run, and the faults a real
+network brings (a camera that goes and comes back, a refused connection, a wrong password, a camera
+that stops answering)."""
+
+import signal
+import socket
+import subprocess
+import sys
+import threading
+import time
+
+import numpy as np
+import psutil
+import pytest
+
+from ptztrack.builders.episode import run_episode
+from ptztrack.builders.live import (
+    live_as_episode,
+    offline_counterpart,
+    run_live_episode,
+    virtual_calibration,
+    virtual_camera,
+)
+from ptztrack.camera.onvif_client import CameraAddress, CameraError, ONVIFClient
+from ptztrack.cli import main
+from ptztrack.config import load_camera_calibration, pets_scenario, write_camera_calibration
+from ptztrack.evaluate.metrics import episode_metrics
+
+pytest.importorskip("ipycam", reason="the virtual ONVIF camera needs ipycam (pip install --no-deps ipycam==1.3.0)")
+pytestmark = pytest.mark.onvif
+
+USER, PASSWORD = "operator", "s3cret-pass"
+# The recording at a quarter of its speed: a step of 0.8 s holds a move (up to 0.33 s here) and a HOG
+# detection (about 0.35 s).
+TIME_SCALE = 0.25
+
+
+def _address(camera, password: str = PASSWORD) -> CameraAddress:
+    return CameraAddress("127.0.0.1", camera.onvif_port, USER, password)
+
+
+@pytest.mark.slow
+def test_a_live_smpl_run_with_hog_scores_within_10_points_of_the_offline_run():
+    steps = 110
+    scenario = pets_scenario("hog", frames=steps)
+    camera, feed = virtual_camera(scenario, TIME_SCALE, 0, USER, PASSWORD)
+    with camera:
+        world, live = run_live_episode(
+            scenario, virtual_calibration(), _address(camera), "smpl", steps, TIME_SCALE, seed=0
+        )
+    live_mota = episode_metrics(live_as_episode(world, live, feed.rows()))["mota"]
+    offline_mota = episode_metrics(run_episode(offline_counterpart(scenario, world, live, feed.rows()), "smpl", 0))[
+        "mota"
+    ]
+    assert len(live.commanded) == steps and np.isfinite(live.capture_time_s).sum() >= 100
+    assert abs(live_mota - offline_mota) <= 0.10, (live_mota, offline_mota)
+
+
+def test_the_run_goes_on_through_a_camera_that_goes_away_and_comes_back():
+    """The camera stops after 2 s and a new one comes up on its port 2 s later, the recording going on:
+    the steps in between capture nothing, the tracker keeps its tracks on predictions, and the run
+    captures again once the camera is back."""
+    scenario = pets_scenario("hog")
+    camera, feed = virtual_camera(scenario, TIME_SCALE, 0, USER, PASSWORD)
+    camera.start()
+    address = _address(camera)
+    result = {}
+
+    def run():
+        result["run"] = run_live_episode(
+            scenario, virtual_calibration(), address, "fix", 16, TIME_SCALE, seed=0, timeout_s=1.0
+        )
+
+    runner = threading.Thread(target=run)
+    runner.start()
+    time.sleep(2.0)
+    camera.stop()
+    time.sleep(2.0)
+    restarted, _ = virtual_camera(scenario, TIME_SCALE, address.port, USER, PASSWORD, feed)
+    with restarted:
+        runner.join(timeout=60)
+    assert not runner.is_alive()
+    _, live = result["run"]
+    captured = np.isfinite(live.capture_time_s)
+    gap = np.flatnonzero(~captured[2:]) + 2
+    assert len(gap) >= 3, "no steps without the camera"
+    assert captured[gap[-1] + 1 :].any(), "never captured again"
+    # Tracks too uncertain are not reported while the camera is away; the tracker keeps them, and
+    # reports them again under the same ids once it sees their people.
+    before = set(live.tracks[gap[0] - 1].ids)
+    after = set().union(*(set(tracks.ids) for tracks in live.tracks[gap[-1] + 1 :]))
+    assert before and before & after, "tracks lost while the camera was away"
+
+
+def test_a_refused_connection_exits_2_with_one_line(capsys):
+    with socket.socket() as probe:  # a port nobody listens on
+        probe.bind(("127.0.0.1", 0))
+        port = probe.getsockname()[1]
+    status = main(["live", "--camera", f"onvif://{USER}:{PASSWORD}@127.0.0.1:{port}", "--calibration", "virtual"])
+    error = capsys.readouterr().err.strip().splitlines()
+    assert status == 2 and len(error) == 1 and "connection refused" in error[0]
+    assert PASSWORD not in error[0]
+
+
+def test_a_wrong_password_exits_2_with_one_line_that_does_not_show_it(capsys):
+    camera, _ = virtual_camera(pets_scenario("hog"), 1.0, 0, USER, PASSWORD)
+    with camera:
+        url = f"onvif://{USER}:not-the-password@127.0.0.1:{camera.onvif_port}"
+        status = main(["live", "--camera", url, "--calibration", "virtual", "--steps", "3"])
+    error = capsys.readouterr().err.strip().splitlines()
+    assert status == 2 and len(error) == 1 and "user name or password" in error[0]
+    assert "not-the-password" not in error[0]
+
+
+def test_a_camera_that_stops_answering_times_out_instead_of_hanging():
+    """A listener that accepts and never answers: every call gives up after its timeout."""
+    with socket.socket() as silent:
+        silent.bind(("127.0.0.1", 0))
+        silent.listen()
+        client = ONVIFClient(CameraAddress("127.0.0.1", silent.getsockname()[1], USER, PASSWORD), timeout_s=1.0)
+        started = time.monotonic()
+        with pytest.raises(CameraError, match="no answer within 1 s"):
+            client.connect()
+        client.close()
+    assert time.monotonic() - started < 3.0
+
+
+def test_calibrate_times_the_moves_and_writes_the_virtual_cameras_speeds_into_the_file(tmp_path, capsys):
+    """The virtual camera turns at 90 deg/s and zooms at 3 per second: the fitted slopes are their
+    inverses, the intercepts about the polling interval."""
+    path = tmp_path / "camera.yaml"
+    write_camera_calibration(path, virtual_calibration())
+    camera, _ = virtual_camera(pets_scenario("hog"), 1.0, 0, USER, PASSWORD)
+    with camera:
+        url = f"onvif://{USER}:{PASSWORD}@127.0.0.1:{camera.onvif_port}"
+        assert main(["camera", "calibrate", "--camera", url, "--calibration", str(path)]) == 0
+    move_times = load_camera_calibration(path).move_times
+    assert move_times.pan[1] == pytest.approx(1 / 90, rel=0.15) and move_times.tilt[1] == pytest.approx(
+        1 / 90, rel=0.15
+    )
+    assert move_times.zoom[1] == pytest.approx(1 / 3, rel=0.15)
+    assert all(0 <= intercept < 0.2 for intercept, _ in (move_times.pan, move_times.tilt, move_times.zoom))
+    assert "wrote move_times" in capsys.readouterr().out
+
+
+def test_serve_camera_serves_pets_on_127_0_0_1_until_stopped_and_logs_its_truth(tmp_path):
+    """`ptztrack serve-camera` as a user runs it: a client reads its status, every socket of the command
+    and of its children is on 127.0.0.1 and none is UDP 3702, Ctrl-C stops it with status 0, and its
+    truth log has a picture's time, step and pose per line."""
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        port = probe.getsockname()[1]
+    log = tmp_path / "truth.csv"
+    command = [sys.executable, "-m", "ptztrack.cli", "serve-camera", "--port", str(port), "--truth-log", str(log)]
+    server = subprocess.Popen(
+        command,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
+    )
+    try:
+        assert f"onvif://127.0.0.1:{port}" in server.stdout.readline()
+        client = ONVIFClient(CameraAddress("127.0.0.1", port), timeout_s=5.0)
+        client.connect()
+        assert not client.status().moving and client.snapshot().shape == (120, 160, 3)  # the paper's PETS view
+        client.close()
+        process = psutil.Process(server.pid)
+        sockets = [s for p in [process, *process.children(recursive=True)] for s in p.net_connections("inet")]
+        assert sockets and all(s.laddr.ip == "127.0.0.1" for s in sockets), sockets
+        assert not any(s.type == socket.SOCK_DGRAM and s.laddr.port == 3702 for s in sockets)
+        time.sleep(1.0)
+    finally:
+        server.send_signal(signal.SIGINT)
+        server.wait(timeout=30)
+    assert server.returncode == 0, server.stderr.read()
+    lines = log.read_text().splitlines()
+    assert lines[0] == "time_s,step,pan_deg,tilt_deg,zoom" and len(lines) > 5
+    assert all(len(line.split(",")) == 5 for line in lines[1:])
