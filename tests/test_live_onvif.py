@@ -15,13 +15,14 @@ import pytest
 
 from ptztrack.builders.episode import run_episode
 from ptztrack.builders.live import (
+    camera_spaces,
     live_as_episode,
     offline_counterpart,
     run_live_episode,
     virtual_calibration,
     virtual_camera,
 )
-from ptztrack.camera.onvif_client import CameraAddress, CameraError, ONVIFClient
+from ptztrack.camera.onvif_client import CameraAddress, CameraError, ONVIFClient, read_stream_frame
 from ptztrack.cli import main
 from ptztrack.config import load_camera_calibration, pets_scenario, write_camera_calibration
 from ptztrack.evaluate.metrics import episode_metrics
@@ -177,3 +178,40 @@ def test_serve_camera_serves_pets_on_127_0_0_1_until_stopped_and_logs_its_truth(
     lines = log.read_text().splitlines()
     assert lines[0] == "time_s,step,pan_deg,tilt_deg,zoom" and len(lines) > 5
     assert all(len(line.split(",")) == 5 for line in lines[1:])
+
+
+def test_the_client_moves_reads_limits_keeps_presets_and_reads_the_rtsp_stream():
+    """Every ONVIF call of the client against the virtual camera, each checked by the pose it leads to."""
+    camera, _ = virtual_camera(pets_scenario("hog"), 1.0, 0, USER, PASSWORD)
+    spaces = camera_spaces(virtual_calibration())
+    with camera:
+        client = ONVIFClient(_address(camera), timeout_s=5.0)
+        client.connect()
+        try:
+            np.testing.assert_allclose(client.position_limits(), [[-1, 1], [-1, 1], [0, 1]])
+            client.move_to(spaces.normalised([30.0, 10.0, 2.0]))
+            _wait_still(client)
+            home = client.set_preset("entrance")
+            assert client.presets()[home] == "entrance"
+            client.relative_move([-0.1, 0.0, 0.0])  # -9 degrees of pan: a tenth of half the range
+            _wait_still(client)
+            np.testing.assert_allclose(spaces.pose(client.status().position), [21.0, 10.0, 2.0], atol=1e-6)
+            client.continuous_move([0.5, 0.0, 0.0], 10.0)
+            time.sleep(0.3)
+            client.stop()
+            stopped = spaces.pose(client.status().position)
+            assert not client.status().moving and 21.0 + 5.0 < stopped[0] < 21.0 + 25.0  # 45 deg/s for ~0.3 s
+            client.goto_preset(home)
+            _wait_still(client)
+            np.testing.assert_allclose(spaces.pose(client.status().position), [30.0, 10.0, 2.0], atol=1e-6)
+            if camera.rtsp_port is None:
+                pytest.skip("ffmpeg is not on the PATH: the virtual camera has no RTSP stream")
+            assert read_stream_frame(client.stream_uri()).shape == (120, 160, 3)
+        finally:
+            client.close()
+
+
+def _wait_still(client: ONVIFClient) -> None:
+    deadline = time.monotonic() + 5.0
+    while client.status().moving and time.monotonic() < deadline:
+        time.sleep(0.02)

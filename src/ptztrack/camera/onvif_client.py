@@ -20,7 +20,7 @@ import threading
 from collections.abc import Coroutine
 from dataclasses import dataclass, field
 from typing import Any
-from urllib.parse import unquote, urlsplit
+from urllib.parse import quote, unquote, urlsplit
 
 import cv2
 import numpy as np
@@ -91,6 +91,7 @@ class ONVIFClient:
         self._thread = threading.Thread(target=self._loop.run_forever, name="onvif-client", daemon=True)
         self._thread.start()
         self._camera: Any = None
+        self._media: Any = None
         self._ptz: Any = None
         self._profile = ""
 
@@ -113,6 +114,58 @@ class ONVIFClient:
             "Speed": {"PanTilt": {"x": 1.0, "y": 1.0}, "Zoom": {"x": 1.0}},
         }
         self._call(self._ptz.AbsoluteMove(request))
+
+    def relative_move(self, translation) -> None:
+        """RelativeMove by ``translation`` (3,) in the generic translation spaces."""
+        x, y, zoom = (float(value) for value in translation)
+        request = {"ProfileToken": self._profile, "Translation": {"PanTilt": {"x": x, "y": y}, "Zoom": {"x": zoom}}}
+        self._call(self._ptz.RelativeMove(request))
+
+    def continuous_move(self, velocity, duration_s: float) -> None:
+        """ContinuousMove at ``velocity`` (3,) (fractions of each axis' top speed) for ``duration_s``."""
+        x, y, zoom = (float(value) for value in velocity)
+        request = {
+            "ProfileToken": self._profile,
+            "Velocity": {"PanTilt": {"x": x, "y": y}, "Zoom": {"x": zoom}},
+            "Timeout": f"PT{duration_s:.3f}S",
+        }
+        self._call(self._ptz.ContinuousMove(request))
+
+    def stop(self) -> None:
+        """Stop every axis."""
+        self._call(self._ptz.Stop({"ProfileToken": self._profile, "PanTilt": True, "Zoom": True}))
+
+    def set_preset(self, name: str) -> str:
+        """Store the current position as a preset called ``name``; its token."""
+        return str(self._call(self._ptz.SetPreset({"ProfileToken": self._profile, "PresetName": name})))
+
+    def presets(self) -> dict[str, str]:
+        """{token: name} of the camera's presets."""
+        found = self._call(self._ptz.GetPresets({"ProfileToken": self._profile})) or []
+        return {str(preset.token): str(preset.Name) for preset in found}
+
+    def goto_preset(self, token: str) -> None:
+        self._call(self._ptz.GotoPreset({"ProfileToken": self._profile, "PresetToken": token}))
+
+    def position_limits(self) -> np.ndarray:
+        """(3, 2) [low, high] of pan, tilt and zoom in the node's absolute position spaces."""
+        spaces = self._call(self._ptz.GetNodes())[0].SupportedPTZSpaces
+        pan_tilt, zoom = spaces.AbsolutePanTiltPositionSpace[0], spaces.AbsoluteZoomPositionSpace[0]
+        ranges = (pan_tilt.XRange, pan_tilt.YRange, zoom.XRange)
+        return np.array([[float(axis.Min), float(axis.Max)] for axis in ranges])
+
+    def stream_uri(self) -> str:
+        """The RTSP URI of the profile's stream, with the client's credentials in it."""
+        request = {
+            "StreamSetup": {"Stream": "RTP-Unicast", "Transport": {"Protocol": "RTSP"}},
+            "ProfileToken": self._profile,
+        }
+        uri = str(self._call(self._media.GetStreamUri(request)).Uri)
+        if not self.address.username:
+            return uri
+        scheme, _, rest = uri.partition("://")
+        credentials = f"{quote(self.address.username, safe='')}:{quote(self.address.password, safe='')}@"
+        return f"{scheme}://{credentials}{rest}"
 
     def snapshot(self) -> np.ndarray:
         """The camera's current image, (h, w, 3) uint8 BGR, from its snapshot URI (HTTP Basic)."""
@@ -144,9 +197,9 @@ class ONVIFClient:
         camera = onvif.ONVIFCamera(address.host, address.port, address.username, address.password, wsdl, no_cache=True)
         try:
             await camera.update_xaddrs()
-            media = await camera.create_media_service()
+            self._media = await camera.create_media_service()
             self._ptz = await camera.create_ptz_service()
-            profiles = await media.GetProfiles()
+            profiles = await self._media.GetProfiles()
         except BaseException:
             await camera.close()
             raise
@@ -166,6 +219,23 @@ class ONVIFClient:
             raise
         except Exception as error:
             raise CameraError(f"{self.address}: {_reason(error)}") from None
+
+
+def read_stream_frame(uri: str, timeout_s: float = 10.0) -> np.ndarray:
+    """One frame (h, w, 3) uint8 BGR of an RTSP stream through OpenCV's ffmpeg, over TCP, within
+    ``timeout_s`` to open and to read; a :class:`CameraError` naming the stream (not its credentials)."""
+    # OpenCV's ffmpeg reads its options from the environment: RTP over TCP, one connection, no UDP ports.
+    os.environ.setdefault("OPENCV_FFMPEG_CAPTURE_OPTIONS", "rtsp_transport;tcp")
+    milliseconds = int(1000 * timeout_s)
+    options = [cv2.CAP_PROP_OPEN_TIMEOUT_MSEC, milliseconds, cv2.CAP_PROP_READ_TIMEOUT_MSEC, milliseconds]
+    capture = cv2.VideoCapture(uri, cv2.CAP_FFMPEG, options)
+    try:
+        ok, frame = capture.read()
+    finally:
+        capture.release()
+    if not ok:
+        raise CameraError(f"{urlsplit(uri).hostname}:{urlsplit(uri).port}: no frame from the RTSP stream")
+    return frame
 
 
 def _reason(error: Exception) -> str:
