@@ -52,6 +52,7 @@ from ptztrack.camera.move_timing import measure_move_times
 from ptztrack.camera.onvif_client import PASSWORD_VARIABLE, ONVIFClient, camera_address
 from ptztrack.config import (
     LiveView,
+    MoveTimesSection,
     PoseError,
     Scenario,
     ScenarioError,
@@ -226,7 +227,7 @@ def calibrate_camera_command(args: argparse.Namespace) -> int:
             f"{axis}: {intercept:.3f} s + {slope:.4f} s/{unit} "
             f"({len(seconds)} moves of {distances.max():.3g} {unit} at most)"
         )
-    section = {axis: list(getattr(move_times, axis)) for axis in ("pan", "tilt", "zoom")}
+    section = MoveTimesSection(pan=move_times.pan, tilt=move_times.tilt, zoom=move_times.zoom)
     write_camera_calibration(args.calibration, calibration.model_copy(update={"move_times": section}))
     print(f"wrote move_times into {args.calibration}")
     return 0
