@@ -1,6 +1,6 @@
 import numpy as np
 
-from ptztrack.builders.episode import run_episode
+from ptztrack.builders.episode import episode_world, make_policy, run_episode
 from ptztrack.config import scenario_from_dict
 from ptztrack.evaluate.metrics import episode_metrics
 from ptztrack.loop import episode_seeds
@@ -55,3 +55,24 @@ def test_the_trackers_stream_leaves_the_first_four_streams_as_they_were():
     before = [np.random.default_rng(stream).random(3) for stream in np.random.SeedSequence(7).spawn(4)]
     np.testing.assert_array_equal(draws[:4], before)
     assert not np.array_equal(draws[4], draws[3])
+
+
+def test_an_observer_sees_every_step_and_changes_nothing_and_intg_exposes_its_rewards():
+    scenario = scenario_from_dict({"frames": 12})
+    world = episode_world(scenario, 3)
+    policy = make_policy("intg", scenario, world)
+    seen = []
+
+    def observer(step, context, record):
+        rewards = policy.last_reward_nats
+        assert rewards.shape == (world.grid.size,)
+        assert np.all(np.isfinite(rewards[context.reachable]))
+        assert np.isnan(rewards).sum() == world.grid.size - len(context.reachable)
+        assert record["actions"] in context.reachable
+        seen.append(step)
+
+    observed = run_episode(scenario, policy, 3, world, observer=observer)
+    plain = run_episode(scenario, "intg", 3)
+    assert seen == list(range(12))
+    np.testing.assert_array_equal(observed.actions, plain.actions)
+    np.testing.assert_array_equal(observed.poses, plain.poses)

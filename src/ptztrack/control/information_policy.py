@@ -36,6 +36,8 @@ class InformationGainPolicy:
     person_height_m, person_width_m : the person the policy expects.
     method : 'intg' (equation 8, closed form) or 'smpl' (equation 19, ``samples`` draws).
     beta, exploration : the patrolling term's weight and map (None: no patrolling term).
+    last_reward_nats : (L,) after each choice, the reward of every action of the grid, NaN where not
+        reachable (for a live view of the decision; None before the first choice).
     """
 
     camera: PTZCamera
@@ -49,6 +51,7 @@ class InformationGainPolicy:
     beta: float = 0.0
     exploration: ExplorationMap | None = None
     geometry: ActionGeometry = field(init=False, repr=False)
+    last_reward_nats: np.ndarray | None = field(default=None, init=False, repr=False)
 
     def __post_init__(self):
         self.geometry = action_geometry(self.camera, self.grid.poses, self.person_height_m)
@@ -84,6 +87,8 @@ class InformationGainPolicy:
 
     def choose(self, context: DecisionContext) -> int:
         reward = self.rewards(context.reachable, context.tracks, context.rng)
+        self.last_reward_nats = np.full(self.grid.size, np.nan)
+        self.last_reward_nats[context.reachable] = reward
         best = int(np.argmax(reward))
         staying = np.flatnonzero(context.reachable == context.current_action)
         if len(staying) and reward[staying[0]] >= reward[best]:
