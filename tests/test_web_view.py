@@ -97,3 +97,24 @@ def test_a_browser_draws_the_run_pauses_steps_resumes_and_keeps_the_final_state(
     assert screenshot.stat().st_size > 10_000
     SCREENSHOT_COPY.parent.mkdir(parents=True, exist_ok=True)
     shutil.copyfile(screenshot, SCREENSHOT_COPY)
+
+
+def test_run_with_view_prints_the_address_starts_when_a_page_connects_and_sends_the_final_state():
+    import json
+    import subprocess
+    import sys
+
+    from websockets.sync.client import connect
+
+    command = [sys.executable, "-m", "ptztrack.cli", "run", "--frames", "12", "--policy", "intg", "--view"]
+    with subprocess.Popen(command, stdout=subprocess.PIPE, text=True) as run:
+        assert run.stdout is not None
+        line = run.stdout.readline()
+        assert line.startswith("view at http://127.0.0.1:")
+        address = line.split()[2]
+        with connect(address.replace("http://", "ws://") + "ws", max_size=None) as socket:
+            states = [json.loads(message) for message in socket]
+        rest = run.stdout.read()
+    assert run.returncode == 0
+    assert states[-1]["finished"] and states[-1]["step"] == 11
+    assert "MOTA" in rest

@@ -14,7 +14,7 @@ import numpy as np
 
 from ptztrack import registry
 from ptztrack.builders.budget import refuse_if_too_large
-from ptztrack.builders.episode import episode_world, run_episode
+from ptztrack.builders.episode import episode_world, make_policy, run_episode
 from ptztrack.builders.experiments import (
     POSE_SOURCES,
     STRATEGIES,
@@ -91,6 +91,8 @@ from ptztrack.evaluate.registration import summarise_registration
 from ptztrack.evaluate.report import RUN_FILES, write_figure, write_outputs
 from ptztrack.evaluate.tables import format_table, paired_difference, summarise
 from ptztrack.evaluate.video import view_renderer
+from ptztrack.evaluate.view_state import ViewState
+from ptztrack.evaluate.web_view import ViewHub, ViewServer
 from ptztrack.files import InputError, check_output_file, check_output_folder, read_text, run_folder, write_json
 from ptztrack.scene.roads import walk_roads
 
@@ -144,7 +146,10 @@ def run_command(args: argparse.Namespace) -> int:
     )
     refuse_if_too_large(scenario, (args.policy,))
     world = episode_world(scenario, args.seed)
-    episode = run_episode(scenario, args.policy, args.seed, world)
+    if args.view is None:
+        episode = run_episode(scenario, args.policy, args.seed, world)
+    else:
+        episode = _run_with_view(scenario, args, world)
     metrics = episode_metrics(episode)
     print(
         f"scenario {args.scenario}, policy {args.policy}, detector {scenario.detector.kind}, "
@@ -157,6 +162,16 @@ def run_command(args: argparse.Namespace) -> int:
             write_outputs(folder, episode, metrics, title, view_renderer(world))
         print(f"wrote {', '.join(RUN_FILES)} into {args.out}")
     return 0
+
+
+def _run_with_view(scenario: Scenario, args: argparse.Namespace, world):
+    """The episode with the live web view on 127.0.0.1:``args.view``; it starts when a page connects."""
+    policy = make_policy(args.policy, scenario, world)
+    steps = world.truth.positions_m.shape[0]
+    hub = ViewHub(ViewState(world, policy, steps, args.policy), paused=True, resume_on_connect=True)
+    with ViewServer(hub, args.view) as server:
+        print(f"view at {server.address} (the run starts when a page opens it)", flush=True)
+        return run_episode(scenario, policy, args.seed, world, observer=hub)
 
 
 def _credentials(args: argparse.Namespace) -> dict | None:
@@ -552,6 +567,14 @@ def parser() -> argparse.ArgumentParser:
     _add_tracker_arguments(run)
     run.add_argument("--out", type=Path, help=f"directory for {', '.join(RUN_FILES)}; written whole or not at all")
     run.add_argument("--overwrite", action="store_true", help="replace a non-empty --out folder")
+    run.add_argument(
+        "--view",
+        type=_port,
+        nargs="?",
+        const=0,
+        metavar="PORT",
+        help="serve a live view of the run on http://127.0.0.1:PORT/ (no PORT or 0: any free one)",
+    )
     _add_recording_arguments(run)
     run.set_defaults(handler=run_command)
 
