@@ -12,19 +12,22 @@ each step taking the truth of the step its image showed.
 import threading
 import time
 from dataclasses import dataclass, field, replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ptztrack.builders.episode import episode_world, make_policy, make_tracker
 from ptztrack.camera.live_camera import ReconnectingCamera
 from ptztrack.camera.onvif_client import CameraAddress, CameraError, ONVIFClient
-from ptztrack.camera.onvif_server import AxisSpeeds, VirtualONVIFCamera
-from ptztrack.camera.onvif_spaces import CameraSpaces, MoveTimes
+from ptztrack.camera.onvif_spaces import AxisSpeeds, CameraSpaces, MoveTimes
 from ptztrack.camera.recorded import RecordedPTZ
 from ptztrack.config import VIRTUAL_CAMERA_CALIBRATION, CameraCalibrationFile, Scenario
 from ptztrack.live import LiveEpisode, run_live
 from ptztrack.loop import Episode, World
 from ptztrack.types import GroundTruth
+
+if TYPE_CHECKING:
+    from ptztrack.camera.onvif_server import VirtualONVIFCamera
 
 
 def camera_spaces(calibration: CameraCalibrationFile) -> CameraSpaces:
@@ -130,9 +133,15 @@ def virtual_camera(
     username: str = "",
     password: str = "",
     feed: RecordingFeed | None = None,
-) -> tuple[VirtualONVIFCamera, RecordingFeed]:
+) -> tuple["VirtualONVIFCamera", RecordingFeed]:
     """The virtual ONVIF camera over ``scenario``'s recording (not started) and the feed that logs its
     truth (``feed``, to go on with one)."""
+    try:  # the server is ipycam's, installed apart (it must not bring opencv-python): only here is it needed
+        from ptztrack.camera.onvif_server import VirtualONVIFCamera
+    except ImportError:
+        raise RuntimeError(
+            "the virtual ONVIF camera needs ipycam: pip install --no-deps ipycam==1.3.0 (README, Real cameras)"
+        ) from None
     if feed is None:
         feed = RecordingFeed(episode_world(scenario, 0), 1.0 / scenario.frame_rate_hz, time_scale)
     world = feed.world
