@@ -213,6 +213,4 @@ def test_the_client_moves_reads_limits_keeps_presets_and_reads_the_rtsp_stream()
 
 
 def _wait_still(client: ONVIFClient) -> None:
-    deadline = time.monotonic() + 5.0
-    while client.status().moving and time.monotonic() < deadline:
-        time.sleep(0.02)
+    client.wait_still(time.monotonic() + 5.0)
