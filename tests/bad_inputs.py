@@ -237,6 +237,16 @@ def cases(scratch: Path | None) -> list[Case]:
             view="detections: det.txt.gz",
             files={"det.txt.gz": gzip.compress(b"1,-1,300,200,40,100,0.9,-1,-1,-1\n" * 100)[:-8]},
         ),
+        Case("live: not an ONVIF URL", ("live", "--camera", "rtsp://op:pw@127.0.0.1/x", "--calibration", "virtual")),
+        Case(
+            "live: --time-scale 0", ("live", "--camera", "127.0.0.1", "--calibration", "virtual", "--time-scale", "0")
+        ),
+        Case(
+            "live: a zoom curve that falls",
+            ("live", "--camera", "127.0.0.1:9", "--calibration", "{dir}/c.yaml"),
+            {"c.yaml": "pan_deg: [-90, 90]\ntilt_deg: [-45, 45]\nzoom_curve: [[0, 4], [1, 1]]\n"},
+        ),
+        Case("serve-camera: a user without a password", ("serve-camera", "--port", "0", "--user", "op")),
         _dataset("occupancy --out not empty", files={"out/keep.txt": "keep me\n"}, extra=("--out", "{dir}/out")),
     ]
 

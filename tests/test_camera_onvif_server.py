@@ -24,8 +24,8 @@ onvif = pytest.importorskip("onvif", reason="the ONVIF client is onvif-zeep-asyn
 
 import zeep.exceptions  # noqa: E402  (onvif-zeep-async's SOAP library)
 
-from ptztrack.camera.onvif_server import AxisSpeeds, VirtualONVIFCamera  # noqa: E402
-from ptztrack.camera.onvif_spaces import CameraSpaces  # noqa: E402
+from ptztrack.camera.onvif_server import VirtualONVIFCamera  # noqa: E402
+from ptztrack.camera.onvif_spaces import AxisSpeeds, CameraSpaces  # noqa: E402
 
 pytestmark = pytest.mark.onvif
 

@@ -253,6 +253,11 @@ def serve_camera_command(args: argparse.Namespace) -> int:
     credentials = _credentials(args) or {}
     username = args.user or credentials.get("username", "")
     password = credentials.get("password") or os.environ.get(PASSWORD_VARIABLE, "")
+    if bool(username) != bool(password):
+        raise ScenarioError(
+            f"serve-camera: give a user and a password (--user with --credentials or ${PASSWORD_VARIABLE}), "
+            "or neither for a camera without authentication"
+        )
     camera, feed = virtual_camera(scenario, args.time_scale, args.port, username, password)
     log_file = None if args.truth_log is None else open(args.truth_log, "w", encoding="utf-8")  # noqa: SIM115
     written = 0
@@ -267,7 +272,9 @@ def serve_camera_command(args: argparse.Namespace) -> int:
             time.sleep(0.5)
             if log_file is not None:
                 rows = feed.rows(written)
-                log_file.writelines(",".join(f"{value:.6f}" for value in row) + "\n" for row in rows)
+                log_file.writelines(
+                    f"{row[0]:.6f},{int(row[1])},{row[2]:.6f},{row[3]:.6f},{row[4]:.6f}\n" for row in rows
+                )
                 log_file.flush()
                 written += len(rows)
     except KeyboardInterrupt:

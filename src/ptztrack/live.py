@@ -58,6 +58,11 @@ class LiveEpisode:
     tracks: list[Tracks]
     detections: list[Detections]
 
+    @property
+    def seen_time_s(self) -> np.ndarray:
+        """(T,) epoch seconds of what each step saw: its capture, or its start where nothing was captured."""
+        return np.where(np.isfinite(self.capture_time_s), self.capture_time_s, self.step_time_s)
+
 
 class _CapturedView:
     """The captured image as a camera backend for the detector: a real camera knows no people."""

@@ -12,30 +12,28 @@ each step taking the truth of the step its image showed.
 import threading
 import time
 from dataclasses import dataclass, field, replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ptztrack.builders.episode import episode_world, make_policy, make_tracker
 from ptztrack.camera.live_camera import ReconnectingCamera
 from ptztrack.camera.onvif_client import CameraAddress, CameraError, ONVIFClient
-from ptztrack.camera.onvif_server import AxisSpeeds, VirtualONVIFCamera
-from ptztrack.camera.onvif_spaces import CameraSpaces, MoveTimes
+from ptztrack.camera.onvif_spaces import AxisSpeeds, CameraSpaces
 from ptztrack.camera.recorded import RecordedPTZ
 from ptztrack.config import VIRTUAL_CAMERA_CALIBRATION, CameraCalibrationFile, Scenario
 from ptztrack.live import LiveEpisode, run_live
 from ptztrack.loop import Episode, World
 from ptztrack.types import GroundTruth
 
+if TYPE_CHECKING:
+    from ptztrack.camera.onvif_server import VirtualONVIFCamera
+
 
 def camera_spaces(calibration: CameraCalibrationFile) -> CameraSpaces:
     return CameraSpaces(
         calibration.pan_deg, calibration.tilt_deg, tuple((float(z), float(f)) for z, f in calibration.zoom_curve)
     )
-
-
-def move_times(calibration: CameraCalibrationFile) -> MoveTimes:
-    section = calibration.move_times
-    return MoveTimes(section.pan, section.tilt, section.zoom)
 
 
 @dataclass
@@ -93,8 +91,7 @@ def live_as_episode(world: World, live: LiveEpisode, truth_log=None) -> Episode:
         truth = GroundTruth(positions_m, np.zeros(0), np.zeros(0), truth.frame_rate_hz)
         shown = np.arange(len(live.commanded))
     else:
-        times_s = np.where(np.isfinite(live.capture_time_s), live.capture_time_s, live.step_time_s)
-        shown = np.clip(shown_steps(truth_log, times_s), 0, truth.positions_m.shape[0] - 1)
+        shown = np.clip(shown_steps(truth_log, live.seen_time_s), 0, truth.positions_m.shape[0] - 1)
     captured = np.all(np.isfinite(live.poses), axis=1)
     poses = np.where(captured[:, None], live.poses, live.commanded)
     return Episode(
@@ -130,9 +127,15 @@ def virtual_camera(
     username: str = "",
     password: str = "",
     feed: RecordingFeed | None = None,
-) -> tuple[VirtualONVIFCamera, RecordingFeed]:
+) -> tuple["VirtualONVIFCamera", RecordingFeed]:
     """The virtual ONVIF camera over ``scenario``'s recording (not started) and the feed that logs its
     truth (``feed``, to go on with one)."""
+    try:  # the server is ipycam's, installed apart (it must not bring opencv-python): only here is it needed
+        from ptztrack.camera.onvif_server import VirtualONVIFCamera
+    except ImportError:
+        raise RuntimeError(
+            "the virtual ONVIF camera needs ipycam: pip install --no-deps ipycam==1.3.0 (README, Real cameras)"
+        ) from None
     if feed is None:
         feed = RecordingFeed(episode_world(scenario, 0), 1.0 / scenario.frame_rate_hz, time_scale)
     world = feed.world
@@ -208,8 +211,7 @@ def offline_counterpart(scenario: Scenario, world: World, live: LiveEpisode, tru
     recording = scenario.required_recording("the offline counterpart of a live run")
     backend = world.backend
     assert isinstance(backend, RecordedPTZ)
-    times_s = np.where(np.isfinite(live.capture_time_s), live.capture_time_s, live.step_time_s)
-    first = int(backend.scene.video_frame[max(int(shown_steps(truth_log, times_s)[0]), 0)])
+    first = int(backend.scene.video_frame[max(int(shown_steps(truth_log, live.seen_time_s)[0]), 0)])
     frame_range = (first, first + len(live.commanded) * recording.frame_step)
     narrowed = recording.model_copy(update={"frame_range": frame_range})
     return scenario.model_copy(update={"recording": narrowed, "frames": len(live.commanded)})

@@ -36,7 +36,6 @@ class Capture:
 
 
 FIRST_RETRY_S = 0.5
-POLL_S = 0.02
 LONGEST_RETRY_S = 8.0
 
 
@@ -71,10 +70,7 @@ class ReconnectingCamera:
         if client is None:
             return None
         try:
-            status = client.status()
-            while status.moving and self._clock() < until_s:
-                time.sleep(POLL_S)
-                status = client.status()
+            status = client.wait_still(until_s)
             if status.moving:
                 return None
             if self._moved:  # the images of the new pose come after the camera stands there

@@ -11,17 +11,14 @@ from ptztrack.camera.onvif_spaces import CameraSpaces, MoveTimes
 
 # Moves of these fractions of each axis' range, there and back from the middle of the range.
 MOVE_FRACTIONS = (0.05, 0.1, 0.2, 0.4)
-POLL_S = 0.02
 
 
 def timed_move(client: ONVIFClient, position, timeout_s: float = 30.0) -> float:
     """Seconds from an AbsoluteMove to ``position`` (3,) (normalised) until the camera reports it idle."""
     started = time.monotonic()
     client.move_to(position)
-    while client.status().moving:
-        if time.monotonic() - started > timeout_s:
-            raise TimeoutError(f"the camera was still moving after {timeout_s:g} s")
-        time.sleep(POLL_S)
+    if client.wait_still(started + timeout_s).moving:
+        raise TimeoutError(f"the camera was still moving after {timeout_s:g} s")
     return time.monotonic() - started
 
 

@@ -17,6 +17,7 @@ import asyncio
 import logging
 import os
 import threading
+import time
 from collections.abc import Coroutine
 from dataclasses import dataclass, field
 from typing import Any
@@ -28,6 +29,7 @@ import numpy as np
 PASSWORD_VARIABLE = "PTZTRACK_CAMERA_PASSWORD"
 USER_VARIABLE = "PTZTRACK_CAMERA_USER"
 DEFAULT_ONVIF_PORT = 80
+POLL_S = 0.02
 
 
 class CameraError(RuntimeError):
@@ -104,6 +106,15 @@ class ONVIFClient:
         pan_tilt, zoom = status.Position.PanTilt, status.Position.Zoom
         moving = any(str(getattr(status.MoveStatus, axis, "IDLE")) == "MOVING" for axis in ("PanTilt", "Zoom"))
         return CameraStatus(np.array([pan_tilt.x, pan_tilt.y, zoom.x], dtype=float), moving)
+
+    def wait_still(self, until_s: float) -> CameraStatus:
+        """GetStatus every ``POLL_S`` until the camera stands still or ``until_s`` passes (on
+        ``time.monotonic``'s clock); the last status."""
+        status = self.status()
+        while status.moving and time.monotonic() < until_s:
+            time.sleep(POLL_S)
+            status = self.status()
+        return status
 
     def move_to(self, position) -> None:
         """AbsoluteMove to ``position`` (3,) in the normalised spaces, at full speed."""

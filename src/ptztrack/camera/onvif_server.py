@@ -80,7 +80,7 @@ from ipycam import (
 )
 from ipycam.rtsp import RTSPState
 
-from ptztrack.camera.onvif_spaces import CameraSpaces
+from ptztrack.camera.onvif_spaces import AxisSpeeds, CameraSpaces
 
 log = logging.getLogger("ptztrack.onvif_server")
 
@@ -115,15 +115,6 @@ _DEFAULT_TIMEOUT_S, _MAX_TIMEOUT_S = 10.0, 60.0
 _JOIN_S = 5.0
 # xs:duration from days to seconds (years and months have no fixed length): P1D, PT10S, PT0.5S, PT1M30S.
 _DURATION = re.compile(r"P(?=\d|T\d)(?:(\d+)D)?(?:T(?=\d)(?:(\d+)H)?(?:(\d+)M)?(?:(\d+(?:\.\d+)?)S)?)?")
-
-
-@dataclass(frozen=True)
-class AxisSpeeds:
-    """The mechanics the virtual camera moves at: degrees per second of pan and tilt, zoom factor per second."""
-
-    pan_deg_s: float
-    tilt_deg_s: float
-    zoom_per_s: float
 
 
 @dataclass(frozen=True)

@@ -59,6 +59,15 @@ class CameraSpaces:
 
 
 @dataclass(frozen=True)
+class AxisSpeeds:
+    """The mechanics a (virtual) camera moves at: degrees per second of pan and tilt, zoom factor per second."""
+
+    pan_deg_s: float
+    tilt_deg_s: float
+    zoom_per_s: float
+
+
+@dataclass(frozen=True)
 class MoveTimes:
     """``intercept_s + slope x distance`` per axis: (intercept_s, slope) of pan and tilt (s per degree)
     and of zoom (s per unit of zoom factor)."""
