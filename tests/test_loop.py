@@ -57,18 +57,21 @@ def test_the_trackers_stream_leaves_the_first_four_streams_as_they_were():
     assert not np.array_equal(draws[4], draws[3])
 
 
-def test_an_observer_sees_every_step_and_changes_nothing_and_intg_exposes_its_rewards():
+def test_an_observer_sees_every_step_and_changes_nothing_and_intg_exposes_its_reward_terms():
     scenario = scenario_from_dict({"frames": 12})
     world = episode_world(scenario, 3)
     policy = make_policy("intg", scenario, world)
     seen = []
 
     def observer(step, context, record):
-        rewards = policy.last_reward_nats
-        assert rewards.shape == (world.grid.size,)
-        assert np.all(np.isfinite(rewards[context.reachable]))
-        assert np.isnan(rewards).sum() == world.grid.size - len(context.reachable)
-        assert record["actions"] in context.reachable
+        terms = policy.last_terms
+        np.testing.assert_array_equal(terms.actions, context.reachable)
+        np.testing.assert_array_equal(terms.track_ids, context.tracks.ids)
+        assert terms.track_nats.shape == (len(context.reachable), len(context.tracks))
+        assert np.all(terms.track_nats >= 0) and np.all(np.isfinite(terms.patrol_nats))
+        # The action taken is the best by the terms' total (or the current one where it ties)
+        total = terms.total_nats
+        assert total[context.reachable == record["actions"]][0] == total.max()
         seen.append(step)
 
     observed = run_episode(scenario, policy, 3, world, observer=observer)
