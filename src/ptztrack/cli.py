@@ -91,11 +91,13 @@ from ptztrack.evaluate.registration import summarise_registration
 from ptztrack.evaluate.report import RUN_FILES, write_figure, write_outputs
 from ptztrack.evaluate.tables import format_table, paired_difference, summarise
 from ptztrack.evaluate.video import view_renderer
-from ptztrack.evaluate.view_state import ViewState
-from ptztrack.evaluate.web_view import ViewHub, ViewServer
+from ptztrack.evaluate.view_state import VIEW_STATES_FILE, StepView, ViewState, read_view_states
+from ptztrack.evaluate.web_view import ViewHub, ViewServer, replay
 from ptztrack.files import InputError, check_output_file, check_output_folder, read_text, run_folder, write_json
+from ptztrack.loop import StepObserver
 from ptztrack.scene.roads import walk_roads
 
+RUN_FOLDER_FILES = (*RUN_FILES, VIEW_STATES_FILE)  # what run, follow and live write into --out
 RUN_FIGURES = ("mota", "motp_m", "idf1", "height_px", "detections", "zoom", "switches")
 
 
@@ -146,10 +148,10 @@ def run_command(args: argparse.Namespace) -> int:
     )
     refuse_if_too_large(scenario, (args.policy,))
     world = episode_world(scenario, args.seed)
-    if args.view is None:
-        episode = run_episode(scenario, args.policy, args.seed, world)
-    else:
-        episode = _run_with_view(scenario, args, world)
+    policy = make_policy(args.policy, scenario, world)
+    watch = Watch(args.view, args.out is not None, partial(_run_view, label=args.policy))
+    with watch:
+        episode = run_episode(scenario, policy, args.seed, world, observer=watch.observe(world, policy))
     metrics = episode_metrics(episode)
     print(
         f"scenario {args.scenario}, policy {args.policy}, detector {scenario.detector.kind}, "
@@ -160,18 +162,63 @@ def run_command(args: argparse.Namespace) -> int:
         title = f"{args.policy}, {scenario.detector.kind} detector, seed {args.seed}: MOTA {metrics['mota']:.1%}"
         with run_folder(args.out, args.overwrite) as folder:
             write_outputs(folder, episode, metrics, title, view_renderer(world))
-        print(f"wrote {', '.join(RUN_FILES)} into {args.out}")
+            watch.write(folder)
+        print(f"wrote {', '.join(RUN_FOLDER_FILES)} into {args.out}")
     return 0
 
 
-def _run_with_view(scenario: Scenario, args: argparse.Namespace, world):
-    """The episode with the live web view on 127.0.0.1:``args.view``; it starts when a page connects."""
-    policy = make_policy(args.policy, scenario, world)
-    steps = world.truth.positions_m.shape[0]
-    hub = ViewHub(ViewState(world, policy, steps, args.policy), paused=True, resume_on_connect=True)
-    with ViewServer(hub, args.view) as server:
-        print(f"view at {server.address} (the run starts when a page opens it)", flush=True)
-        return run_episode(scenario, policy, args.seed, world, observer=hub)
+def _run_view(world, policy, label: str) -> ViewState:
+    """The view of a run in ``world``: the backend's images (the synthetic scene's drawn), its grid."""
+    return ViewState(world, policy, world.truth.positions_m.shape[0], label, view_renderer(world))
+
+
+class Watch:
+    """What watches a run of ``run``, ``follow`` or ``live``: the web view on 127.0.0.1:``port`` (None:
+    none; a context manager: the server runs inside the block), and where ``keep``, every step's view
+    state, for the run folder's view_states.jsonl (what ``ptztrack view`` replays).
+
+    view : ``view(world, policy)`` gives the run's :class:`ViewState`.
+    """
+
+    def __init__(self, port: int | None, keep: bool, view):
+        self.view, self.port, self.keep = view, port, keep
+        self.views: list[StepView] = []
+        self.view_state: ViewState | None = None
+        # A run started with a view waits after its first step for a page to open it.
+        self.hub = None if self.port is None else ViewHub(paused=True, resume_on_connect=True)
+        self._server: ViewServer | None = None
+
+    def __enter__(self) -> "Watch":
+        if self.hub is not None and self.port is not None:
+            self._server = ViewServer(self.hub, self.port).__enter__()
+            print(f"view at {self._server.address} (the run starts when a page opens it)", flush=True)
+        return self
+
+    def __exit__(self, *failure) -> None:
+        if self._server is not None:
+            self._server.__exit__(*failure)
+
+    def observe(self, world, policy) -> StepObserver | None:
+        """The run's step observer (None when nothing watches)."""
+        if self.hub is None and not self.keep:
+            return None
+        self.view_state = self.view(world, policy)
+        publish = None if self.hub is None else self.hub.after_step
+        return self.view_state.observer(publish, self.views if self.keep else None)
+
+    def write(self, folder: Path) -> None:
+        """view_states.jsonl into the run's folder."""
+        assert self.view_state is not None, "observe() gives the run its observer first"
+        self.view_state.write(folder / VIEW_STATES_FILE, self.views)
+
+
+def view_command(args: argparse.Namespace) -> int:
+    lines = read_view_states(args.folder)
+    hub = ViewHub(paused=True, resume_on_connect=True)
+    with ViewServer(hub, args.port) as server:
+        print(f"view at {server.address} (the replay of {len(lines)} steps starts when a page opens it)", flush=True)
+        replay(hub, lines, args.steps_per_s)
+    return 0
 
 
 def _credentials(args: argparse.Namespace) -> dict | None:
@@ -190,9 +237,12 @@ def live_command(args: argparse.Namespace) -> int:
     address = camera_address(args.camera, _credentials(args))
     steps = args.steps or scenario.frames
     print(f"live: {args.policy} on {address}, up to {steps} steps at {scenario.frame_rate_hz * args.time_scale:g} Hz")
-    world, live = run_live_episode(
-        scenario, calibration, address, args.policy, steps, args.time_scale, args.seed, args.timeout_s
-    )
+    label = f"live {args.policy}"
+    with Watch(args.view, args.out is not None, lambda w, p: ViewState(w, p, steps, label, truth=False)) as watch:
+        world, live = run_live_episode(
+            scenario, calibration, address, args.policy, steps, args.time_scale, args.seed, args.timeout_s,
+            watch.observe,
+        )  # fmt: skip
     truth_log = None if args.truth is None else read_truth_log(args.truth)
     episode = live_as_episode(world, live, truth_log)
     captured = np.isfinite(live.capture_time_s)
@@ -209,7 +259,8 @@ def live_command(args: argparse.Namespace) -> int:
         title = f"live {args.policy}, {scenario.detector.kind} detector: {len(live.commanded)} steps"
         with run_folder(args.out, args.overwrite) as folder:
             write_outputs(folder, episode, metrics, title, None)
-        print(f"wrote {', '.join(RUN_FILES)} into {args.out}")
+            watch.write(folder)
+        print(f"wrote {', '.join(RUN_FOLDER_FILES)} into {args.out}")
     return 0
 
 
@@ -471,7 +522,15 @@ def follow_command(args: argparse.Namespace) -> int:
     scenario = _follow_scenario(args, args.tracker)
     if args.frames is not None:
         scenario = scenario.model_copy(update={"frames": args.frames})
-    narrowed, world, episode = follow_run(FollowCell(scenario, args.tracker, args.target, args.seed))
+    label = f"follow person {args.target}, {args.tracker}"
+
+    def view(world, policy) -> ViewState:
+        target_point_px = policy.parameters.target_point_px
+        steps = world.truth.positions_m.shape[0]
+        return ViewState(world, policy, steps, label, view_renderer(world), grid=False, target_point_px=target_point_px)
+
+    with Watch(args.view, True, view) as watch:
+        narrowed, world, episode = follow_run(FollowCell(scenario, args.tracker, args.target, args.seed), watch.observe)
     row = follow_row(narrowed, world, episode)
     frame_range = narrowed.required_recording("the follow camera").frame_range
     first_frame = frame_range[0] if frame_range is not None else 0
@@ -480,7 +539,8 @@ def follow_command(args: argparse.Namespace) -> int:
     title = f"person {args.target}, {args.tracker}: in view {row['in_view_fraction']:.0%}"
     with run_folder(out, args.overwrite) as folder:
         write_outputs(folder, episode, row, title, view_renderer(world))
-    print(f"wrote {', '.join(RUN_FILES)} into {out}")
+        watch.write(folder)
+    print(f"wrote {', '.join(RUN_FOLDER_FILES)} into {out}")
     return 0
 
 
@@ -572,18 +632,19 @@ def parser() -> argparse.ArgumentParser:
     run.add_argument("--seed", type=_non_negative_int, default=0)
     run.add_argument("--frames", type=_positive_int, help="overrides the scenario's number of frames")
     _add_tracker_arguments(run)
-    run.add_argument("--out", type=Path, help=f"directory for {', '.join(RUN_FILES)}; written whole or not at all")
-    run.add_argument("--overwrite", action="store_true", help="replace a non-empty --out folder")
     run.add_argument(
-        "--view",
-        type=_port,
-        nargs="?",
-        const=0,
-        metavar="PORT",
-        help="serve a live view of the run on http://127.0.0.1:PORT/ (no PORT or 0: any free one)",
+        "--out", type=Path, help=f"directory for {', '.join(RUN_FOLDER_FILES)}; written whole or not at all"
     )
+    run.add_argument("--overwrite", action="store_true", help="replace a non-empty --out folder")
+    _add_view_argument(run)
     _add_recording_arguments(run)
     run.set_defaults(handler=run_command)
+
+    view = commands.add_parser("view", help="replay a finished run's --out folder in the web view")
+    view.add_argument("folder", type=Path, help="a folder written by ptztrack run, follow or live with --out")
+    view.add_argument("--port", type=_port, default=0, help="serve on http://127.0.0.1:PORT/ (default: any free one)")
+    view.add_argument("--steps-per-s", type=_positive_float, default=10.0, help="the replay's pace")
+    view.set_defaults(handler=view_command)
 
     experiment = commands.add_parser("experiment", help="run one of the papers' experiments and print its table")
     experiments = experiment.add_subparsers(
@@ -691,8 +752,11 @@ def _add_camera_commands(commands, policies: list[str]) -> None:
         "--truth", type=Path, help="score against a virtual camera's truth log (serve-camera --truth-log)"
     )
     live.add_argument("--seed", type=_non_negative_int, default=0)
-    live.add_argument("--out", type=Path, help=f"directory for {', '.join(RUN_FILES)}; written whole, Ctrl-C too")
+    live.add_argument(
+        "--out", type=Path, help=f"directory for {', '.join(RUN_FOLDER_FILES)}; written whole, Ctrl-C too"
+    )
     live.add_argument("--overwrite", action="store_true", help="replace a non-empty --out folder")
+    _add_view_argument(live)
     live.set_defaults(handler=live_command)
 
     camera = commands.add_parser("camera", help="tools for a real camera").add_subparsers(dest="tool", required=True)
@@ -732,9 +796,10 @@ def _add_follow_commands(commands, experiments) -> None:
     follow.add_argument(
         "--out",
         type=Path,
-        help=f"directory for {', '.join(RUN_FILES)} (default follow-TARGET); written whole or not at all",
+        help=f"directory for {', '.join(RUN_FOLDER_FILES)} (default follow-TARGET); written whole or not at all",
     )
     follow.add_argument("--overwrite", action="store_true", help="replace a non-empty --out folder")
+    _add_view_argument(follow)
     _add_follow_scenario_arguments(follow)
     follow.set_defaults(handler=follow_command)
 
@@ -793,6 +858,17 @@ def _add_executor_arguments(command: argparse.ArgumentParser, rows: str) -> None
     command.add_argument("--executor", choices=EXECUTORS, default="local")
     command.add_argument("--workers", type=_positive_int, help="processes of the local executor (default: all cores)")
     command.add_argument("--json", type=Path, help=f"write {rows} here")
+
+
+def _add_view_argument(command: argparse.ArgumentParser) -> None:
+    command.add_argument(
+        "--view",
+        type=_port,
+        nargs="?",
+        const=0,
+        metavar="PORT",
+        help="serve a live view of the run on http://127.0.0.1:PORT/ (no PORT or 0: any free one)",
+    )
 
 
 def _add_tracker_arguments(command: argparse.ArgumentParser) -> None:

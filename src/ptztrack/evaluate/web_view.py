@@ -1,19 +1,27 @@
-"""The live web view of a run: a page on 127.0.0.1 that draws each step, with pause, step and resume.
+"""The web view of a run: a page on 127.0.0.1 that draws each step, with pause, step and resume.
 
-:class:`ViewHub` is the loop's observer (:data:`ptztrack.loop.StepObserver`)
-and the meeting point of two threads: the run's, which builds a step's state
-(:class:`~ptztrack.evaluate.view_state.ViewState`) only when a page is
-connected and has taken the last one, at most MAX_STATES_PER_S times a
-second (so the view costs a fast run little), and blocks while paused; and
-uvicorn's (:class:`ViewServer`), whose WebSocket sends the newest state to
-each page and passes its buttons back. The page (``web/index.html``: plain
-JavaScript and SVG, no build step) keeps the last state when the run ends.
+:class:`ViewHub` is the meeting point of two threads. The run's thread
+calls :meth:`ViewHub.after_step` after each step (through
+:meth:`ViewState.observer <ptztrack.evaluate.view_state.ViewState.observer>`,
+or a replay of a finished run's states): only when a page is connected, has
+taken the last state and a new one is due does it take the step's state
+(references, and a synthetic view's picture), and it blocks while paused.
+uvicorn's thread (:class:`ViewServer`) builds the state's JSON, once for
+every page, and sends it: a page's sender sleeps until the run's thread
+wakes it (``call_soon_threadsafe``), so an idle view costs nothing. A state
+is due at most MAX_STATES_PER_S times a second, and no sooner than the last
+one's cost (taking and building it) divided by VIEW_SHARE: the view takes
+at most that share of a fast run's time, and shows every step of a slow
+one. The page (``web/index.html``: plain JavaScript and SVG, no build step)
+keeps the last state when the run ends.
 """
 
 import asyncio
+import contextlib
 import json
 import threading
 import time
+from collections.abc import Callable
 from importlib import resources
 
 import uvicorn
@@ -22,54 +30,70 @@ from starlette.responses import HTMLResponse
 from starlette.routing import Route, WebSocketRoute
 from starlette.websockets import WebSocket, WebSocketDisconnect
 
-from ptztrack.evaluate.view_state import ViewState
-from ptztrack.types import DecisionContext
-
 HOST = "127.0.0.1"  # never another interface: the view shows a camera's pictures
-MAX_STATES_PER_S = 30.0  # faster than a page redraws is wasted work in the run's thread
-SEND_POLL_S = 0.01  # how often a page's sender looks for a newer state
+MAX_STATES_PER_S = 30.0  # faster than a page redraws is wasted work
+VIEW_SHARE = 0.03  # of a fast run's time, at most, for taking and building states
 FINAL_SEND_TIMEOUT_S = 5.0  # how long the end of a run waits for the open pages to get the final state
 COMMANDS = ("pause", "step", "resume")
 
+Build = Callable[[], str]
+"""Builds a step's state as JSON (on the server's thread)."""
+
 
 class ViewHub:
-    """The run's side of the view: observer, pause switch, newest state.
+    """The run's side of the view: the newest state, the pause switch, the pages.
 
-    paused : the run waits after its first step until a page sends resume or step (a run started
-        with a view waits for someone to see it: ``resume_on_connect`` resumes it when a page connects).
+    paused : the run waits after its first step until a page sends resume or step; with
+        ``resume_on_connect`` the first page to connect resumes it (a run started with a view waits
+        for someone to see it).
     """
 
-    def __init__(self, view_state: ViewState, paused: bool = False, resume_on_connect: bool = False):
-        self.view_state = view_state
+    def __init__(self, paused: bool = False, resume_on_connect: bool = False):
         self.resume_on_connect = resume_on_connect
         self._condition = threading.Condition()
         self._paused, self._steps_allowed = paused, 0
-        self._message, self._version, self._taken, self._finished = "", 0, True, False
-        self._pages, self._pages_with_final = 0, 0
-        self._last_built_s = -float("inf")
+        self._build: Build = lambda: "{}"
+        self._version, self._flags, self._finished = 0, (paused, False), False
+        self._message, self._message_version = "", 0
+        self._taken = True  # whether a page has taken the newest state (so that a newer one may be taken)
+        self._due_s, self._published_s, self._take_s = -float("inf"), 0.0, 0.0
+        self._wake: dict[int, Callable[[], None]] = {}  # per page: wakes its sender (from any thread)
 
-    def __call__(self, step: int, context: DecisionContext, record: dict) -> None:
-        """After each step of the loop: count, publish a state if a page can take one, wait while paused."""
-        self.view_state.count(record)
-        last = step == self.view_state.steps - 1
+    def after_step(self, step: int, last: bool, take: Callable[[], Build]) -> None:
+        """From the run's thread after each step: ``take()`` (on this thread) the step's state if a page
+        can show it (always while paused, and at the last step), then wait while paused."""
         with self._condition:
-            due = self._taken and time.perf_counter() - self._last_built_s >= 1.0 / MAX_STATES_PER_S
+            due = self._taken and time.perf_counter() >= self._due_s
             # While paused every step is shown: it is where the run waits, or a single step.
-            wanted = self._paused or last or (self._pages > 0 and due)
+            wanted = self._paused or last or (bool(self._wake) and due)
         if wanted:
-            self._publish(self.view_state.state(step, context, record), finished=last)
+            started_s = time.perf_counter()
+            build = take()
+            with self._condition:
+                self._published_s = time.perf_counter()
+                self._take_s = self._published_s - started_s
+                self._due_s = self._published_s + 1.0 / MAX_STATES_PER_S
+                self._build, self._version = build, self._version + 1
+                self._flags, self._finished, self._taken = (self._paused, last), last, False
+                wake = list(self._wake.values())
+            for wake_page in wake:
+                wake_page()
         if not last:  # nothing is left to wait for after the last step
             with self._condition:
                 self._steps_allowed = max(0, self._steps_allowed - 1)
                 self._condition.wait_for(lambda: not self._paused or self._steps_allowed > 0)
 
-    def _publish(self, state: dict, finished: bool) -> None:
+    def end(self) -> None:
+        """The run is over, at its last step or cut short (Ctrl-C of a live run): the newest state
+        becomes the final one, sent to the open pages, which then close."""
         with self._condition:
-            state["paused"], state["finished"] = self._paused, finished
-            self._message = json.dumps(state, allow_nan=False)
-            self._version += 1
-            self._taken, self._finished = False, finished
-            self._last_built_s = time.perf_counter()
+            if self._finished:
+                return
+            self._version += self._version > 0  # republished as final; without a state, nothing to send
+            self._flags, self._finished, self._taken = (False, True), True, False
+            wake = list(self._wake.values())
+        for wake_page in wake:
+            wake_page()
 
     def command(self, name: str) -> None:
         """A page's button: pause, step (one step, then paused) or resume."""
@@ -83,28 +107,47 @@ class ViewHub:
             self._condition.notify_all()
 
     def newest(self) -> tuple[str, int, bool]:
-        """(the newest state as JSON, its version, whether it is the run's last) for a page's sender."""
+        """(the newest state's message, its version, whether it is the run's last) for a page's sender;
+        the message is built here by the first sender to ask for it."""
         with self._condition:
-            self._taken = True
-            return self._message, self._version, self._finished
+            version, build, (paused, finished) = self._version, self._build, self._flags
+            message = self._message if self._message_version == version else None
+        if message is None:
+            started_s = time.perf_counter()
+            state = build()
+            message = f'{{"paused": {json.dumps(paused)}, "finished": {json.dumps(finished)}, "state": {state}}}'
+            cost_s = self._take_s + time.perf_counter() - started_s
+            with self._condition:
+                if self._version == version:
+                    self._message, self._message_version = message, version
+                    self._due_s = max(self._due_s, self._published_s + cost_s / VIEW_SHARE)
+        with self._condition:
+            self._taken = self._taken or self._version == version
+        return message, version, finished
 
-    def page_opened(self) -> None:
+    @property
+    def pages(self) -> int:
+        """The pages connected."""
         with self._condition:
-            self._pages += 1
+            return len(self._wake)
+
+    def page_opened(self, page: int, wake: Callable[[], None]) -> None:
+        """A page's sender, and how to wake it when a state is published."""
+        with self._condition:
+            self._wake[page] = wake
             if self.resume_on_connect:
                 self._paused, self.resume_on_connect = False, False
                 self._condition.notify_all()
 
-    def page_closed(self, got_final: bool) -> None:
+    def page_closed(self, page: int) -> None:
         with self._condition:
-            self._pages -= 1
-            self._pages_with_final += got_final
+            del self._wake[page]
             self._condition.notify_all()
 
     def wait_for_pages(self, timeout_s: float = FINAL_SEND_TIMEOUT_S) -> bool:
         """Wait until every open page has been sent the final state and closed; False on timeout."""
         with self._condition:
-            return self._condition.wait_for(lambda: self._pages == 0, timeout_s)
+            return self._condition.wait_for(lambda: not self._wake, timeout_s)
 
 
 def page_html() -> str:
@@ -121,25 +164,39 @@ def view_app(hub: ViewHub) -> Starlette:
 
     async def socket(websocket: WebSocket) -> None:
         await websocket.accept()
-        hub.page_opened()
+        loop, published = asyncio.get_running_loop(), asyncio.Event()
+        page = id(published)
+
+        def wake() -> None:
+            with contextlib.suppress(RuntimeError):  # the server stopped as the run published: nobody to wake
+                loop.call_soon_threadsafe(published.set)
+
+        hub.page_opened(page, wake)
         receiving = asyncio.create_task(_receive_commands(websocket, hub))
         sent, finished = 0, False
         try:
-            while not finished and not receiving.done():
+            while not receiving.done():
+                # Cleared before looking: a state published after the look sets it again.
+                published.clear()
                 message, version, finished = hub.newest()
                 if version != sent:
                     await websocket.send_text(message)
                     sent = version
-                else:
-                    await asyncio.sleep(SEND_POLL_S)
+                    if not finished:
+                        continue  # a newer state may be out already
+                if finished:
+                    break
+                waiting = asyncio.create_task(published.wait())
+                await asyncio.wait((waiting, receiving), return_when=asyncio.FIRST_COMPLETED)
+                waiting.cancel()
             if finished:
                 # A clean close after the final state: the page keeps it, and logs no error.
                 await websocket.close(code=1000)
         except WebSocketDisconnect:
-            finished = False
+            pass  # the page went
         finally:
             receiving.cancel()
-            hub.page_closed(finished)
+            hub.page_closed(page)
 
     return Starlette(routes=[Route("/", index), WebSocketRoute("/ws", socket)])
 
@@ -188,6 +245,27 @@ class ViewServer:
 
     def __exit__(self, exc_type, exc, traceback) -> None:
         if exc_type is None:  # after a failure there is no final state to wait for
+            self.hub.end()
             self.hub.wait_for_pages()
         self._server.should_exit = True
         self._thread.join()
+
+
+def replay(hub: ViewHub, lines: list[str], steps_per_s: float) -> None:
+    """A finished run's states (``view_states.jsonl``'s lines) through ``hub`` as a run would publish
+    them, ``steps_per_s`` of them a second (pause, step and resume work the same)."""
+    for step, line in enumerate(lines):
+        shown_s = time.monotonic()
+        last = step == len(lines) - 1
+        hub.after_step(step, last, _built(line))
+        if not last:
+            time.sleep(max(0.0, shown_s + 1.0 / steps_per_s - time.monotonic()))
+
+
+def _built(state: str) -> Callable[[], Build]:
+    """``take`` of a state built already."""
+
+    def take() -> Build:
+        return lambda: state
+
+    return take
