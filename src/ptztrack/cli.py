@@ -67,7 +67,7 @@ from ptztrack.config import (
     write_camera_calibration,
 )
 from ptztrack.control.msg_scheduler import SCHEDULERS
-from ptztrack.evaluate.executors import EXECUTORS, print_progress, run_cells
+from ptztrack.evaluate.executors import EXECUTORS, Progress, run_cells
 from ptztrack.evaluate.follow import (
     FOLLOW_FIGURES,
     OTB_FIGURES,
@@ -149,7 +149,7 @@ def run_command(args: argparse.Namespace) -> int:
     refuse_if_too_large(scenario, (args.policy,))
     world = episode_world(scenario, args.seed)
     policy = make_policy(args.policy, scenario, world)
-    watch = Watch(args.view, args.out is not None, partial(_run_view, label=args.policy))
+    watch = Watch(args.view, args.out is not None, partial(_run_view, label=args.policy), Progress("step", args.quiet))
     with watch:
         episode = run_episode(scenario, policy, args.seed, world, observer=watch.observe(world, policy))
     metrics = episode_metrics(episode)
@@ -174,18 +174,19 @@ def _run_view(world, policy, label: str) -> ViewState:
 
 class Watch:
     """What watches a run of ``run``, ``follow`` or ``live``: the web view on 127.0.0.1:``port`` (None:
-    none; a context manager: the server runs inside the block), and where ``keep``, every step's view
-    state, for the run folder's view_states.jsonl (what ``ptztrack view`` replays).
+    none; a context manager: the server runs inside the block), where ``keep``, every step's view
+    state, for the run folder's view_states.jsonl (what ``ptztrack view`` replays), and a progress bar
+    of the steps (``progress``; None: none).
 
     view : ``view(world, policy)`` gives the run's :class:`ViewState`.
     """
 
-    def __init__(self, port: int | None, keep: bool, view):
-        self.view, self.port, self.keep = view, port, keep
+    def __init__(self, port: int | None, keep: bool, view, progress: Progress | None = None):
+        self.view, self.port, self.keep, self.progress = view, port, keep, progress
         self.views: list[StepView] = []
         self.view_state: ViewState | None = None
         # A run started with a view waits after its first step for a page to open it.
-        self.hub = None if self.port is None else ViewHub(paused=True, resume_on_connect=True)
+        self.hub = None if port is None else ViewHub(paused=True, resume_on_connect=True)
         self._server: ViewServer | None = None
 
     def __enter__(self) -> "Watch":
@@ -195,16 +196,29 @@ class Watch:
         return self
 
     def __exit__(self, *failure) -> None:
+        if self.progress is not None:
+            self.progress.close()
         if self._server is not None:
             self._server.__exit__(*failure)
 
     def observe(self, world, policy) -> StepObserver | None:
         """The run's step observer (None when nothing watches)."""
-        if self.hub is None and not self.keep:
-            return None
-        self.view_state = self.view(world, policy)
-        publish = None if self.hub is None else self.hub.after_step
-        return self.view_state.observer(publish, self.views if self.keep else None)
+        view_state = self.view_state = self.view(world, policy)
+        watching = None
+        if self.hub is not None or self.keep:
+            watching = view_state.observer(
+                None if self.hub is None else self.hub.after_step, self.views if self.keep else None
+            )
+        progress = self.progress
+        if progress is None:
+            return watching
+
+        def observe(step: int, context, record: dict) -> None:
+            if watching is not None:
+                watching(step, context, record)
+            progress(step + 1, view_state.steps)
+
+        return observe
 
     def write(self, folder: Path) -> None:
         """view_states.jsonl into the run's folder."""
@@ -337,10 +351,16 @@ def serve_camera_command(args: argparse.Namespace) -> int:
     return 0
 
 
+def _run_cells(args: argparse.Namespace, cells: list, run, noun: str = "episode") -> list:
+    """An experiment's cells on ``--executor``, with a progress bar (none with ``--quiet`` or off a terminal)."""
+    with Progress(noun, args.quiet) as progress:
+        return run_cells(cells, run, args.executor, args.workers, progress)
+
+
 def msg_experiment_command(args: argparse.Namespace) -> int:
     cells = msg_cells(args.runs)
     print(f"{len(cells)} simulations x {len(SCHEDULERS)} schedulers, {args.executor} executor", file=sys.stderr)
-    rows = [row for rows in run_cells(cells, run_msg_cell, args.executor, args.workers, print_progress) for row in rows]
+    rows = [row for rows in _run_cells(args, cells, run_msg_cell, "simulation") for row in rows]
     print("Face capture on the MSG: M by N_j/s bin, mean +- standard deviation (runs)")
     print(format_ambiguity_table(summarise_by_ambiguity(rows)))
     print(format_paired_differences(rows))
@@ -385,12 +405,13 @@ def registration_experiment_command(args: argparse.Namespace) -> int:
         print(f"{'building' if built else 'reading'} the reference index {index_path}", file=sys.stderr)
         index = reference_index(scenario)
         print(f"{len(index.poses)} reference views; registering {args.views} live views", file=sys.stderr)
-        views = registration_views(scenario, index, args.views, args.seed, partial(print_progress, noun="views"))
+        with Progress("view", args.quiet) as progress:
+            views = registration_views(scenario, index, args.views, args.seed, progress)
         summary = summarise_registration(views)
         pose_error = PoseError(pan_tilt_sigma_deg=args.pose_noise_deg, zoom_sigma=args.zoom_noise)
         cells = closed_loop_cells(scenario, pose_error, args.policy, args.pose_sources)
         print(f"{len(cells)} closed-loop runs, {args.executor} executor", file=sys.stderr)
-        closed_loop = run_cells(cells, run_closed_loop_cell, args.executor, args.workers, print_progress)
+        closed_loop = _run_cells(args, cells, run_closed_loop_cell)
     size = scenario.pose_feedback.image_size_px
     print(
         f"Registration of {summary['views']} live views at random reachable poses, {size[0]} x {size[1]} px, "
@@ -488,7 +509,7 @@ def _run_table(
     print(f"{len(cells)} episodes, {args.executor} executor", file=sys.stderr)
     runs_at_once = 1 if args.executor == "serial" else min(len(cells), args.workers or os.cpu_count() or 1)
     refuse_if_too_large(cells[0].scenario, tuple(args.strategies), runs_at_once)
-    summary = summarise(run_cells(cells, run_cell, args.executor, args.workers, print_progress))
+    summary = summarise(_run_cells(args, cells, run_cell))
     summary = [{**row, **(extra or {})} for row in summary]
     print(format_table(summary, title, spread))
     labels = {row["label"] for row in summary}
@@ -529,7 +550,7 @@ def follow_command(args: argparse.Namespace) -> int:
         steps = world.truth.positions_m.shape[0]
         return ViewState(world, policy, steps, label, view_renderer(world), grid=False, target_point_px=target_point_px)
 
-    with Watch(args.view, True, view) as watch:
+    with Watch(args.view, True, view, Progress("step", args.quiet)) as watch:
         narrowed, world, episode = follow_run(FollowCell(scenario, args.tracker, args.target, args.seed), watch.observe)
     row = follow_row(narrowed, world, episode)
     frame_range = narrowed.required_recording("the follow camera").frame_range
@@ -548,10 +569,10 @@ def follow_experiment_command(args: argparse.Namespace) -> int:
     scenario = _follow_scenario(args)
     cells = follow_cells(scenario, args.trackers, args.targets, args.seed)
     print(f"{len(cells)} closed-loop runs, {args.executor} executor", file=sys.stderr)
-    people = run_cells(cells, run_follow_cell, args.executor, args.workers, print_progress)
+    people = _run_cells(args, cells, run_follow_cell)
     otb_runs = otb_cells(scenario, args.trackers, args.otb_tracks, args.seed)
     print(f"{len(otb_runs)} one-pass runs on the still recording", file=sys.stderr)
-    otb_people = run_cells(otb_runs, run_otb_cell, args.executor, args.workers, partial(print_progress, noun="runs"))
+    otb_people = _run_cells(args, otb_runs, run_otb_cell, "run")
     closed_loop, otb = summarise_follow(people, FOLLOW_FIGURES), summarise_follow(otb_people, OTB_FIGURES)
     print(
         f"Follow camera, {scenario.camera.image_size_px[0]} x {scenario.camera.image_size_px[1]} view, "
@@ -583,12 +604,12 @@ OCCUPANCY_COLUMNS = (
 
 
 def occupancy_experiment_command(args: argparse.Namespace) -> int:
-    progress = partial(print_progress, noun="frames")
-    if args.dataset == "synthetic-room":
-        runs = room_runs(args.frames or ROOM_FRAMES, args.seed, progress)
-    else:
-        dataset = pets_dataset() if args.dataset == "pets" else load_dataset(args.dataset)
-        runs = dataset_runs(dataset, args.frames, progress)
+    with Progress("frame", args.quiet) as progress:
+        if args.dataset == "synthetic-room":
+            runs = room_runs(args.frames or ROOM_FRAMES, args.seed, progress)
+        else:
+            dataset = pets_dataset() if args.dataset == "pets" else load_dataset(args.dataset)
+            runs = dataset_runs(dataset, args.frames, progress)
     rows = [row for run in runs for row in run.rows]
     columns = [(key, form) for key, form in OCCUPANCY_COLUMNS if any(key in row for row in rows)]
     print(f"Occupancy-map detection on {args.dataset}: MODA, MODP, precision, recall within 0.5 m; tracker fed by LPOM")
@@ -637,6 +658,7 @@ def parser() -> argparse.ArgumentParser:
     )
     run.add_argument("--overwrite", action="store_true", help="replace a non-empty --out folder")
     _add_view_argument(run)
+    _add_quiet_argument(run)
     _add_recording_arguments(run)
     run.set_defaults(handler=run_command)
 
@@ -800,6 +822,7 @@ def _add_follow_commands(commands, experiments) -> None:
     )
     follow.add_argument("--overwrite", action="store_true", help="replace a non-empty --out folder")
     _add_view_argument(follow)
+    _add_quiet_argument(follow)
     _add_follow_scenario_arguments(follow)
     follow.set_defaults(handler=follow_command)
 
@@ -846,6 +869,7 @@ def _add_occupancy_parser(experiments) -> None:
     occupancy.add_argument("--overwrite", action="store_true", help="replace a non-empty --out folder")
     occupancy.add_argument("--images-every", type=_positive_int, default=10, help="a map picture every N frames")
     occupancy.add_argument("--json", type=Path, help="write one row per method (and people count) here")
+    _add_quiet_argument(occupancy)
     occupancy.set_defaults(handler=occupancy_experiment_command)
 
 
@@ -858,6 +882,13 @@ def _add_executor_arguments(command: argparse.ArgumentParser, rows: str) -> None
     command.add_argument("--executor", choices=EXECUTORS, default="local")
     command.add_argument("--workers", type=_positive_int, help="processes of the local executor (default: all cores)")
     command.add_argument("--json", type=Path, help=f"write {rows} here")
+    _add_quiet_argument(command)
+
+
+def _add_quiet_argument(command: argparse.ArgumentParser) -> None:
+    command.add_argument(
+        "--quiet", action="store_true", help="no progress bar (there is none either where stderr is not a terminal)"
+    )
 
 
 def _add_view_argument(command: argparse.ArgumentParser) -> None:
