@@ -77,6 +77,8 @@ def main() -> None:
         plain.append(timed_run(scenario, args.policy, False))
         viewed.append(timed_run(scenario, args.policy, True))
     steps = args.frames - 1
+    for name, runs in (("without", plain), ("with", viewed)):
+        print(f"{name:<8} steps/s " + " ".join(f"{steps / wall_s:6.1f}" for wall_s, _, _ in runs))
     best_plain, best_viewed = min(plain), min(viewed)
     print(f"{args.policy}, {steps} steps timed, best of {args.repeats} (interleaved)")
     for name, (wall_s, cpu_s, states) in (("without a view", best_plain), ("with a view", best_viewed)):

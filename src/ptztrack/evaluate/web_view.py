@@ -10,8 +10,8 @@ uvicorn's thread (:class:`ViewServer`) builds the state's JSON, once for
 every page, and sends it: a page's sender sleeps until the run's thread
 wakes it (``call_soon_threadsafe``), so an idle view costs nothing. A state
 is due at most MAX_STATES_PER_S times a second, and no sooner than the last
-one's cost (taking and building it) divided by VIEW_SHARE: the view takes
-at most that share of a fast run's time, and shows every step of a slow
+one's cost (taking, building and sending it) divided by VIEW_SHARE: the view
+takes about that share of a fast run's time, and shows every step of a slow
 one. The page (``web/index.html``: plain JavaScript and SVG, no build step)
 keeps the last state when the run ends.
 """
@@ -55,8 +55,8 @@ class ViewHub:
         self._build: Build = lambda: "{}"
         self._version, self._flags, self._finished = 0, (paused, False), False
         self._message, self._message_version = "", 0
-        self._taken = True  # whether a page has taken the newest state (so that a newer one may be taken)
-        self._due_s, self._published_s, self._take_s = -float("inf"), 0.0, 0.0
+        self._taken = True  # whether a page has been sent the newest state (so that a newer one may be taken)
+        self._due_s, self._published_s, self._take_s, self._cost_s = -float("inf"), 0.0, 0.0, 0.0
         self._wake: dict[int, Callable[[], None]] = {}  # per page: wakes its sender (from any thread)
 
     def after_step(self, step: int, last: bool, take: Callable[[], Build]) -> None:
@@ -71,7 +71,7 @@ class ViewHub:
             build = take()
             with self._condition:
                 self._published_s = time.perf_counter()
-                self._take_s = self._published_s - started_s
+                self._take_s, self._cost_s = self._published_s - started_s, 0.0
                 self._due_s = self._published_s + 1.0 / MAX_STATES_PER_S
                 self._build, self._version = build, self._version + 1
                 self._flags, self._finished, self._taken = (self._paused, last), last, False
@@ -113,17 +113,20 @@ class ViewHub:
             version, build, (paused, finished) = self._version, self._build, self._flags
             message = self._message if self._message_version == version else None
         if message is None:
-            started_s = time.perf_counter()
-            state = build()
-            message = f'{{"paused": {json.dumps(paused)}, "finished": {json.dumps(finished)}, "state": {state}}}'
-            cost_s = self._take_s + time.perf_counter() - started_s
+            message = f'{{"paused": {json.dumps(paused)}, "finished": {json.dumps(finished)}, "state": {build()}}}'
             with self._condition:
                 if self._version == version:
                     self._message, self._message_version = message, version
-                    self._due_s = max(self._due_s, self._published_s + cost_s / VIEW_SHARE)
-        with self._condition:
-            self._taken = self._taken or self._version == version
         return message, version, finished
+
+    def sent(self, version: int, cost_s: float) -> None:
+        """A page's sender has sent state ``version``, which took it ``cost_s`` (building it, if it did,
+        and sending it): the next state is due no sooner than all of the state's cost over VIEW_SHARE."""
+        with self._condition:
+            if version == self._version:
+                self._cost_s += cost_s
+                self._due_s = max(self._due_s, self._published_s + (self._take_s + self._cost_s) / VIEW_SHARE)
+                self._taken = True
 
     @property
     def pages(self) -> int:
@@ -178,9 +181,11 @@ def view_app(hub: ViewHub) -> Starlette:
             while not receiving.done():
                 # Cleared before looking: a state published after the look sets it again.
                 published.clear()
+                started_s = time.perf_counter()
                 message, version, finished = hub.newest()
                 if version != sent:
                     await websocket.send_text(message)
+                    hub.sent(version, time.perf_counter() - started_s)
                     sent = version
                     if not finished:
                         continue  # a newer state may be out already
