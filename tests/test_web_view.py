@@ -17,12 +17,13 @@ import psutil
 import pytest
 from websockets.sync.client import connect
 
-from ptztrack.builders.episode import episode_world, make_policy, run_episode
+from ptztrack.builders.episode import episode_world, make_policy, make_tracker, run_episode
 from ptztrack.cli import main
 from ptztrack.config import scenario_from_dict
 from ptztrack.evaluate.video import view_renderer
 from ptztrack.evaluate.view_state import VIEW_STATES_FILE, ViewState
 from ptztrack.evaluate.web_view import ViewHub, ViewServer
+from ptztrack.live import run_live
 
 CHROMIUM = Path("/usr/bin/chromium")  # Debian's (apt-get install chromium); Playwright's own is not downloadable here
 # Where the screenshots are kept for CI to publish (else in the test's temporary folder only).
@@ -123,6 +124,37 @@ def test_live_with_view_sends_the_cameras_frames(tmp_path):
     assert [json.loads(line)["image_jpeg"] is not None for line in lines] == captured and any(captured)
 
 
+def test_a_paused_view_holds_a_live_runs_schedule_instead_of_letting_it_catch_up():
+    """On a simulated clock: the observer blocks for three steps' time after step 1 (a page paused the
+    run); the steps after it keep their period, as before the pause."""
+    scenario = scenario_from_dict({"frames": 6})
+    world = episode_world(scenario, 0)
+    now_s, period_s, sleeps_s = [0.0], 0.5, []
+
+    def sleep(seconds: float) -> None:
+        sleeps_s.append(seconds)
+        now_s[0] += seconds
+
+    class Unseen:  # a camera that never stands still long enough for an image
+        def send(self, pose) -> bool:
+            return True
+
+        def capture(self, until_s: float):
+            now_s[0] = max(now_s[0], until_s)
+            return None
+
+    def observer(step, context, record):
+        now_s[0] += 3 * period_s if step == 1 else 0.0
+
+    live = run_live(
+        world, make_policy("fix", scenario, world), make_tracker(None, scenario, world), Unseen(), 6, period_s, 0,
+        clock=lambda: now_s[0], sleep=sleep, observer=observer,
+    )  # fmt: skip
+    assert len(live.commanded) == 6
+    # Each step sleeps the half step the capture left; the step after the pause too.
+    assert sleeps_s == pytest.approx([0.0] + [period_s / 2] * 5)
+
+
 @contextmanager
 def _served(command: list[str]):
     """A ptztrack command that serves a view: (its page's address, the process)."""
@@ -221,6 +253,7 @@ def test_a_browser_draws_the_run_pauses_steps_resumes_and_keeps_the_final_state(
         assert set(shares) == {str(i) for i in last.track_ids} and len(last.track_ids) > 0
         for k, track_id in enumerate(last.track_ids):
             assert float(shares[str(track_id)]) == pytest.approx(last.track_nats[row, k], abs=1e-4)
+        page.mouse.move(0, 0)  # the terms stay; the chosen cell shows its red mark again
         _screenshot(page, tmp_path / "web_view.png")
     assert problems == []
 
