@@ -97,7 +97,6 @@ class ViewState:
                      "zoom": _rounded(actions.zoom, 2)} if grid else None,
             "target_point_px": None if target_point_px is None else _rounded(target_point_px, 1),
             "sigmas": SIGMAS,
-            "frame_rate_hz": world.truth.frame_rate_hz,
         }  # fmt: skip
         # The same every step, and sent each time all the same (a page that opens late needs nothing else):
         # encoded once.
@@ -153,7 +152,7 @@ class ViewState:
             if publish is not None:
 
                 def take():
-                    view = kept or self.take(step, context, record)
+                    view = kept if kept is not None else self.take(step, context, record)
                     if self.render is not None:  # drawn on the run's thread: a recording's reader is not shared
                         view = replace(view, image=self.render(step, view.pose))
                     return lambda: self.state_json(view)

@@ -129,6 +129,12 @@ class ViewHub:
                 self._taken = True
 
     @property
+    def published(self) -> int:
+        """The states published so far."""
+        with self._condition:
+            return self._version
+
+    @property
     def pages(self) -> int:
         """The pages connected."""
         with self._condition:
