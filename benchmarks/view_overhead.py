@@ -41,7 +41,10 @@ with sync_playwright() as playwright:
     browser = playwright.chromium.launch(executable_path="/usr/bin/chromium", headless=True)
     page = browser.new_page(viewport={"width": 1500, "height": 1000})
     page.goto(sys.argv[1])
-    page.wait_for_function("document.getElementById('status').textContent === 'run finished'", timeout=600_000)
+    # Polled every 250 ms: Playwright's default polls every animation frame, which keeps Chromium drawing
+    page.wait_for_function(
+        "document.getElementById('status').textContent === 'run finished'", polling=250, timeout=600_000
+    )
     browser.close()
 """,
 }

@@ -10,9 +10,9 @@ uvicorn's thread (:class:`ViewServer`) builds the state's JSON, once for
 every page, and sends it: a page's sender sleeps until the run's thread
 wakes it (``call_soon_threadsafe``), so an idle view costs nothing. A state
 is due at most MAX_STATES_PER_S times a second, and no sooner than the last
-one's cost (taking, building and sending it) divided by VIEW_SHARE: the view
-takes about that share of a fast run's time, and shows every step of a slow
-one. The page (``web/index.html``: plain JavaScript and SVG, no build step)
+one's cost (the CPU time of taking, building and sending it) divided by
+VIEW_SHARE: the view takes about that share of a fast run's time, and shows
+every step of a slow one. The page (``web/index.html``: plain JavaScript and SVG, no build step)
 keeps the last state when the run ends.
 """
 
@@ -67,11 +67,14 @@ class ViewHub:
             # While paused every step is shown: it is where the run waits, or a single step.
             wanted = self._paused or last or (bool(self._wake) and due)
         if wanted:
-            started_s = time.perf_counter()
+            # Costs in the working thread's CPU time: on a loaded machine the wall time would count
+            # other processes' turns too.
+            started_s = time.thread_time()
             build = take()
+            taken_s = time.thread_time() - started_s
             with self._condition:
                 self._published_s = time.perf_counter()
-                self._take_s, self._cost_s = self._published_s - started_s, 0.0
+                self._take_s, self._cost_s = taken_s, 0.0
                 self._due_s = self._published_s + 1.0 / MAX_STATES_PER_S
                 self._build, self._version = build, self._version + 1
                 self._flags, self._finished, self._taken = (self._paused, last), last, False
@@ -120,8 +123,9 @@ class ViewHub:
         return message, version, finished
 
     def sent(self, version: int, cost_s: float) -> None:
-        """A page's sender has sent state ``version``, which took it ``cost_s`` (building it, if it did,
-        and sending it): the next state is due no sooner than all of the state's cost over VIEW_SHARE."""
+        """A page's sender has sent state ``version``, which took its thread ``cost_s`` of CPU time (building
+        it, if it did, and sending it): the next state is due no sooner than all of the state's cost over
+        VIEW_SHARE after it was published."""
         with self._condition:
             if version == self._version:
                 self._cost_s += cost_s
@@ -187,11 +191,11 @@ def view_app(hub: ViewHub) -> Starlette:
             while not receiving.done():
                 # Cleared before looking: a state published after the look sets it again.
                 published.clear()
-                started_s = time.perf_counter()
+                started_s = time.thread_time()
                 message, version, finished = hub.newest()
                 if version != sent:
                     await websocket.send_text(message)
-                    hub.sent(version, time.perf_counter() - started_s)
+                    hub.sent(version, time.thread_time() - started_s)
                     sent = version
                     if not finished:
                         continue  # a newer state may be out already
