@@ -11,9 +11,9 @@ every page, and sends it: a page's sender sleeps until the run's thread
 wakes it (``call_soon_threadsafe``), so an idle view costs nothing. A state
 is due at most MAX_STATES_PER_S times a second, and no sooner than the last
 one's cost (the CPU time of taking, building and sending it) divided by
-VIEW_SHARE: the view takes about that share of a fast run's time, and shows
-every step of a slow one. The page (``web/index.html``: plain JavaScript and SVG, no build step)
-keeps the last state when the run ends.
+VIEW_SHARE: a fast run gives the view a small share of its time, and a slow
+one shows every step. The page (``web/index.html``: plain JavaScript and
+SVG, no build step) keeps the last state when the run ends.
 """
 
 import asyncio
@@ -32,7 +32,9 @@ from starlette.websockets import WebSocket, WebSocketDisconnect
 
 HOST = "127.0.0.1"  # never another interface: the view shows a camera's pictures
 MAX_STATES_PER_S = 30.0  # faster than a page redraws is wasted work
-VIEW_SHARE = 0.03  # of a fast run's time, at most, for taking and building states
+# The share of a fast run's CPU time for taking, building and sending states; the run loses about twice
+# that (the threads' switching, the caches), some 3 % in benchmarks/view_overhead.py.
+VIEW_SHARE = 0.02
 FINAL_SEND_TIMEOUT_S = 5.0  # how long the end of a run waits for the open pages to get the final state
 COMMANDS = ("pause", "step", "resume")
 
