@@ -33,6 +33,7 @@ def particle_filter_parameters(scenario: Scenario) -> ParticleFilterParameters:
         bins=follow.histogram_bins,
         achromatic=follow.achromatic_bins,
         samples=follow.samples_per_patch,
+        background_ring_scale=None if follow.background_area_ratio is None else follow.background_area_ratio**0.5,
         lambda_colour=follow.lambda_colour,
         lambda_loss=follow.lambda_loss,
         lambda_motion=follow.lambda_motion,

@@ -84,6 +84,8 @@ class ParticleFilterParameters:
     patches : (K, 4) (left, top, width, height) in box units (:mod:`ptztrack.track.colour_model`).
     bins : N of the N x N hue-saturation histograms; achromatic : N more bins by value for greys
     (:func:`ptztrack.track.colour_model.colour_bins`); samples : grid points per patch axis.
+    background_ring_scale : the background-weighted histograms' ring, the box scaled by this much
+    (:func:`ptztrack.track.colour_model.background_weights`); None: unweighted, the paper's.
     lambda_colour, lambda_motion : equations 3 and 4.
     lambda_loss : the colour likelihood's lambda in the loss test (``likelihood``, ``P_ref``).
     walk_sigma : random-walk step of x and y in box heights; scale_sigma : relative step of h.
@@ -99,6 +101,7 @@ class ParticleFilterParameters:
     bins: int
     achromatic: bool
     samples: int
+    background_ring_scale: float | None
     lambda_colour: float
     lambda_motion: float
     lambda_loss: float
@@ -121,7 +124,8 @@ class ParticleFilter:
 
     particles : (P, 3) states (x_px, y_px, h_px) in the current view; weights : (P,), summing to 1.
     estimate : (3,) the weighted mean (equation 6); likelihood : its colour likelihood P(z_col | s_t).
-    reference : (K, B) the patches' reference histograms (B bins); aspect : box width / height.
+    reference : (K, B) the patches' reference histograms (B bins), weighted by ``bin_weights`` (B,)
+    as every candidate's are; aspect : box width / height.
     reference_likelihood : P_ref (None before the first step); lost_steps : steps lost (0 while tracking).
     motion : the motion history image; velocity_px : (2,) the estimate's velocity, px per step.
     """
@@ -131,6 +135,7 @@ class ParticleFilter:
     estimate: np.ndarray
     likelihood: float
     reference: np.ndarray
+    bin_weights: np.ndarray
     aspect: float
     reference_likelihood: float | None
     lost_steps: int
@@ -178,12 +183,18 @@ def start_filter(image_bgr, box_px, parameters: ParticleFilterParameters) -> Par
     patches = colour_model.patch_boxes(np.asarray(box_px, dtype=float), parameters.patches)
     total_bins = colour_model.bin_count(parameters.bins, parameters.achromatic)
     reference = colour_model.patch_histograms(bins, patches, total_bins, REFERENCE_OVERSAMPLING * parameters.samples)
+    bin_weights = (
+        np.ones(total_bins)
+        if parameters.background_ring_scale is None
+        else colour_model.background_weights(bins, box_px, total_bins, parameters.background_ring_scale)
+    )
     return ParticleFilter(
         particles=np.tile(state, (parameters.particles, 1)),
         weights=np.full(parameters.particles, 1.0 / parameters.particles),
         estimate=state,
         likelihood=1.0,
-        reference=reference,
+        reference=colour_model.weigh_histograms(reference, bin_weights),
+        bin_weights=bin_weights,
         aspect=width / height,
         reference_likelihood=None,
         lost_steps=0,
@@ -216,14 +227,14 @@ def step_filter(
         particles = _random_walk(chosen, parameters.walk_sigma, parameters.scale_sigma, rng)
     # The weighted mean's box lies within the particles' boxes' extent: one region of bins serves both.
     region = _ColourRegion.of(image_bgr, particles, state.aspect, parameters)
-    colour = region.log_likelihood(particles, state.reference, state.aspect, parameters)
+    colour = region.log_likelihood(particles, state, parameters)
     log_weights = colour + _motion_log_likelihood(motion, particles, state.aspect, parameters)
     weights = np.exp(log_weights - log_weights.max())
     weights /= weights.sum()
     estimate = weights @ particles
     # The loss test's likelihoods: the same sum of squared distances over lambda_loss.
     to_loss = parameters.lambda_colour / parameters.lambda_loss
-    estimate_colour = region.log_likelihood(estimate[None], state.reference, state.aspect, parameters)[0]
+    estimate_colour = region.log_likelihood(estimate[None], state, parameters)[0]
     likelihood = float(np.exp(to_loss * estimate_colour))
     reference = state.reference_likelihood
     if reference is None:  # the first step: P_ref is the best particle's likelihood
@@ -294,17 +305,19 @@ class _ColourRegion(NamedTuple):
         )
         return cls(bins, np.array([col0, row0]))
 
-    def log_likelihood(self, states, reference, aspect: float, parameters) -> np.ndarray:
-        """Log colour likelihoods (n,) of states (n, 3) whose patches lie within the region."""
-        boxes = colour_model.box_of_states(states, aspect)
+    def log_likelihood(self, states, target: ParticleFilter, parameters) -> np.ndarray:
+        """Log colour likelihoods (n,) of states (n, 3) whose patches lie within the region, against the
+        target's reference histograms."""
+        boxes = colour_model.box_of_states(states, target.aspect)
         boxes = colour_model.patch_boxes(boxes, parameters.patches) - [*self.origin, 0, 0]
         total_bins = colour_model.bin_count(parameters.bins, parameters.achromatic)
         if self.bins.size:
             histograms = colour_model.patch_histograms(self.bins, boxes, total_bins, parameters.samples)
         else:
             histograms = np.zeros(boxes.shape[:-1] + (total_bins,))
+        histograms = colour_model.weigh_histograms(histograms, target.bin_weights)
         return colour_model.colour_log_likelihood(
-            colour_model.bhattacharyya_distance(reference, histograms), parameters.lambda_colour
+            colour_model.bhattacharyya_distance(target.reference, histograms), parameters.lambda_colour
         )
 
 
