@@ -424,6 +424,7 @@ class Follow(_Strict):
     histogram_bins: int = Field(10, ge=1, le=64)
     achromatic_bins: bool = False
     background_area_ratio: Annotated[float, Field(gt=1), at_most(10_000, "box areas")] | None = 3.0
+    height_log_sigma: PositiveFloat | None = 0.1
     samples_per_patch: Annotated[int, Field(ge=1), at_most(1000, _PARTICLE_TIME)] = 20
     lambda_colour: Annotated[PositiveFloat, at_most(1e6, "a likelihood scale")] = 0.15
     lambda_loss: Annotated[PositiveFloat, at_most(1e6, "a likelihood scale")] = 1.0

@@ -37,6 +37,7 @@ def particle_filter_parameters(scenario: Scenario) -> ParticleFilterParameters:
         lambda_colour=follow.lambda_colour,
         lambda_loss=follow.lambda_loss,
         lambda_motion=follow.lambda_motion,
+        height_log_sigma=follow.height_log_sigma,
         walk_sigma=follow.walk_heights_per_s * step_s,
         scale_sigma=follow.scale_change_per_s * step_s,
         velocity_gain=1.0 - smoothing_pole(scenario) if follow.prediction == "constant_velocity" else 0.0,

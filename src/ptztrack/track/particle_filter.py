@@ -53,12 +53,18 @@ an exponential average, with weight ``velocity_gain``, of the estimate's
 steps. ``velocity_gain`` 0 is the paper's walk; while lost, and when the
 track is back, the velocity is 0.
 
+Height prior (not in the paper). Where the view is calibrated, a box's height is weighed against
+the height of a person standing on its bottom centre: a log-normal prior, ``ln(h / h_standing)``
+with spread ``height_log_sigma``. Background-weighted histograms no longer count the background a
+box takes in, so without it nothing stops a box from growing; the paper's prior on h is none.
+
 Likelihoods: colour from the patches' hue-saturation histograms, motion
 ``exp(-E^2 / lambda_mot)`` with E the fraction of non-moving pixels under the
 patches (the paper's count of non-motion pixels, divided by the pixels there
 so that smaller boxes are not favoured).
 """
 
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 from typing import NamedTuple
 
@@ -73,6 +79,12 @@ from ptztrack.track.motion_image import MotionImage, first_motion_image, next_mo
 MIN_HEIGHT_PX = 8.0
 # The reference histograms are sampled this much more densely per axis than the particles' ones.
 REFERENCE_OVERSAMPLING = 4
+# The height prior treats a box no one could stand in as this many spreads off, not as impossible: were
+# every particle so, their weights would otherwise all vanish.
+MAX_HEIGHT_Z = 10.0
+
+# The height (n,) px of a person standing on feet pixels (n, 2) of a view, NaN where no one can stand.
+StandingHeight = Callable[[np.ndarray], np.ndarray]
 
 
 @dataclass(frozen=True)
@@ -88,6 +100,8 @@ class ParticleFilterParameters:
     (:func:`ptztrack.track.colour_model.background_weights`); None: unweighted, the paper's.
     lambda_colour, lambda_motion : equations 3 and 4.
     lambda_loss : the colour likelihood's lambda in the loss test (``likelihood``, ``P_ref``).
+    height_log_sigma : the spread of ``ln(h / h_standing)``, h_standing the calibrated height of a
+    person standing on the box's feet (the height prior, see the module); None: no prior, the paper's.
     walk_sigma : random-walk step of x and y in box heights; scale_sigma : relative step of h.
     velocity_gain : the weight of the last step in the velocity's exponential average; 0: no velocity.
     loss_fraction, adapt_fraction, reference_rate : the loss test and the adaptation of ``P_ref``.
@@ -105,6 +119,7 @@ class ParticleFilterParameters:
     lambda_colour: float
     lambda_motion: float
     lambda_loss: float
+    height_log_sigma: float | None
     walk_sigma: float
     scale_sigma: float
     velocity_gain: float
@@ -204,9 +219,17 @@ def start_filter(image_bgr, box_px, parameters: ParticleFilterParameters) -> Par
 
 
 def step_filter(
-    state: ParticleFilter, image_bgr, homography, parameters: ParticleFilterParameters, rng: np.random.Generator
+    state: ParticleFilter,
+    image_bgr,
+    homography,
+    parameters: ParticleFilterParameters,
+    rng: np.random.Generator,
+    standing_height_px: StandingHeight | None = None,
 ) -> ParticleFilter:
-    """One step on the next view (h, w, 3) uint8 BGR, into which the previous view maps by ``homography``."""
+    """One step on the next view (h, w, 3) uint8 BGR, into which the previous view maps by ``homography``.
+
+    standing_height_px : the view's calibration, for the height prior (with ``height_log_sigma``).
+    """
     motion = next_motion_image(
         state.motion, image_bgr, homography, parameters.motion_threshold, parameters.motion_decay
     )
@@ -229,6 +252,8 @@ def step_filter(
     region = _ColourRegion.of(image_bgr, particles, state.aspect, parameters)
     colour = region.log_likelihood(particles, state, parameters)
     log_weights = colour + _motion_log_likelihood(motion, particles, state.aspect, parameters)
+    if standing_height_px is not None and parameters.height_log_sigma is not None:
+        log_weights += height_log_prior(particles, standing_height_px, parameters.height_log_sigma)
     weights = np.exp(log_weights - log_weights.max())
     weights /= weights.sum()
     estimate = weights @ particles
@@ -262,6 +287,16 @@ def step_filter(
         motion=motion,
         velocity_px=velocity_px,
     )
+
+
+def height_log_prior(states, standing_height_px: StandingHeight, log_sigma: float) -> np.ndarray:
+    """Log prior (n,) of states (n, 3): ``-z^2 / 2``, ``z = ln(h / h_standing) / log_sigma``, h_standing the
+    height of a person standing on the box's bottom centre; a box whose feet no one can stand on
+    (beyond the horizon) counts as ``MAX_HEIGHT_Z`` spreads off."""
+    feet_px = states[:, :2] + np.c_[np.zeros(len(states)), states[:, 2] / 2]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        z = np.log(states[:, 2] / standing_height_px(feet_px)) / log_sigma
+    return -0.5 * np.minimum(np.nan_to_num(z, nan=MAX_HEIGHT_Z) ** 2, MAX_HEIGHT_Z**2)
 
 
 def _random_walk(states, walk_sigma: float, scale_sigma: float, rng: np.random.Generator) -> np.ndarray:
