@@ -19,7 +19,7 @@ from ptztrack.control.exploration import ExplorationMap
 from ptztrack.control.information_gain import (
     ActionGeometry,
     action_geometry,
-    detection_weight_integral,
+    detection_weight_and_information_integral,
     detection_weight_sampled,
     information_if_detected_nats,
 )
@@ -55,18 +55,19 @@ class InformationGainPolicy:
 
     def rewards(self, actions, tracks: Tracks, rng: np.random.Generator) -> np.ndarray:
         """Expected information (nats) of each of ``actions`` (flat indices) about ``tracks``; (len(actions),)."""
-        geometry = self.geometry.take(actions)
         reward = np.zeros(len(actions))
         if len(tracks):
             mean_m = tracks.mean[:, :2]
             position_cov_m2 = tracks.covariance[:, :2, :2]
             if self.method == "intg":
-                alpha = detection_weight_integral(self.camera, geometry, self.recall, mean_m, position_cov_m2, self.V)
+                alpha, information = detection_weight_and_information_integral(
+                    self.camera, self.geometry, self.recall, mean_m, position_cov_m2, self.V, actions
+                )
             else:
                 reference_pose = look_at(self.camera, mean_m.mean(axis=0), zoom=1.0)
                 alpha = detection_weight_sampled(
                     self.camera,
-                    geometry,
+                    self.geometry,
                     self.recall,
                     mean_m,
                     position_cov_m2,
@@ -75,8 +76,9 @@ class InformationGainPolicy:
                     reference_pose,
                     rng,
                     self.samples,
+                    actions,
                 )
-            information = information_if_detected_nats(geometry, mean_m, position_cov_m2, self.V)
+                information = information_if_detected_nats(self.geometry, mean_m, position_cov_m2, self.V, actions)
             reward += np.sum(alpha * information, axis=-1)
         if self.exploration is not None:
             reward += self.beta * self.exploration.information_nats(actions)
