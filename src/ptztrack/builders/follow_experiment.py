@@ -8,18 +8,20 @@ tracker gives other boxes on the same frames from run to run (also with
 """
 
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from functools import partial
 
 import numpy as np
 
-from ptztrack.builders.episode import episode_world, run_episode
+from ptztrack.builders.episode import episode_world, make_policy, run_episode
 from ptztrack.builders.follow import follow_parameters, target_scenario, target_source
 from ptztrack.camera.recorded import RecordedPTZ
 from ptztrack.config import Scenario
 from ptztrack.evaluate.follow import follow_metrics, one_pass_scores, target_in_views
 from ptztrack.geometry.calibration import load_calibration, standing_height_px
-from ptztrack.loop import Episode, World, episode_seeds
+from ptztrack.loop import Episode, StepObserver, World, episode_seeds
+from ptztrack.roles import Policy
 from ptztrack.scene.pets import Annotations, RecordedVideo, load_mot_ground_truth
 
 OTB_TRACKS = 5
@@ -49,11 +51,18 @@ def follow_cells(scenario: Scenario, trackers, targets=None, seed: int = 0) -> l
     return [FollowCell(scenario, tracker, int(person), seed) for tracker in trackers for person in people]
 
 
-def follow_run(cell: FollowCell) -> tuple[Scenario, World, Episode]:
-    """The cell's scenario narrowed to its person, its world and its episode."""
+def follow_run(
+    cell: FollowCell, observe: Callable[[World, Policy], StepObserver | None] | None = None
+) -> tuple[Scenario, World, Episode]:
+    """The cell's scenario narrowed to its person, its world and its episode.
+
+    observe : ``observe(world, policy)`` gives the run's step observer (a live view, say).
+    """
     scenario = target_scenario(cell.scenario.model_copy(update={"tracker": _tracker(cell)}), cell.target_id)
     world = episode_world(scenario, cell.seed)
-    return scenario, world, run_episode(scenario, "follow", cell.seed, world)
+    policy = make_policy("follow", scenario, world)
+    observer = None if observe is None else observe(world, policy)
+    return scenario, world, run_episode(scenario, policy, cell.seed, world, observer=observer)
 
 
 def _tracker(cell: FollowCell):

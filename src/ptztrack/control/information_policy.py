@@ -28,6 +28,26 @@ from ptztrack.geometry.ptz import PTZCamera, look_at
 from ptztrack.types import DecisionContext, Tracks
 
 
+@dataclass(frozen=True)
+class RewardTerms:
+    """One decision's rewards (nats) term by term.
+
+    actions : (R,) the flat indices scored; track_ids : (n,) the predicted tracks' ids;
+    track_nats : (R, n) each track's expected information gain ``alpha_k(a) I_k(a)``;
+    patrol_nats : (R,) the patrolling term ``beta I_p(a)`` (zeros without one).
+    """
+
+    actions: np.ndarray
+    track_ids: np.ndarray
+    track_nats: np.ndarray
+    patrol_nats: np.ndarray
+
+    @property
+    def total_nats(self) -> np.ndarray:
+        """(R,) the reward of each action, as the policy compares them."""
+        return np.sum(self.track_nats, axis=-1) + self.patrol_nats
+
+
 @dataclass
 class InformationGainPolicy:
     """Greedy expected-information-gain control.
@@ -36,6 +56,8 @@ class InformationGainPolicy:
     person_height_m, person_width_m : the person the policy expects.
     method : 'intg' (equation 8, closed form) or 'smpl' (equation 19, ``samples`` draws).
     beta, exploration : the patrolling term's weight and map (None: no patrolling term).
+    last_terms : the last choice's rewards term by term (for a live view of the decision; None before
+        the first choice). Kept by reference: the arrays are the ones the choice was made from.
     """
 
     camera: PTZCamera
@@ -49,13 +71,19 @@ class InformationGainPolicy:
     beta: float = 0.0
     exploration: ExplorationMap | None = None
     geometry: ActionGeometry = field(init=False, repr=False)
+    last_terms: RewardTerms | None = field(default=None, init=False, repr=False)
 
     def __post_init__(self):
         self.geometry = action_geometry(self.camera, self.grid.poses, self.person_height_m)
 
     def rewards(self, actions, tracks: Tracks, rng: np.random.Generator) -> np.ndarray:
         """Expected information (nats) of each of ``actions`` (flat indices) about ``tracks``; (len(actions),)."""
-        reward = np.zeros(len(actions))
+        return self.reward_terms(actions, tracks, rng).total_nats
+
+    def reward_terms(self, actions, tracks: Tracks, rng: np.random.Generator) -> RewardTerms:
+        """The rewards of ``actions`` (flat indices) term by term: each track's, and the patrolling term."""
+        actions = np.asarray(actions)
+        track_nats = np.zeros((len(actions), len(tracks)))
         if len(tracks):
             mean_m = tracks.mean[:, :2]
             position_cov_m2 = tracks.covariance[:, :2, :2]
@@ -79,13 +107,15 @@ class InformationGainPolicy:
                     actions,
                 )
                 information = information_if_detected_nats(self.geometry, mean_m, position_cov_m2, self.V, actions)
-            reward += np.sum(alpha * information, axis=-1)
+            track_nats = alpha * information
+        patrol_nats = np.zeros(len(actions))
         if self.exploration is not None:
-            reward += self.beta * self.exploration.information_nats(actions)
-        return reward
+            patrol_nats = self.beta * self.exploration.information_nats(actions)
+        return RewardTerms(actions, tracks.ids, track_nats, patrol_nats)
 
     def choose(self, context: DecisionContext) -> int:
-        reward = self.rewards(context.reachable, context.tracks, context.rng)
+        self.last_terms = self.reward_terms(context.reachable, context.tracks, context.rng)
+        reward = self.last_terms.total_nats
         best = int(np.argmax(reward))
         staying = np.flatnonzero(context.reachable == context.current_action)
         if len(staying) and reward[staying[0]] >= reward[best]:
