@@ -10,6 +10,7 @@ tracker gives other boxes on the same frames from run to run (also with
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
+from functools import partial
 
 import numpy as np
 
@@ -18,6 +19,7 @@ from ptztrack.builders.follow import follow_parameters, target_scenario, target_
 from ptztrack.camera.recorded import RecordedPTZ
 from ptztrack.config import Scenario
 from ptztrack.evaluate.follow import follow_metrics, one_pass_scores, target_in_views
+from ptztrack.geometry.calibration import load_calibration, standing_height_px
 from ptztrack.loop import Episode, StepObserver, World, episode_seeds
 from ptztrack.roles import Policy
 from ptztrack.scene.pets import Annotations, RecordedVideo, load_mot_ground_truth
@@ -152,12 +154,14 @@ def run_otb_cell(cell: OnePassCell) -> dict:
     rng = np.random.default_rng(episode_seeds(cell.seed)[4])
     source = target_source(cell.scenario, cell.tracker, rng)
     still = np.eye(3)
+    calibration = load_calibration(recording.calibration, recording.view)
+    standing = partial(standing_height_px, calibration, height_m=cell.scenario.control.person_height_m)
     tracked = np.zeros((len(frames), 4))
     elapsed_s = 0.0
     for index, frame in enumerate(frames):
         image = video.frame(int(frame))
         started = time.perf_counter()
-        estimate = source.start(image, boxes[0]) if index == 0 else source.step(image, still)
+        estimate = source.start(image, boxes[0]) if index == 0 else source.step(image, still, standing)
         elapsed_s += time.perf_counter() - started
         tracked[index] = estimate.box_px
     annotated = np.all(np.isfinite(boxes), axis=1)

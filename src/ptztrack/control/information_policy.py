@@ -19,7 +19,7 @@ from ptztrack.control.exploration import ExplorationMap
 from ptztrack.control.information_gain import (
     ActionGeometry,
     action_geometry,
-    detection_weight_integral,
+    detection_weight_and_information_integral,
     detection_weight_sampled,
     information_if_detected_nats,
 )
@@ -83,18 +83,19 @@ class InformationGainPolicy:
     def reward_terms(self, actions, tracks: Tracks, rng: np.random.Generator) -> RewardTerms:
         """The rewards of ``actions`` (flat indices) term by term: each track's, and the patrolling term."""
         actions = np.asarray(actions)
-        geometry = self.geometry.take(actions)
         track_nats = np.zeros((len(actions), len(tracks)))
         if len(tracks):
             mean_m = tracks.mean[:, :2]
             position_cov_m2 = tracks.covariance[:, :2, :2]
             if self.method == "intg":
-                alpha = detection_weight_integral(self.camera, geometry, self.recall, mean_m, position_cov_m2, self.V)
+                alpha, information = detection_weight_and_information_integral(
+                    self.camera, self.geometry, self.recall, mean_m, position_cov_m2, self.V, actions
+                )
             else:
                 reference_pose = look_at(self.camera, mean_m.mean(axis=0), zoom=1.0)
                 alpha = detection_weight_sampled(
                     self.camera,
-                    geometry,
+                    self.geometry,
                     self.recall,
                     mean_m,
                     position_cov_m2,
@@ -103,8 +104,10 @@ class InformationGainPolicy:
                     reference_pose,
                     rng,
                     self.samples,
+                    actions,
                 )
-            track_nats = alpha * information_if_detected_nats(geometry, mean_m, position_cov_m2, self.V)
+                information = information_if_detected_nats(self.geometry, mean_m, position_cov_m2, self.V, actions)
+            track_nats = alpha * information
         patrol_nats = np.zeros(len(actions))
         if self.exploration is not None:
             patrol_nats = self.beta * self.exploration.information_nats(actions)

@@ -127,6 +127,18 @@ def head_from_feet_homology(camera: PTZCamera, poses, height_m) -> np.ndarray:
     return plane_homography(camera, poses, height_m) @ image_to_ground(camera, poses)
 
 
+def standing_height_px(head_from_feet, feet_px) -> np.ndarray:
+    """The image height (N,) px of a person standing on feet pixels (N, 2), through a head/feet
+    homology (3, 3) (:func:`head_from_feet_homology`); NaN where the head would not be above the feet
+    (feet on or beyond the horizon)."""
+    feet_px = np.asarray(feet_px, dtype=float)
+    homogeneous = np.c_[feet_px, np.ones(len(feet_px))] @ np.asarray(head_from_feet, dtype=float).T
+    with np.errstate(divide="ignore", invalid="ignore"):
+        head_px = homogeneous[:, :2] / homogeneous[:, 2:]
+    height_px = np.linalg.norm(feet_px - head_px, axis=-1)
+    return np.where((homogeneous[:, 2] > 0) & (head_px[:, 1] < feet_px[:, 1]), height_px, np.nan)
+
+
 def homography_jacobian(H, points) -> np.ndarray:
     """Jacobian of ``p -> H p`` (inhomogeneous) at ``points``.
 
