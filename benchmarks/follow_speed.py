@@ -31,7 +31,7 @@ from ptztrack.builders.follow import initial_box, target_scenario, target_source
 from ptztrack.builders.follow_experiment import FollowCell, follow_run  # noqa: E402
 from ptztrack.config import pets_follow_scenario  # noqa: E402
 from ptztrack.files import write_json  # noqa: E402
-from ptztrack.geometry.ptz import head_from_feet_homology, rotation_homography, standing_height_px  # noqa: E402
+from ptztrack.geometry.ptz import rotation_homography, standing_height_px  # noqa: E402
 from ptztrack.track.target import box_corners_carried  # noqa: E402
 
 
@@ -47,8 +47,8 @@ def recorded_views(person: int, steps: int):
     views = [world.backend.image(step, pose).copy() for step, pose in enumerate(poses)]
     first_box = box_corners_carried(box, rotation_homography(world.camera, start_pose, poses[0]))
     homographies = [rotation_homography(world.camera, a, b) for a, b in zip(poses, poses[1:], strict=False)]
-    homologies = head_from_feet_homology(world.camera, poses[1:], narrowed.control.person_height_m)
-    standing = [partial(standing_height_px, homology) for homology in homologies]
+    height_m = narrowed.control.person_height_m
+    standing = [partial(standing_height_px, world.camera, pose, height_m) for pose in poses[1:]]
     return narrowed, views, list(zip(homographies, standing, strict=True)), first_box
 
 

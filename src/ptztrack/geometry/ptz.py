@@ -127,16 +127,16 @@ def head_from_feet_homology(camera: PTZCamera, poses, height_m) -> np.ndarray:
     return plane_homography(camera, poses, height_m) @ image_to_ground(camera, poses)
 
 
-def standing_height_px(head_from_feet, feet_px) -> np.ndarray:
-    """The image height (N,) px of a person standing on feet pixels (N, 2), through a head/feet
-    homology (3, 3) (:func:`head_from_feet_homology`); NaN where the head would not be above the feet
-    (feet on or beyond the horizon)."""
+def standing_height_px(camera: PTZCamera, pose, height_m: float, feet_px) -> np.ndarray:
+    """The image height (N,) px of a person ``height_m`` tall standing on feet pixels (N, 2) at ``pose``
+    (3,): the distance from the feet to the projected head; NaN where the feet's ray meets the ground
+    behind the camera (above the horizon) or the head is behind it."""
     feet_px = np.asarray(feet_px, dtype=float)
-    homogeneous = np.c_[feet_px, np.ones(len(feet_px))] @ np.asarray(head_from_feet, dtype=float).T
-    with np.errstate(divide="ignore", invalid="ignore"):
-        head_px = homogeneous[:, :2] / homogeneous[:, 2:]
-    height_px = np.linalg.norm(feet_px - head_px, axis=-1)
-    return np.where((homogeneous[:, 2] > 0) & (head_px[:, 1] < feet_px[:, 1]), height_px, np.nan)
+    ground_m = apply_homography(image_to_ground(camera, pose), feet_px)
+    head_px = apply_homography(plane_homography(camera, pose, height_m), ground_m)
+    feet_m, head_m = (np.c_[ground_m, np.full(len(ground_m), z)] for z in (0.0, height_m))
+    in_front = (camera_depth_m(camera, pose, feet_m) > 0) & (camera_depth_m(camera, pose, head_m) > 0)
+    return np.where(in_front, np.linalg.norm(head_px - feet_px, axis=-1), np.nan)
 
 
 def homography_jacobian(H, points) -> np.ndarray:

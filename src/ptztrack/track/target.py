@@ -42,7 +42,6 @@ import numpy as np
 from ptztrack.geometry.ptz import (
     PTZCamera,
     apply_homography,
-    head_from_feet_homology,
     homography_jacobian,
     plane_homography,
     rotation_homography,
@@ -215,7 +214,7 @@ class TargetTracker:
             )
             estimate = self.source.start(image, carried)
         else:
-            standing = partial(standing_height_px, head_from_feet_homology(self.camera, pose, self.person_height_m))
+            standing = partial(standing_height_px, self.camera, pose, self.person_height_m)
             estimate = self.source.step(image, rotation_homography(self.camera, self.pose, pose), standing)
         self.pose = pose
         box = np.asarray(estimate.box_px, dtype=float)
