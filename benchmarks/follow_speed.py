@@ -3,7 +3,7 @@
 A closed-loop PETS episode of one person (CSRT moves the camera, so that the
 views are those of a camera following somebody) gives 640 x 480 views and
 the homographies between their poses; then the particle filter (the
-scenario's defaults: 100 particles, 3 patches) is timed on those views
+scenario's defaults: 100 particles, 5 patches) is timed on those views
 alone: its colour and motion likelihoods, the motion image with its warp,
 resampling and the loss test, rendering excluded. ``pf_steps_per_s`` counts
 the steps it tracked with 100 particles; the steps it spent searching after

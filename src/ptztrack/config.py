@@ -383,17 +383,19 @@ class Follow(_Strict):
     max_zoom_acceleration (per s^2) : of the natural logarithm of the zoom; zoom_range : [lowest, highest].
     smoothing_cutoff_hz : the tracker's output low-pass filter.
     particles, search_particles : tracking, and searching after a loss.
-    patches : [left, top, width, height] in units of the person's box (default: head, torso, legs).
+    patches : [left, top, width, height] in units of the person's box (default: the head, and the torso
+    and the legs each split into a left and a right half).
     histogram_bins : N of the N x N hue-saturation histograms; samples_per_patch : grid points per axis.
     achromatic_bins : N more bins by value for pixels too grey or dark to have a hue (Perez et al.);
     false: the paper's hue-saturation histograms alone.
     background_area_ratio : weigh the histograms' bins down by how common they are in the ring around
     the first box, out to a box of this many times its area (Comaniciu et al.'s background-weighted
     histogram, their 3); null: the paper's unweighted histograms.
-    lambda_colour, lambda_motion : equations 3 and 4.
+    lambda_colour, lambda_motion : equations 3 and 4 (lambda_colour: K / 20 for K patches, Perez et al.'s
+    exp(-20 D^2) on the patches' mean).
     lambda_loss : the colour likelihood's lambda in the loss test, exp(-sum_p B_p^2 / lambda_loss): the
     weights stay sharp (``lambda_colour``) while the loss test tolerates the appearance changes of a
-    walking person (chosen on the even-numbered PETS people; see the README).
+    walking person (K / 3: 1.0 chosen for three patches on the even-numbered PETS people; see the README).
     walk_heights_per_s : random-walk spread of the box position, box heights per second;
     scale_change_per_s : relative random-walk spread of its height per second.
     prediction : 'constant_velocity' (the random walk about the person's image velocity, averaged
@@ -418,16 +420,18 @@ class Follow(_Strict):
     search_particles: Annotated[int, Field(ge=2), at_most(100_000, _PARTICLE_TIME)] = 400
     patches: Annotated[tuple[Patch, ...], at_most_items(100, _PARTICLE_TIME)] = (
         (0.3, 0.0, 0.4, 0.15),
-        (0.15, 0.15, 0.7, 0.35),
-        (0.2, 0.5, 0.6, 0.5),
+        (0.15, 0.15, 0.35, 0.35),
+        (0.5, 0.15, 0.35, 0.35),
+        (0.2, 0.5, 0.3, 0.5),
+        (0.5, 0.5, 0.3, 0.5),
     )
     histogram_bins: int = Field(10, ge=1, le=64)
     achromatic_bins: bool = False
     background_area_ratio: Annotated[float, Field(gt=1), at_most(10_000, "box areas")] | None = 3.0
     height_log_sigma: PositiveFloat | None = 0.1
     samples_per_patch: Annotated[int, Field(ge=1), at_most(1000, _PARTICLE_TIME)] = 20
-    lambda_colour: Annotated[PositiveFloat, at_most(1e6, "a likelihood scale")] = 0.15
-    lambda_loss: Annotated[PositiveFloat, at_most(1e6, "a likelihood scale")] = 1.0
+    lambda_colour: Annotated[PositiveFloat, at_most(1e6, "a likelihood scale")] = 5 / 20
+    lambda_loss: Annotated[PositiveFloat, at_most(1e6, "a likelihood scale")] = 5 / 3
     lambda_motion: Annotated[PositiveFloat, at_most(1e6, "a likelihood scale")] = 0.434
     walk_heights_per_s: Annotated[PositiveFloat, at_most(1000, "box heights per second")] = 1.0
     scale_change_per_s: Annotated[PositiveFloat, at_most(100, "per second")] = 0.2

@@ -1,7 +1,8 @@
 """The robot-cameraman paper's target model (seed 003, section III-B and III-C3): multi-patch colour histograms.
 
-A target is a box with rectangular patches inside it (by default head, torso
-and legs), each described by a normalised 2-D hue-saturation histogram of
+A target is a box with rectangular patches inside it (the paper's head, torso
+and legs; by default the torso and the legs are each split into a left and a
+right half), each described by a normalised 2-D hue-saturation histogram of
 N x N bins (the paper's N = 10), optionally with N more bins by value for
 the pixels too grey or too dark to have a hue (:func:`colour_bins`). A candidate box is compared with the
 reference patch by patch through the Bhattacharyya distance (equation 2),
