@@ -102,17 +102,21 @@ def test_scanning_every_window_is_opencvs_detect_multiscale_hit_for_hit(hog_worl
     np.testing.assert_allclose(scores[order], np.ravel(weights)[expected_order], rtol=1e-12)
 
 
-def test_the_ground_search_scans_a_subset_of_the_windows_and_they_score_as_in_the_full_search(hog_world):
-    pose = whole_frame_at_zoom(hog_world, 0)
-    enlarged = cv2.resize(hog_world.backend.image(7, pose), None, fx=6.0, fy=6.0, interpolation=cv2.INTER_LINEAR)
+def test_the_ground_search_scans_the_full_searchs_windows_in_its_bands_and_no_others(hog_world):
     hog = hog_world.detector._hog
-    everywhere = scan(hog, enlarged, level_bands(*every_window(), (960, 720), 6.0, SCALE_TOLERANCE), -1.0)
-    bands = hog_world.detector.search.bands(pose, 6.0, (960, 720))
-    searched = scan(hog, enlarged, bands, -1.0)
-    # A hit threshold of -1 keeps many windows that do not hold a person, so that the subset is a real test.
-    assert 0 < len(searched[0]) < len(everywhere[0])
-    full = {tuple(box): score for box, score in zip(everywhere[0].tolist(), everywhere[1], strict=True)}
-    assert all(full[tuple(box)] == score for box, score in zip(searched[0].tolist(), searched[1], strict=True))
+    for step, pose in [(7, whole_frame_at_zoom(hog_world, 0)), (14, whole_frame_at_zoom(hog_world, 3) - [0, 10, 0])]:
+        enlarged = cv2.resize(hog_world.backend.image(step, pose), None, fx=6.0, fy=6.0)
+        # A hit threshold of -1.5 keeps most windows, whether they hold a person or not.
+        everywhere, everywhere_scores = scan(hog, enlarged, level_bands(*every_window(), (960, 720), 6.0, 1.3), -1.5)
+        bands = hog_world.detector.search.bands(pose, 6.0, (960, 720))
+        searched, scores = scan(hog, enlarged, bands, -1.5)
+        in_bands = np.zeros(len(everywhere), dtype=bool)
+        for band in bands:
+            tops_px = np.rint(np.arange(band.first_top_px, band.last_top_px + 1, 8) * band.scale)
+            in_bands |= (everywhere[:, 2] == np.rint(64 * band.scale)) & np.isin(everywhere[:, 1], tops_px)
+        assert 0 < in_bands.sum() < len(everywhere)
+        expected = dict(zip(map(tuple, everywhere[in_bands].tolist()), everywhere_scores[in_bands], strict=True))
+        assert dict(zip(map(tuple, searched.tolist()), scores, strict=True)) == expected
 
 
 def test_the_ground_search_finds_every_person_the_full_search_finds_at_their_size(hog_world):

@@ -253,9 +253,8 @@ def scan(
     """The windows of ``bands`` that fire on the upsampled view: boxes (K, 4) (left, top, width, height)
     in upsampled pixels, as detectMultiScale reports them before grouping, and their scores (K,).
 
-    Each level is the view resized as detectMultiScale resizes it; each band is cut out of it with one
-    stride of margin above and below, so that its windows keep their place on the level's grid and
-    read the neighbours of their edge pixels; the windows in the margins are dropped.
+    Each level is the view resized as detectMultiScale resizes it; each band is cut out of it
+    (:func:`band_rows`) and scanned, and the windows outside the band are dropped.
     """
     boxes, scores = [np.zeros((0, 4))], [np.zeros(0)]
     level_key, level = None, upsampled
@@ -264,10 +263,9 @@ def scan(
             same = band.size_px == (upsampled.shape[1], upsampled.shape[0])
             level = upsampled if same else cv2.resize(upsampled, band.size_px, interpolation=cv2.INTER_LINEAR_EXACT)
             level_key = band.size_px
-        top = max(0, band.first_top_px - STRIDE_PX[1])
-        bottom = min(band.size_px[1], band.last_top_px + WINDOW_PX[1] + STRIDE_PX[1])
+        top, bottom, padding_px = band_rows(band)
         found, weights = hog.detect(
-            level[top:bottom], hitThreshold=hit_threshold, winStride=STRIDE_PX, padding=PADDING_PX
+            level[top:bottom], hitThreshold=hit_threshold, winStride=STRIDE_PX, padding=padding_px
         )
         if len(found) == 0:
             continue
@@ -277,6 +275,22 @@ def scan(
         boxes.append(np.c_[np.rint(corners[keep] * band.scale), np.broadcast_to(size, (keep.sum(), 2))])
         scores.append(np.ravel(weights)[keep])
     return np.concatenate(boxes), np.concatenate(scores)
+
+
+def band_rows(band: LevelBand) -> tuple[int, int, tuple[int, int]]:
+    """The rows [top, bottom) of the level that a band is cut out of, and the padding to scan them with.
+
+    A window's score reads its own pixels and, for the gradient, their neighbours. The cut starts one
+    stride above the band's first window, so that its windows keep their place on the level's grid (the
+    window in that margin is dropped), and ends one row below its last. A band that reaches into the
+    level's padding (a window above its top or below its bottom) is cut to that edge and scanned with
+    detectMultiScale's padding, as the level itself is.
+    """
+    first, last, height = band.first_top_px, band.last_top_px, band.size_px[1]
+    top = max(0, first - STRIDE_PX[1])
+    bottom = min(height, last + WINDOW_PX[1] + 1)
+    padded = first < 0 or last + WINDOW_PX[1] > height
+    return top, bottom, PADDING_PX if padded else (PADDING_PX[0], 0)
 
 
 def group_rectangles(
