@@ -232,3 +232,31 @@ def test_the_scenario_chooses_the_search_and_refuses_a_falling_height_range():
         pets_scenario("hog", **{"detector.hog_person_height_m": (2.0, 1.5)})
     with pytest.raises(ScenarioError, match="hog_search"):
         pets_scenario("hog", **{"detector.hog_search": "sky"})
+
+
+class CountingDetector(HogPeopleDetector):
+    """The HOG detector, counting the views it searches."""
+
+    searched = 0
+
+    def boxes(self, image, pose=None):
+        self.searched += 1
+        return super().boxes(image, pose)
+
+
+def test_a_view_seen_before_gives_the_boxes_found_then_without_searching_again(hog_world, monkeypatch):
+    monkeypatch.setattr("ptztrack.detect.hog._BOXES_SEEN", {})
+    backend, search = hog_world.backend, hog_world.detector.search
+    pose = whole_frame_at_zoom(hog_world, 0)
+    first, second = CountingDetector(search=search), CountingDetector(search=search)
+    found = first.detect(backend, 3, pose, np.random.default_rng(0))
+    again = second.detect(backend, 3, pose, np.random.default_rng(1))
+    assert (first.searched, second.searched) == (1, 0) and len(found) >= 1
+    np.testing.assert_array_equal(again.feet_px, found.feet_px)
+    np.testing.assert_array_equal(again.score, found.score)
+    # Another image, another pose or other settings are searched.
+    second.detect(backend, 4, pose, np.random.default_rng(0))
+    second.detect(backend, 3, pose + [2.0, 0.0, 0.0], np.random.default_rng(0))
+    other = CountingDetector(nms_iou=0.3, search=search)
+    other.detect(backend, 3, pose, np.random.default_rng(0))
+    assert (second.searched, other.searched) == (2, 1)

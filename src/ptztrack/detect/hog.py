@@ -41,6 +41,7 @@ to the tallest's x 1.3 (``SCALE_TOLERANCE``).
 """
 
 import functools
+import hashlib
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
@@ -67,6 +68,11 @@ SCALE_TOLERANCE = 1 + 1.5 * GROUP_EPS
 # A person's height in a row is taken every this many pixels across it; the poses whose search is kept.
 COLUMN_STEP_PX = 8.0
 CACHED_POSES = 512
+# The boxes found in the views seen before in this process, by the detector's settings, the pose and the
+# image, up to MEMO_VIEWS views: the runs of an experiment that differ only in their seed (smpl's Monte Carlo
+# samples) mostly look at the same views, where HOG finds the same boxes.
+MEMO_VIEWS = 20_000
+_BOXES_SEEN: dict[tuple, tuple[np.ndarray, np.ndarray]] = {}
 
 
 @dataclass(frozen=True)
@@ -107,6 +113,13 @@ class GroundSearch:
         if not self.tolerance >= 1:
             raise ValueError(f"tolerance must be at least 1, got {self.tolerance}")
         self._bands = functools.lru_cache(maxsize=CACHED_POSES)(self._bands_at)
+        self.key = (
+            self.camera,
+            np.asarray(self.area_polygon_m, dtype=float).tobytes(),
+            shortest,
+            tallest,
+            self.tolerance,
+        )
 
     def bands(self, pose, upsample: float, upsampled_size_px: tuple[int, int]) -> list[LevelBand]:
         """The windows to scan in the view at ``pose`` (3,) upsampled ``upsample`` times, to (width,
@@ -141,15 +154,26 @@ class HogPeopleDetector:
     def __post_init__(self):
         self._hog = cv2.HOGDescriptor()
         self._hog.setSVMDetector(cv2.HOGDescriptor.getDefaultPeopleDetector())
+        self._settings = (self.upsample, self.hit_threshold, self.nms_iou, self.search and self.search.key)
 
     def detect(self, camera: CameraBackend, step: int, pose, rng: np.random.Generator) -> Detections:
-        """People in the camera's view at ``pose``: feet and heights from the boxes, SVM scores."""
+        """People in the camera's view at ``pose``: feet and heights from the boxes, SVM scores. A view
+        seen before (the same image at the same pose) gives the boxes found then (``MEMO_VIEWS``)."""
         image = camera.image(step, pose)
         if image is None:
             raise RuntimeError("the HOG detector needs a camera backend that renders images")
-        boxes, scores = self.boxes(image, pose)
+        image = np.ascontiguousarray(image)
+        digest = hashlib.blake2b(image.data, digest_size=16).digest()
+        key = (self._settings, np.asarray(pose, dtype=float).tobytes(), image.shape, digest)
+        found = _BOXES_SEEN.get(key)
+        if found is None:
+            found = self.boxes(image, pose)
+            if len(_BOXES_SEEN) >= MEMO_VIEWS:
+                del _BOXES_SEEN[next(iter(_BOXES_SEEN))]
+            _BOXES_SEEN[key] = found
+        boxes, scores = found
         feet_px, height_px = feet_and_height_px(boxes)
-        return Detections(feet_px, height_px, np.full(len(feet_px), -1), scores)
+        return Detections(feet_px, height_px, np.full(len(feet_px), -1), scores.copy())
 
     def boxes(self, image, pose=None) -> tuple[np.ndarray, np.ndarray]:
         """People in a BGR image taken at ``pose`` (needed with a search): boxes (K, 4) as (left, top,
