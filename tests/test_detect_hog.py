@@ -260,3 +260,14 @@ def test_a_view_seen_before_gives_the_boxes_found_then_without_searching_again(h
     other = CountingDetector(nms_iou=0.3, search=search)
     other.detect(backend, 3, pose, np.random.default_rng(0))
     assert (second.searched, other.searched) == (2, 1)
+
+
+def test_scanning_the_levels_on_threads_finds_the_same_windows(hog_world):
+    pose = whole_frame_at_zoom(hog_world, 1)
+    enlarged = cv2.resize(hog_world.backend.image(5, pose), None, fx=6.0, fy=6.0)
+    bands = hog_world.detector.search.bands(pose, 6.0, (960, 720))
+    alone = scan(hog_world.detector._hog, enlarged, bands, -1.0)
+    threaded = scan(hog_world.detector._hog, enlarged, bands, -1.0, threads=3)
+    assert len(alone[0]) > 0
+    np.testing.assert_array_equal(threaded[0], alone[0])
+    np.testing.assert_array_equal(threaded[1], alone[1])

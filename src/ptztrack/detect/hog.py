@@ -42,7 +42,9 @@ to the tallest's x 1.3 (``SCALE_TOLERANCE``).
 
 import functools
 import hashlib
+import itertools
 from collections.abc import Sequence
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 
 import cv2
@@ -195,7 +197,8 @@ class HogPeopleDetector:
                     f"{camera.image_width_px}x{camera.image_height_px} px"
                 )
             bands = self.search.bands(pose, self.upsample, (enlarged.shape[1], enlarged.shape[0]))
-            found, weights = group_rectangles(*scan(self._hog, enlarged, bands, self.hit_threshold))
+            hits = scan(self._hog, enlarged, bands, self.hit_threshold, cv2.getNumThreads())
+            found, weights = group_rectangles(*hits)
             found, weights = clip_boxes(found, weights, (enlarged.shape[1], enlarged.shape[0]))
         if len(found) == 0:
             return np.zeros((0, 4)), np.zeros(0)
@@ -272,21 +275,34 @@ def level_bands(
 
 
 def scan(
-    hog: cv2.HOGDescriptor, upsampled, bands: list[LevelBand], hit_threshold: float
+    hog: cv2.HOGDescriptor, upsampled, bands: list[LevelBand], hit_threshold: float, threads: int = 1
 ) -> tuple[np.ndarray, np.ndarray]:
     """The windows of ``bands`` that fire on the upsampled view: boxes (K, 4) (left, top, width, height)
     in upsampled pixels, as detectMultiScale reports them before grouping, and their scores (K,).
 
     Each level is the view resized as detectMultiScale resizes it; each band is cut out of it
-    (:func:`band_rows`) and scanned, and the windows outside the band are dropped.
+    (:func:`band_rows`) and scanned, and the windows outside the band are dropped. With ``threads`` > 1
+    the levels are scanned on that many threads (OpenCV lets go of the GIL), with the same result.
     """
+    levels = [list(same) for _, same in itertools.groupby(bands, key=lambda band: band.size_px)]
+    if threads > 1 and len(levels) > 1:
+        with ThreadPoolExecutor(threads) as pool:
+            found = list(pool.map(functools.partial(_scan_level, hog, upsampled, hit_threshold), levels))
+    else:
+        found = [_scan_level(hog, upsampled, hit_threshold, level_bands) for level_bands in levels]
+    boxes, scores = zip(*found, strict=True) if found else ((), ())
+    return np.concatenate([np.zeros((0, 4)), *boxes]), np.concatenate([np.zeros(0), *scores])
+
+
+def _scan_level(
+    hog: cv2.HOGDescriptor, upsampled, hit_threshold: float, bands: list[LevelBand]
+) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`scan` of bands of one level."""
+    size_px = bands[0].size_px
+    same = size_px == (upsampled.shape[1], upsampled.shape[0])
+    level = upsampled if same else cv2.resize(upsampled, size_px, interpolation=cv2.INTER_LINEAR_EXACT)
     boxes, scores = [np.zeros((0, 4))], [np.zeros(0)]
-    level_key, level = None, upsampled
     for band in bands:
-        if band.size_px != level_key:
-            same = band.size_px == (upsampled.shape[1], upsampled.shape[0])
-            level = upsampled if same else cv2.resize(upsampled, band.size_px, interpolation=cv2.INTER_LINEAR_EXACT)
-            level_key = band.size_px
         top, bottom, padding_px = band_rows(band)
         found, weights = hog.detect(
             level[top:bottom], hitThreshold=hit_threshold, winStride=STRIDE_PX, padding=padding_px
