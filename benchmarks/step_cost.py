@@ -7,11 +7,13 @@ scenario with OpenCV's HOG detector (``pets_scenario("hog")``, beta 1, seed
 ``smpl``), and times each role of a step with ``time.perf_counter``:
 
 * read: decoding the step's recorded frame (``RecordedVideo.frame``);
-* warp: rendering the 160 x 120 virtual view from it (``VirtualPTZ.render``);
+* warp: rendering the 160 x 120 virtual view from it (``VirtualPTZ.render``;
+  the sampling map of a pose is kept from its first view on);
 * detect: HOG on the view where a standing person can be (the scenario's
   ``hog_search`` 'ground', :class:`ptztrack.detect.hog.GroundSearch`), 6x
   upsampling and non-maximum suppression included
-  (``HogPeopleDetector.boxes``), then ``feet_and_height_px``;
+  (``HogPeopleDetector.boxes``, without the memo of views seen before that
+  ``detect`` keeps), then ``feet_and_height_px``;
 * track: the tracker's ``predict`` and ``update``;
 * decide: the reachable actions and ``policy.choose``.
 
@@ -48,9 +50,11 @@ for the new loop and today's detector each.
 Single-threaded: OMP, OpenBLAS, MKL and Numba are limited to one thread
 through their environment variables (OMP_NUM_THREADS, OPENBLAS_NUM_THREADS,
 MKL_NUM_THREADS, NUMBA_NUM_THREADS = 1, set before NumPy and Numba load) and
-OpenCV through ``cv2.setNumThreads(1)``.
+OpenCV through ``cv2.setNumThreads(1)``; ``--threads N`` gives OpenCV N
+threads instead (both detectors spread their pyramid levels over them), the
+rest of the step staying on one.
 
-    python benchmarks/step_cost.py [--steps N] [--warmup N] [--repeats N] [--json PATH]
+    python benchmarks/step_cost.py [--steps N] [--warmup N] [--repeats N] [--threads N] [--json PATH]
 """
 
 import os
@@ -228,16 +232,18 @@ def main() -> None:
     parser.add_argument("--warmup", type=int, default=5, help="untimed steps run first")
     parser.add_argument("--repeats", type=int, default=2, help="runs per policy; the fastest is kept")
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--threads", type=int, default=1, help="OpenCV's threads (the detectors')")
     parser.add_argument("--json", type=Path, help="write the rows here")
     args = parser.parse_args()
-    if args.steps < 1 or args.warmup < 0 or args.repeats < 1:
-        parser.error("--steps and --repeats must be at least 1 and --warmup at least 0")
+    if args.steps < 1 or args.warmup < 0 or args.repeats < 1 or args.threads < 1:
+        parser.error("--steps, --repeats and --threads must be at least 1 and --warmup at least 0")
+    cv2.setNumThreads(args.threads)
     scenario = pets_scenario("hog", **{"control.beta": 1.0})
     settings = scenario.detector
     reference = HogPeopleDetector(settings.hog_upsample, settings.hog_hit_threshold, settings.hog_nms_iou)
     print(
         f"PETS 2009, HOG detector, beta 1, seed {args.seed}: ms per step over {args.steps} steps "
-        f"after {args.warmup} warm-up steps, one thread, fastest of {args.repeats} runs; "
+        f"after {args.warmup} warm-up steps, OpenCV on {args.threads} thread(s), fastest of {args.repeats} runs; "
         "today: every window (detectMultiScale) on the same views"
     )
     header = f"{'policy':<8}{'zoom':>6}" + "".join(f"{part:>8}" for part in PARTS) + f"{'total':>8}{'steps/s':>9}"

@@ -98,7 +98,8 @@ class GroundSearch:
     camera : the PTZ camera model of the views; area_polygon_m : (K, 2) the walkable area on the ground;
     person_heights_m : (shortest, tallest) standing person; tolerance : windows from the shortest
     person's height / tolerance to the tallest's x tolerance are scanned (see the module's notes).
-    The windows of a pose are worked out once and kept (for the last ``CACHED_POSES`` poses).
+    The windows of a pose are worked out once and kept (for the last ``CACHED_POSES`` poses); ``key``
+    tells one search from another (a detector's memo of the views it has seen keys on it).
     """
 
     camera: PTZCamera
