@@ -21,6 +21,7 @@ for variable in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
 
 import argparse  # noqa: E402
 import time  # noqa: E402
+from functools import partial  # noqa: E402
 from pathlib import Path  # noqa: E402
 
 import cv2  # noqa: E402
@@ -30,13 +31,14 @@ from ptztrack.builders.follow import initial_box, target_scenario, target_source
 from ptztrack.builders.follow_experiment import FollowCell, follow_run  # noqa: E402
 from ptztrack.config import pets_follow_scenario  # noqa: E402
 from ptztrack.files import write_json  # noqa: E402
-from ptztrack.geometry.ptz import rotation_homography  # noqa: E402
+from ptztrack.geometry.ptz import rotation_homography, standing_height_px  # noqa: E402
 from ptztrack.track.target import box_corners_carried  # noqa: E402
 
 
 def recorded_views(person: int, steps: int):
-    """The first ``steps`` views (640 x 480) of a closed-loop run following ``person``, their poses, and
-    the person's box in the first view."""
+    """The first ``steps`` views (640 x 480) of a closed-loop run following ``person``, the homographies
+    from each view to the next, each next view's standing heights (the calibration the particle
+    filter's height prior reads), and the person's box in the first view."""
     scenario = pets_follow_scenario("csrt", frames=steps)
     narrowed, world, episode = follow_run(FollowCell(scenario, "csrt", person))
     narrowed = narrowed.model_copy(update={"frames": min(steps, narrowed.frames)})
@@ -45,7 +47,9 @@ def recorded_views(person: int, steps: int):
     views = [world.backend.image(step, pose).copy() for step, pose in enumerate(poses)]
     first_box = box_corners_carried(box, rotation_homography(world.camera, start_pose, poses[0]))
     homographies = [rotation_homography(world.camera, a, b) for a, b in zip(poses, poses[1:], strict=False)]
-    return narrowed, views, homographies, first_box
+    height_m = narrowed.control.person_height_m
+    standing = [partial(standing_height_px, world.camera, pose, height_m) for pose in poses[1:]]
+    return narrowed, views, list(zip(homographies, standing, strict=True)), first_box
 
 
 def step_times(scenario, tracker: str, views, homographies, first_box, seed: int = 0):
@@ -54,9 +58,9 @@ def step_times(scenario, tracker: str, views, homographies, first_box, seed: int
     source = target_source(scenario, tracker, np.random.default_rng(seed))
     source.start(views[0], first_box)
     times_s, lost = [], []
-    for view, homography in zip(views[1:], homographies, strict=True):
+    for view, (homography, standing) in zip(views[1:], homographies, strict=True):
         started = time.perf_counter()
-        estimate = source.step(view, homography)
+        estimate = source.step(view, homography, standing)
         times_s.append(time.perf_counter() - started)
         lost.append(estimate.lost)
     return np.array(times_s), np.array(lost)

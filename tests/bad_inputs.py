@@ -247,6 +247,10 @@ def cases(scratch: Path | None) -> list[Case]:
             {"c.yaml": "pan_deg: [-90, 90]\ntilt_deg: [-45, 45]\nzoom_curve: [[0, 4], [1, 1]]\n"},
         ),
         Case("serve-camera: a user without a password", ("serve-camera", "--port", "0", "--user", "op")),
+        Case("view: a folder without view states", ("view", "{dir}")),
+        Case("view: a file, not a folder", ("view", "{dir}/f"), {"f": "keep me\n"}),
+        Case("view: a line that is not a state", ("view", "{dir}/run"), {"run/view_states.jsonl": '{"step": 0}\n'}),
+        Case("view: --steps-per-s 0", ("view", "{dir}", "--steps-per-s", "0")),
         _dataset("occupancy --out not empty", files={"out/keep.txt": "keep me\n"}, extra=("--out", "{dir}/out")),
     ]
 

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from ptztrack.camera.virtual import MM_PER_M, virtual_ptz
-from ptztrack.geometry.calibration import load_pinhole, project_pinhole
+from ptztrack.geometry.calibration import load_pinhole, project_pinhole, standing_height_px
 from ptztrack.geometry.ptz import apply_homography, ground_to_image, image_to_ground
 from ptztrack.scene.pets import load_mot_ground_truth, read_video
 
@@ -91,3 +91,16 @@ def test_a_poses_sampling_maps_are_computed_once_and_the_oldest_are_dropped_beyo
     virtual.sampling_maps(pose + [2.0, 0.0, 0.0])
     assert virtual.sampling_maps(pose) is not first
     assert pickle.loads(pickle.dumps(virtual)).sampling_maps(pose)[0].shape == (120, 160)
+
+
+def test_a_person_standing_on_the_recorded_ground_is_as_tall_as_the_projection_of_their_head():
+    """The recording's standing height: the feet pixel's ray meets the ground, the head 1.75 m above
+    it is projected with the lens distortion; so is it computed by hand from ground points."""
+    ground_mm = np.array([[0.0, 0.0, 0.0], [5000.0, 3000.0, 0.0], [-2000.0, 9000.0, 0.0]])
+    feet_px = project_pinhole(RECORDING, ground_mm)
+    head_px = project_pinhole(RECORDING, ground_mm + [0.0, 0.0, 1750.0])
+    np.testing.assert_allclose(
+        standing_height_px(RECORDING, feet_px, 1.75), np.linalg.norm(head_px - feet_px, axis=-1), rtol=1e-5
+    )
+    # The sky holds no one: a pixel far above the horizon.
+    assert np.isnan(standing_height_px(RECORDING, [[384.0, -3000.0]], 1.75)).all()

@@ -1,7 +1,13 @@
 import csv
+import fcntl
 import json
+import os
+import pty
+import re
+import struct
 import subprocess
 import sys
+import termios
 from pathlib import Path
 
 import pytest
@@ -11,8 +17,9 @@ from ptztrack.cli import main
 
 def test_run_writes_metrics_tracks_and_picture(tmp_path, capsys):
     assert main(["run", "--policy", "fix", "--detector", "ideal", "--frames", "20", "--out", str(tmp_path)]) == 0
-    printed = capsys.readouterr().out
-    assert "MOTA" in printed and "MOTP [m]" in printed
+    printed = capsys.readouterr()
+    assert "MOTA" in printed.out and "MOTP [m]" in printed.out
+    assert printed.err == ""  # no progress bar where stderr is not a terminal
     metrics = json.loads((tmp_path / "metrics.json").read_text())
     assert {"mota", "motp_m", "idf1", "height_px", "detections", "zoom"} <= set(metrics)
     with open(tmp_path / "tracks.csv", newline="") as file:
@@ -142,3 +149,36 @@ def test_the_registration_experiment_uses_realistic_live_views_and_says_which(tm
     assert document["ground_err_median_m"] is not None and [row["pose_source"] for row in document["closed_loop"]] == [
         "oracle"
     ]
+
+
+def _stderr(command: list[str]) -> str:
+    """What a command writes on stderr into a pseudo-terminal, as a user sees it."""
+    controller, terminal_end = pty.openpty()
+    fcntl.ioctl(terminal_end, termios.TIOCSWINSZ, struct.pack("HHHH", 24, 120, 0, 0))  # 24 rows, 120 columns
+    chunks = []
+    with subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=terminal_end) as process:
+        os.close(terminal_end)
+        while True:
+            try:
+                chunk = os.read(controller, 4096)
+            except OSError:  # EIO: the command has closed its end
+                break
+            if not chunk:
+                break
+            chunks.append(chunk)
+    os.close(controller)
+    assert process.returncode == 0
+    return b"".join(chunks).decode()
+
+
+def test_a_progress_bar_in_a_terminal_and_none_with_quiet():
+    """tqdm's bar: what is counted, the share done, done / all, elapsed < left, the rate. Off a terminal
+    there is none either (the in-process tests, whose stderr is captured, check it)."""
+    experiment = [sys.executable, "-m", "ptztrack.cli", "experiment", "synthetic", "--sequences", "2"]
+    experiment += ["--frames", "4", "--strategies", "fix", "rnd", "--executor", "serial"]
+    shown = _stderr(experiment)
+    assert re.search(r"episodes: 100%\|.*\| 4/4 \[\d\d:\d\d<00:00, +[\d.]+episode/s\]", shown), shown
+    quiet = _stderr([*experiment, "--quiet"])
+    assert "episodes:" not in quiet and "%|" not in quiet and "4 episodes, serial executor" in quiet
+    run = _stderr([sys.executable, "-m", "ptztrack.cli", "run", "--frames", "6", "--policy", "fix"])
+    assert re.search(r"steps: 100%\|.*\| 6/6 \[\d\d:\d\d<00:00, +[\d.]+step/s\]", run), run

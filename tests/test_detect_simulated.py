@@ -5,6 +5,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from information_gain_reference import occluded_fraction_by_cells
 from overhead import CAMERA as OVERHEAD_CAMERA
 from ptztrack.builders.factories import recall_model
 from ptztrack.config import Scenario
@@ -168,6 +169,22 @@ def test_occluded_fraction_batched_matches_raster(frames):
     assert twice.shape == (2,) + depths.shape
     np.testing.assert_allclose(twice[0], result, rtol=1e-12, atol=1e-12)
     np.testing.assert_allclose(twice[1], result[::-1], rtol=1e-12, atol=1e-12)
+
+
+def test_occluded_fraction_matches_cutting_every_box_along_all_edges():
+    """Real-valued boxes of crowds, where each target meets many occluders: the kernel cuts a
+    box only along the edges of the boxes that overlap it, the reference along all of them."""
+    rng = np.random.default_rng(12)
+    frames, count = 200, 12
+    corner = rng.uniform(0, 60, size=(frames, count, 2))
+    size = rng.uniform(0, 30, size=(frames, count, 2)) * (rng.random((frames, count, 1)) > 0.05)
+    boxes = np.concatenate([corner, corner + size], axis=-1)
+    depths = rng.integers(0, 6, size=(frames, count)).astype(float)  # ties on purpose
+    valid = rng.random((frames, count)) > 0.1
+    result = occluded_fraction(boxes, depths, valid)
+    expected = occluded_fraction_by_cells(boxes, depths, valid)
+    np.testing.assert_allclose(result, expected, rtol=1e-12, atol=1e-12)
+    assert np.mean((expected > 0.05) & (expected < 0.95)) > 0.2, "many boxes must be partly hidden"
 
 
 # ---------------------------------------------------------------------------

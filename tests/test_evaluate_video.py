@@ -18,6 +18,7 @@ from ptztrack.evaluate.video import (
     view_renderer,
     write_episode_video,
 )
+from ptztrack.evaluate.view_state import VIEW_STATES_FILE
 from ptztrack.geometry.area import bounds_m
 from ptztrack.geometry.ptz import PTZCamera
 from test_camera_recorded import EXCERPT, excerpt_scenario
@@ -42,7 +43,8 @@ def test_run_out_writes_an_mp4_with_one_frame_per_step(tmp_path, capsys):
     frames, frame_rate_hz = read_video(tmp_path / "episode.mp4")
     assert frames.shape == (10, FRAME_SIZE_PX[1], FRAME_SIZE_PX[0], 3)
     assert frame_rate_hz == pytest.approx(5.0)
-    assert sorted(os.listdir(tmp_path)) == sorted(RUN_FILES)
+    assert sorted(os.listdir(tmp_path)) == sorted([*RUN_FILES, VIEW_STATES_FILE])
+    assert len((tmp_path / VIEW_STATES_FILE).read_text().splitlines()) == 10  # a state per step, for `ptztrack view`
 
 
 def test_the_video_holds_the_drawn_frames_and_the_same_seed_gives_the_same_bytes(tmp_path):

@@ -22,6 +22,7 @@ from ptztrack.geometry.ptz import (
     projection_matrix,
     rotation_homography,
     rotation_world_to_camera,
+    standing_height_px,
 )
 
 CAMERA = PTZCamera((7.5, -4.0, 7.0), 640, 480, 400.0)
@@ -524,3 +525,31 @@ def test_inside_image_simple_cases():
     grid = np.zeros((2, 3, 2))
     grid[1, 2] = [1000.0, 0.0]
     np.testing.assert_array_equal(inside_image(CAMERA, grid), [[True] * 3, [True, True, False]])
+
+
+@PROPERTY
+@given(pose_and_ground_points())
+def test_standing_height_is_the_distance_from_the_feet_to_the_projected_head(sample):
+    pose, feet_px, ground_xy = sample
+    head_px = apply_homography(plane_homography(CAMERA, pose, 1.75), ground_xy)
+    expected_px = np.linalg.norm(head_px - feet_px, axis=-1)
+    standing = standing_height_px(CAMERA, pose, 1.75, feet_px)
+    np.testing.assert_allclose(standing, expected_px, rtol=1e-9)
+
+
+def test_a_person_under_a_steep_camera_has_the_head_below_the_feet_in_the_image_and_is_still_measured():
+    """Tilted 60 deg down, the nadir is in the image: a person standing below it appears upside down."""
+    pose = np.array([0.0, 60.0, 1.0])
+    feet_px = np.array([[0.0, 480.0]])
+    ground_xy = apply_homography(image_to_ground(CAMERA, pose), feet_px)
+    head_px = apply_homography(plane_homography(CAMERA, pose, 1.75), ground_xy)
+    assert head_px[0, 1] > feet_px[0, 1]
+    np.testing.assert_allclose(
+        standing_height_px(CAMERA, pose, 1.75, feet_px), np.linalg.norm(head_px - feet_px, axis=-1)
+    )
+
+
+def test_no_one_stands_beyond_the_horizon():
+    pose = np.array([0.0, 10.0, 1.0])
+    above_px = [[320.0, horizon_row_px(pose) - 5.0]]
+    assert np.isnan(standing_height_px(CAMERA, pose, 1.75, above_px)).all()

@@ -1,6 +1,6 @@
 import numpy as np
 
-from ptztrack.builders.episode import run_episode
+from ptztrack.builders.episode import episode_world, make_policy, run_episode
 from ptztrack.config import scenario_from_dict
 from ptztrack.evaluate.metrics import episode_metrics
 from ptztrack.loop import episode_seeds
@@ -55,3 +55,27 @@ def test_the_trackers_stream_leaves_the_first_four_streams_as_they_were():
     before = [np.random.default_rng(stream).random(3) for stream in np.random.SeedSequence(7).spawn(4)]
     np.testing.assert_array_equal(draws[:4], before)
     assert not np.array_equal(draws[4], draws[3])
+
+
+def test_an_observer_sees_every_step_and_changes_nothing_and_intg_exposes_its_reward_terms():
+    scenario = scenario_from_dict({"frames": 12})
+    world = episode_world(scenario, 3)
+    policy = make_policy("intg", scenario, world)
+    seen = []
+
+    def observer(step, context, record):
+        terms = policy.last_terms
+        np.testing.assert_array_equal(terms.actions, context.reachable)
+        np.testing.assert_array_equal(terms.track_ids, context.tracks.ids)
+        assert terms.track_nats.shape == (len(context.reachable), len(context.tracks))
+        assert np.all(terms.track_nats >= 0) and np.all(np.isfinite(terms.patrol_nats))
+        # The action taken is the best by the terms' total (or the current one where it ties)
+        total = terms.total_nats
+        assert total[context.reachable == record["actions"]][0] == total.max()
+        seen.append(step)
+
+    observed = run_episode(scenario, policy, 3, world, observer=observer)
+    plain = run_episode(scenario, "intg", 3)
+    assert seen == list(range(12))
+    np.testing.assert_array_equal(observed.actions, plain.actions)
+    np.testing.assert_array_equal(observed.poses, plain.poses)

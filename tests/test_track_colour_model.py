@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 
 from ptztrack.track.colour_model import (
+    background_weights,
     bhattacharyya_distance,
     bin_count,
     box_of_states,
@@ -12,6 +13,7 @@ from ptztrack.track.colour_model import (
     colour_log_likelihood,
     patch_boxes,
     patch_histograms,
+    weigh_histograms,
 )
 
 
@@ -82,3 +84,36 @@ def test_patches_are_placed_in_box_units():
     np.testing.assert_allclose(box, [30.0, 60.0, 40.0, 80.0])
     head_and_legs = patch_boxes(box, [[0.25, 0.0, 0.5, 0.125], [0.0, 0.5, 1.0, 0.5]])
     np.testing.assert_allclose(head_and_legs, [[40.0, 60.0, 20.0, 10.0], [30.0, 100.0, 40.0, 40.0]])
+
+
+def test_background_weights_of_a_ring_counted_by_hand():
+    """Comaniciu et al.'s weights min(o*/o_u, 1): a box of bin 0 in a ring of 36 pixels of bin 1 and 12 of
+    bin 2 (o* = 12); bins 0 and 3 are not in the ring; pixels beyond the ring do not count."""
+    bin_image = np.full((12, 12), 3)
+    bin_image[1:9, 1:9] = 1  # the ring's outer box: 8 x 8 pixels around the 4 x 4 box
+    bin_image[1, 1:9] = 2
+    bin_image[2, 1:5] = 2
+    bin_image[3:7, 3:7] = 0  # the box
+    weights = background_weights(bin_image, (3.0, 3.0, 4.0, 4.0), 4, ring_scale=2.0)
+    np.testing.assert_allclose(weights, [1.0, 12 / 36, 1.0, 1.0])
+    # Weighted histograms are normalised again; the background's colour counts for less.
+    np.testing.assert_allclose(weigh_histograms([[0.5, 0.5, 0.0, 0.0]], weights), [[0.75, 0.25, 0.0, 0.0]])
+    np.testing.assert_array_equal(weigh_histograms(np.zeros(4), weights), np.zeros(4))
+
+
+def test_a_box_on_plain_background_plays_down_the_background_colour_only():
+    """A red figure with a grey head on grey paving: the grey bins weigh little, the red ones fully, and
+    the empty paving, which shares the head's grey, is further from the figure once weighted."""
+    paving = np.full((80, 80, 3), 128, np.uint8)
+    paving[::7, ::5] = (120, 128, 136)  # a few pixels of a second grey: the paving is not uniform
+    figure = paving.copy()
+    cv2.rectangle(figure, (30, 20), (49, 59), (30, 30, 220), -1)
+    figure[20:30, 30:50] = 128
+    bins = colour_bins(figure, 10)
+    box = np.array([30.0, 20.0, 20.0, 40.0])
+    weights = background_weights(bins, box, bin_count(10), ring_scale=3**0.5)
+    assert weights[bins[40, 40]] == 1.0 and weights[bins[1, 1]] < 0.1
+    target, empty = (patch_histograms(b, box, bin_count(10), 20) for b in (bins, colour_bins(paving, 10)))
+    unweighted = bhattacharyya_distance(target, empty)
+    weighted = bhattacharyya_distance(weigh_histograms(target, weights), weigh_histograms(empty, weights))
+    assert weighted > unweighted + 0.1

@@ -8,7 +8,14 @@ import pytest
 
 from ptztrack.builders.follow import particle_filter_parameters
 from ptztrack.config import scenario_from_dict
-from ptztrack.track.particle_filter import carry_states, start_filter, step_filter, systematic_resample
+from ptztrack.track.particle_filter import (
+    MAX_HEIGHT_Z,
+    carry_states,
+    height_log_prior,
+    start_filter,
+    step_filter,
+    systematic_resample,
+)
 
 PARAMETERS = particle_filter_parameters(scenario_from_dict({"frame_rate_hz": 10.0}))
 RANDOM_WALK = replace(PARAMETERS, velocity_gain=0.0)  # the paper's prediction
@@ -138,3 +145,14 @@ def test_the_velocity_carries_the_filter_past_a_twin_that_the_random_walk_follow
     random_walk = [_cross_a_twin(RANDOM_WALK, seed) for seed in range(8)]
     assert all(error_px < 8.0 and not lost for error_px, lost in with_velocity)
     assert sum(error_px > 50.0 or lost for error_px, lost in random_walk) >= 2
+
+
+def test_the_height_prior_is_log_normal_about_the_standing_height():
+    """A view where anyone standing with feet on row v is v / 4 px tall, the sky above row 100."""
+
+    def standing(feet_px):
+        return np.where(feet_px[:, 1] > 100, feet_px[:, 1] / 4, np.nan)
+
+    # Feet at row 400 (centre 350 + h/2): standing height 100 px.
+    states = np.array([[320.0, 350.0, 100.0], [320.0, 400.0 - 50 * np.e**0.1, 100 * np.e**0.1], [320.0, 0.0, 50.0]])
+    np.testing.assert_allclose(height_log_prior(states, standing, 0.1), [0.0, -0.5, -0.5 * MAX_HEIGHT_Z**2])

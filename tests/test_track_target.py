@@ -31,14 +31,16 @@ class ScriptedSource:
 
     boxes: list
     homographies: list = field(default_factory=list)
+    standing_heights: list = field(default_factory=list)
     started_on: np.ndarray | None = None
 
     def start(self, image_bgr, box_px):
         self.started_on = np.asarray(box_px)
         return TargetEstimate(self.started_on, False, np.eye(2))
 
-    def step(self, image_bgr, homography):
+    def step(self, image_bgr, homography, standing_height_px):
         self.homographies.append(homography)
+        self.standing_heights.append(standing_height_px)
         box = self.boxes.pop(0)
         lost = box is None
         return TargetEstimate(self.started_on if lost else box, lost, np.eye(2))
@@ -74,6 +76,10 @@ def test_the_initial_box_is_carried_into_the_first_view_and_the_camera_motion_ha
     np.testing.assert_allclose(source.started_on, expected)
     follower.update(None, second, lambda: IMAGE)
     np.testing.assert_allclose(source.homographies[0], rotation_homography(CAMERA, first, second))
+    # The calibration handed over is the new view's: the projected person standing at (0, 15) m.
+    feet, head = (projection_matrix(CAMERA, second) @ [0.0, 15.0, z, 1.0] for z in (0.0, PERSON_HEIGHT_M))
+    feet_px, head_px = feet[:2] / feet[2], head[:2] / head[2]
+    np.testing.assert_allclose(source.standing_heights[0](feet_px[None]), [np.hypot(*(head_px - feet_px))])
 
 
 def test_the_output_filter_learns_a_walkers_velocity_and_the_prediction_leads_by_it():

@@ -14,7 +14,7 @@ import numpy as np
 
 from ptztrack import registry
 from ptztrack.builders.budget import refuse_if_too_large
-from ptztrack.builders.episode import episode_world, run_episode
+from ptztrack.builders.episode import episode_world, make_policy, run_episode
 from ptztrack.builders.experiments import (
     POSE_SOURCES,
     STRATEGIES,
@@ -67,7 +67,7 @@ from ptztrack.config import (
     write_camera_calibration,
 )
 from ptztrack.control.msg_scheduler import SCHEDULERS
-from ptztrack.evaluate.executors import EXECUTORS, print_progress, run_cells
+from ptztrack.evaluate.executors import EXECUTORS, Progress, run_cells
 from ptztrack.evaluate.follow import (
     FOLLOW_FIGURES,
     OTB_FIGURES,
@@ -91,9 +91,13 @@ from ptztrack.evaluate.registration import summarise_registration
 from ptztrack.evaluate.report import RUN_FILES, write_figure, write_outputs
 from ptztrack.evaluate.tables import format_table, paired_difference, summarise
 from ptztrack.evaluate.video import view_renderer
+from ptztrack.evaluate.view_state import VIEW_STATES_FILE, StepView, ViewState, read_view_states
+from ptztrack.evaluate.web_view import ViewHub, ViewServer, replay
 from ptztrack.files import InputError, check_output_file, check_output_folder, read_text, run_folder, write_json
+from ptztrack.loop import StepObserver
 from ptztrack.scene.roads import walk_roads
 
+RUN_FOLDER_FILES = (*RUN_FILES, VIEW_STATES_FILE)  # what run, follow and live write into --out
 RUN_FIGURES = ("mota", "motp_m", "idf1", "height_px", "detections", "zoom", "switches")
 
 
@@ -144,7 +148,10 @@ def run_command(args: argparse.Namespace) -> int:
     )
     refuse_if_too_large(scenario, (args.policy,))
     world = episode_world(scenario, args.seed)
-    episode = run_episode(scenario, args.policy, args.seed, world)
+    policy = make_policy(args.policy, scenario, world)
+    watch = Watch(args.view, args.out is not None, partial(_run_view, label=args.policy), Progress("step", args.quiet))
+    with watch:
+        episode = run_episode(scenario, policy, args.seed, world, observer=watch.observe(world, policy))
     metrics = episode_metrics(episode)
     print(
         f"scenario {args.scenario}, policy {args.policy}, detector {scenario.detector.kind}, "
@@ -155,7 +162,76 @@ def run_command(args: argparse.Namespace) -> int:
         title = f"{args.policy}, {scenario.detector.kind} detector, seed {args.seed}: MOTA {metrics['mota']:.1%}"
         with run_folder(args.out, args.overwrite) as folder:
             write_outputs(folder, episode, metrics, title, view_renderer(world))
-        print(f"wrote {', '.join(RUN_FILES)} into {args.out}")
+            watch.write(folder)
+        print(f"wrote {', '.join(RUN_FOLDER_FILES)} into {args.out}")
+    return 0
+
+
+def _run_view(world, policy, label: str) -> ViewState:
+    """The view of a run in ``world``: the backend's images (the synthetic scene's drawn), its grid."""
+    return ViewState(world, policy, world.truth.positions_m.shape[0], label, view_renderer(world))
+
+
+class Watch:
+    """What watches a run of ``run``, ``follow`` or ``live``: the web view on 127.0.0.1:``port`` (None:
+    none; a context manager: the server runs inside the block), where ``keep``, every step's view
+    state, for the run folder's view_states.jsonl (what ``ptztrack view`` replays), and a progress bar
+    of the steps (``progress``; None: none).
+
+    view : ``view(world, policy)`` gives the run's :class:`ViewState`.
+    """
+
+    def __init__(self, port: int | None, keep: bool, view, progress: Progress | None = None):
+        self.view, self.port, self.keep, self.progress = view, port, keep, progress
+        self.views: list[StepView] = []
+        self.view_state: ViewState | None = None
+        # A run started with a view waits after its first step for a page to open it.
+        self.hub = None if port is None else ViewHub(paused=True, resume_on_connect=True)
+        self._server: ViewServer | None = None
+
+    def __enter__(self) -> "Watch":
+        if self.hub is not None and self.port is not None:
+            self._server = ViewServer(self.hub, self.port).__enter__()
+            print(f"view at {self._server.address} (the run starts when a page opens it)", flush=True)
+        return self
+
+    def __exit__(self, *failure) -> None:
+        if self.progress is not None:
+            self.progress.close()
+        if self._server is not None:
+            self._server.__exit__(*failure)
+
+    def observe(self, world, policy) -> StepObserver | None:
+        """The run's step observer (None when nothing watches)."""
+        view_state = self.view_state = self.view(world, policy)
+        watching = None
+        if self.hub is not None or self.keep:
+            watching = view_state.observer(
+                None if self.hub is None else self.hub.after_step, self.views if self.keep else None
+            )
+        progress = self.progress
+        if progress is None:
+            return watching
+
+        def observe(step: int, context, record: dict) -> None:
+            if watching is not None:
+                watching(step, context, record)
+            progress(step + 1, view_state.steps)
+
+        return observe
+
+    def write(self, folder: Path) -> None:
+        """view_states.jsonl into the run's folder."""
+        assert self.view_state is not None, "observe() gives the run its observer first"
+        self.view_state.write(folder / VIEW_STATES_FILE, self.views)
+
+
+def view_command(args: argparse.Namespace) -> int:
+    lines = read_view_states(args.folder)
+    hub = ViewHub(paused=True, resume_on_connect=True)
+    with ViewServer(hub, args.port) as server:
+        print(f"view at {server.address} (the replay of {len(lines)} steps starts when a page opens it)", flush=True)
+        replay(hub, lines, args.steps_per_s)
     return 0
 
 
@@ -175,9 +251,12 @@ def live_command(args: argparse.Namespace) -> int:
     address = camera_address(args.camera, _credentials(args))
     steps = args.steps or scenario.frames
     print(f"live: {args.policy} on {address}, up to {steps} steps at {scenario.frame_rate_hz * args.time_scale:g} Hz")
-    world, live = run_live_episode(
-        scenario, calibration, address, args.policy, steps, args.time_scale, args.seed, args.timeout_s
-    )
+    label = f"live {args.policy}"
+    with Watch(args.view, args.out is not None, lambda w, p: ViewState(w, p, steps, label, truth=False)) as watch:
+        world, live = run_live_episode(
+            scenario, calibration, address, args.policy, steps, args.time_scale, args.seed, args.timeout_s,
+            watch.observe,
+        )  # fmt: skip
     truth_log = None if args.truth is None else read_truth_log(args.truth)
     episode = live_as_episode(world, live, truth_log)
     captured = np.isfinite(live.capture_time_s)
@@ -194,7 +273,8 @@ def live_command(args: argparse.Namespace) -> int:
         title = f"live {args.policy}, {scenario.detector.kind} detector: {len(live.commanded)} steps"
         with run_folder(args.out, args.overwrite) as folder:
             write_outputs(folder, episode, metrics, title, None)
-        print(f"wrote {', '.join(RUN_FILES)} into {args.out}")
+            watch.write(folder)
+        print(f"wrote {', '.join(RUN_FOLDER_FILES)} into {args.out}")
     return 0
 
 
@@ -271,10 +351,16 @@ def serve_camera_command(args: argparse.Namespace) -> int:
     return 0
 
 
+def _run_cells(args: argparse.Namespace, cells: list, run, noun: str = "episode") -> list:
+    """An experiment's cells on ``--executor``, with a progress bar (none with ``--quiet`` or off a terminal)."""
+    with Progress(noun, args.quiet) as progress:
+        return run_cells(cells, run, args.executor, args.workers, progress)
+
+
 def msg_experiment_command(args: argparse.Namespace) -> int:
     cells = msg_cells(args.runs)
     print(f"{len(cells)} simulations x {len(SCHEDULERS)} schedulers, {args.executor} executor", file=sys.stderr)
-    rows = [row for rows in run_cells(cells, run_msg_cell, args.executor, args.workers, print_progress) for row in rows]
+    rows = [row for rows in _run_cells(args, cells, run_msg_cell, "simulation") for row in rows]
     print("Face capture on the MSG: M by N_j/s bin, mean +- standard deviation (runs)")
     print(format_ambiguity_table(summarise_by_ambiguity(rows)))
     print(format_paired_differences(rows))
@@ -319,12 +405,13 @@ def registration_experiment_command(args: argparse.Namespace) -> int:
         print(f"{'building' if built else 'reading'} the reference index {index_path}", file=sys.stderr)
         index = reference_index(scenario)
         print(f"{len(index.poses)} reference views; registering {args.views} live views", file=sys.stderr)
-        views = registration_views(scenario, index, args.views, args.seed, partial(print_progress, noun="views"))
+        with Progress("view", args.quiet) as progress:
+            views = registration_views(scenario, index, args.views, args.seed, progress)
         summary = summarise_registration(views)
         pose_error = PoseError(pan_tilt_sigma_deg=args.pose_noise_deg, zoom_sigma=args.zoom_noise)
         cells = closed_loop_cells(scenario, pose_error, args.policy, args.pose_sources)
         print(f"{len(cells)} closed-loop runs, {args.executor} executor", file=sys.stderr)
-        closed_loop = run_cells(cells, run_closed_loop_cell, args.executor, args.workers, print_progress)
+        closed_loop = _run_cells(args, cells, run_closed_loop_cell)
     size = scenario.pose_feedback.image_size_px
     print(
         f"Registration of {summary['views']} live views at random reachable poses, {size[0]} x {size[1]} px, "
@@ -422,7 +509,7 @@ def _run_table(
     print(f"{len(cells)} episodes, {args.executor} executor", file=sys.stderr)
     runs_at_once = 1 if args.executor == "serial" else min(len(cells), args.workers or os.cpu_count() or 1)
     refuse_if_too_large(cells[0].scenario, tuple(args.strategies), runs_at_once)
-    summary = summarise(run_cells(cells, run_cell, args.executor, args.workers, print_progress))
+    summary = summarise(_run_cells(args, cells, run_cell))
     summary = [{**row, **(extra or {})} for row in summary]
     print(format_table(summary, title, spread))
     labels = {row["label"] for row in summary}
@@ -456,7 +543,15 @@ def follow_command(args: argparse.Namespace) -> int:
     scenario = _follow_scenario(args, args.tracker)
     if args.frames is not None:
         scenario = scenario.model_copy(update={"frames": args.frames})
-    narrowed, world, episode = follow_run(FollowCell(scenario, args.tracker, args.target, args.seed))
+    label = f"follow person {args.target}, {args.tracker}"
+
+    def view(world, policy) -> ViewState:
+        target_point_px = policy.parameters.target_point_px
+        steps = world.truth.positions_m.shape[0]
+        return ViewState(world, policy, steps, label, view_renderer(world), grid=False, target_point_px=target_point_px)
+
+    with Watch(args.view, True, view, Progress("step", args.quiet)) as watch:
+        narrowed, world, episode = follow_run(FollowCell(scenario, args.tracker, args.target, args.seed), watch.observe)
     row = follow_row(narrowed, world, episode)
     frame_range = narrowed.required_recording("the follow camera").frame_range
     first_frame = frame_range[0] if frame_range is not None else 0
@@ -465,7 +560,8 @@ def follow_command(args: argparse.Namespace) -> int:
     title = f"person {args.target}, {args.tracker}: in view {row['in_view_fraction']:.0%}"
     with run_folder(out, args.overwrite) as folder:
         write_outputs(folder, episode, row, title, view_renderer(world))
-    print(f"wrote {', '.join(RUN_FILES)} into {out}")
+        watch.write(folder)
+    print(f"wrote {', '.join(RUN_FOLDER_FILES)} into {out}")
     return 0
 
 
@@ -473,10 +569,10 @@ def follow_experiment_command(args: argparse.Namespace) -> int:
     scenario = _follow_scenario(args)
     cells = follow_cells(scenario, args.trackers, args.targets, args.seed)
     print(f"{len(cells)} closed-loop runs, {args.executor} executor", file=sys.stderr)
-    people = run_cells(cells, run_follow_cell, args.executor, args.workers, print_progress)
+    people = _run_cells(args, cells, run_follow_cell)
     otb_runs = otb_cells(scenario, args.trackers, args.otb_tracks, args.seed)
     print(f"{len(otb_runs)} one-pass runs on the still recording", file=sys.stderr)
-    otb_people = run_cells(otb_runs, run_otb_cell, args.executor, args.workers, partial(print_progress, noun="runs"))
+    otb_people = _run_cells(args, otb_runs, run_otb_cell, "run")
     closed_loop, otb = summarise_follow(people, FOLLOW_FIGURES), summarise_follow(otb_people, OTB_FIGURES)
     print(
         f"Follow camera, {scenario.camera.image_size_px[0]} x {scenario.camera.image_size_px[1]} view, "
@@ -508,12 +604,12 @@ OCCUPANCY_COLUMNS = (
 
 
 def occupancy_experiment_command(args: argparse.Namespace) -> int:
-    progress = partial(print_progress, noun="frames")
-    if args.dataset == "synthetic-room":
-        runs = room_runs(args.frames or ROOM_FRAMES, args.seed, progress)
-    else:
-        dataset = pets_dataset() if args.dataset == "pets" else load_dataset(args.dataset)
-        runs = dataset_runs(dataset, args.frames, progress)
+    with Progress("frame", args.quiet) as progress:
+        if args.dataset == "synthetic-room":
+            runs = room_runs(args.frames or ROOM_FRAMES, args.seed, progress)
+        else:
+            dataset = pets_dataset() if args.dataset == "pets" else load_dataset(args.dataset)
+            runs = dataset_runs(dataset, args.frames, progress)
     rows = [row for run in runs for row in run.rows]
     columns = [(key, form) for key, form in OCCUPANCY_COLUMNS if any(key in row for row in rows)]
     print(f"Occupancy-map detection on {args.dataset}: MODA, MODP, precision, recall within 0.5 m; tracker fed by LPOM")
@@ -557,10 +653,20 @@ def parser() -> argparse.ArgumentParser:
     run.add_argument("--seed", type=_non_negative_int, default=0)
     run.add_argument("--frames", type=_positive_int, help="overrides the scenario's number of frames")
     _add_tracker_arguments(run)
-    run.add_argument("--out", type=Path, help=f"directory for {', '.join(RUN_FILES)}; written whole or not at all")
+    run.add_argument(
+        "--out", type=Path, help=f"directory for {', '.join(RUN_FOLDER_FILES)}; written whole or not at all"
+    )
     run.add_argument("--overwrite", action="store_true", help="replace a non-empty --out folder")
+    _add_view_argument(run)
+    _add_quiet_argument(run)
     _add_recording_arguments(run)
     run.set_defaults(handler=run_command)
+
+    view = commands.add_parser("view", help="replay a finished run's --out folder in the web view")
+    view.add_argument("folder", type=Path, help="a folder written by ptztrack run, follow or live with --out")
+    view.add_argument("--port", type=_port, default=0, help="serve on http://127.0.0.1:PORT/ (default: any free one)")
+    view.add_argument("--steps-per-s", type=_positive_float, default=10.0, help="the replay's pace")
+    view.set_defaults(handler=view_command)
 
     experiment = commands.add_parser("experiment", help="run one of the papers' experiments and print its table")
     experiments = experiment.add_subparsers(
@@ -668,8 +774,11 @@ def _add_camera_commands(commands, policies: list[str]) -> None:
         "--truth", type=Path, help="score against a virtual camera's truth log (serve-camera --truth-log)"
     )
     live.add_argument("--seed", type=_non_negative_int, default=0)
-    live.add_argument("--out", type=Path, help=f"directory for {', '.join(RUN_FILES)}; written whole, Ctrl-C too")
+    live.add_argument(
+        "--out", type=Path, help=f"directory for {', '.join(RUN_FOLDER_FILES)}; written whole, Ctrl-C too"
+    )
     live.add_argument("--overwrite", action="store_true", help="replace a non-empty --out folder")
+    _add_view_argument(live)
     live.set_defaults(handler=live_command)
 
     camera = commands.add_parser("camera", help="tools for a real camera").add_subparsers(dest="tool", required=True)
@@ -709,9 +818,11 @@ def _add_follow_commands(commands, experiments) -> None:
     follow.add_argument(
         "--out",
         type=Path,
-        help=f"directory for {', '.join(RUN_FILES)} (default follow-TARGET); written whole or not at all",
+        help=f"directory for {', '.join(RUN_FOLDER_FILES)} (default follow-TARGET); written whole or not at all",
     )
     follow.add_argument("--overwrite", action="store_true", help="replace a non-empty --out folder")
+    _add_view_argument(follow)
+    _add_quiet_argument(follow)
     _add_follow_scenario_arguments(follow)
     follow.set_defaults(handler=follow_command)
 
@@ -758,6 +869,7 @@ def _add_occupancy_parser(experiments) -> None:
     occupancy.add_argument("--overwrite", action="store_true", help="replace a non-empty --out folder")
     occupancy.add_argument("--images-every", type=_positive_int, default=10, help="a map picture every N frames")
     occupancy.add_argument("--json", type=Path, help="write one row per method (and people count) here")
+    _add_quiet_argument(occupancy)
     occupancy.set_defaults(handler=occupancy_experiment_command)
 
 
@@ -770,6 +882,24 @@ def _add_executor_arguments(command: argparse.ArgumentParser, rows: str) -> None
     command.add_argument("--executor", choices=EXECUTORS, default="local")
     command.add_argument("--workers", type=_positive_int, help="processes of the local executor (default: all cores)")
     command.add_argument("--json", type=Path, help=f"write {rows} here")
+    _add_quiet_argument(command)
+
+
+def _add_quiet_argument(command: argparse.ArgumentParser) -> None:
+    command.add_argument(
+        "--quiet", action="store_true", help="no progress bar (there is none either where stderr is not a terminal)"
+    )
+
+
+def _add_view_argument(command: argparse.ArgumentParser) -> None:
+    command.add_argument(
+        "--view",
+        type=_port,
+        nargs="?",
+        const=0,
+        metavar="PORT",
+        help="serve a live view of the run on http://127.0.0.1:PORT/ (no PORT or 0: any free one)",
+    )
 
 
 def _add_tracker_arguments(command: argparse.ArgumentParser) -> None:

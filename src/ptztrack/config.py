@@ -400,6 +400,9 @@ class Follow(_Strict):
     histogram_bins : N of the N x N hue-saturation histograms; samples_per_patch : grid points per axis.
     achromatic_bins : N more bins by value for pixels too grey or dark to have a hue (Perez et al.);
     false: the paper's hue-saturation histograms alone.
+    background_area_ratio : weigh the histograms' bins down by how common they are in the ring around
+    the first box, out to a box of this many times its area (Comaniciu et al.'s background-weighted
+    histogram, their 3); null: the paper's unweighted histograms.
     lambda_colour, lambda_motion : equations 3 and 4.
     lambda_loss : the colour likelihood's lambda in the loss test, exp(-sum_p B_p^2 / lambda_loss): the
     weights stay sharp (``lambda_colour``) while the loss test tolerates the appearance changes of a
@@ -433,6 +436,8 @@ class Follow(_Strict):
     )
     histogram_bins: int = Field(10, ge=1, le=64)
     achromatic_bins: bool = False
+    background_area_ratio: Annotated[float, Field(gt=1), at_most(10_000, "box areas")] | None = 3.0
+    height_log_sigma: PositiveFloat | None = 0.1
     samples_per_patch: Annotated[int, Field(ge=1), at_most(1000, _PARTICLE_TIME)] = 20
     lambda_colour: Annotated[PositiveFloat, at_most(1e6, "a likelihood scale")] = 0.15
     lambda_loss: Annotated[PositiveFloat, at_most(1e6, "a likelihood scale")] = 1.0

@@ -20,7 +20,7 @@ from typing import Protocol
 import numpy as np
 
 from ptztrack.camera.live_camera import Capture
-from ptztrack.loop import World, command, episode_seeds
+from ptztrack.loop import StepObserver, World, command, episode_seeds
 from ptztrack.roles import Policy, Tracker
 from ptztrack.types import DecisionContext, Detections, PeopleInView, Tracks
 
@@ -87,8 +87,14 @@ def run_live(
     seed: int,
     clock=time.monotonic,
     sleep=time.sleep,
+    observer: StepObserver | None = None,
 ) -> LiveEpisode:
-    """At most ``steps`` steps, ``period_s`` apart; Ctrl-C ends the run early with what was recorded."""
+    """At most ``steps`` steps, ``period_s`` apart; Ctrl-C ends the run early with what was recorded.
+
+    observer : called after every step as :func:`ptztrack.loop.run_loop` calls it, with the step's
+    LiveEpisode fields, its ``actions`` (flat index, -1 off the grid) and the captured ``image``
+    (None where nothing was captured).
+    """
     _, detector_seed, policy_seed, _, _ = episode_seeds(seed)
     frame_seeds = detector_seed.spawn(steps)
     policy_rng = np.random.default_rng(policy_seed)
@@ -118,17 +124,25 @@ def run_live(
                 detections, pose = world.detector.detect(view, step, capture.pose, rng), capture.pose
                 update = tracker.update(detections, capture.pose, partial(view.image, step, capture.pose))
                 measured = update.measurements if update.measurements is not None else detections
-            for name, value in (
-                ("commanded", commanded),
-                ("sent", sent),
-                ("poses", pose),
-                ("capture_time_s", np.nan if capture is None else capture.time_s),
-                ("step_time_s", step_time_s),
-                ("decision_s", decision_s),
-                ("tracks", tracker.reported()),
-                ("detections", Detections.empty() if measured is None else measured),
-            ):
+            step_record = {
+                "commanded": commanded,
+                "sent": sent,
+                "poses": pose,
+                "capture_time_s": np.nan if capture is None else capture.time_s,
+                "step_time_s": step_time_s,
+                "decision_s": decision_s,
+                "tracks": tracker.reported(),
+                "detections": Detections.empty() if measured is None else measured,
+            }
+            for name, value in step_record.items():
                 record[name].append(value)
+            if observer is not None:
+                image = None if capture is None else capture.image
+                observed_s = clock()
+                observer(step, context, {**step_record, "actions": action, "image": image})
+                waited_s = clock() - observed_s
+                if waited_s > period_s:  # a paused view: the steps after it keep their pace, not catch up
+                    started += waited_s
     except KeyboardInterrupt:
         pass  # the steps recorded whole so far are the run
     done = min(len(values) for values in record.values())

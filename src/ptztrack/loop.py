@@ -12,6 +12,7 @@ comparison far less noisy.
 """
 
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from functools import partial
 
@@ -84,6 +85,11 @@ class Episode:
 PER_STEP = ("actions", "commanded", "poses", "tracker_poses", "pose_known", "decision_s", "tracks", "detections")
 
 
+StepObserver = Callable[[int, DecisionContext, dict], None]
+"""``observer(step, context, record)``, called after each step with the decision's context and the
+step's record (the PER_STEP names); a live view draws from it, and may block to pause the run."""
+
+
 def command(grid: ActionGrid, choice: int | np.ndarray) -> tuple[int, np.ndarray]:
     """A policy's choice as (flat action index, or -1 for a pose off the grid; the (3,) commanded pose)."""
     if np.ndim(choice) == 0:
@@ -104,8 +110,14 @@ def episode_seeds(seed: int) -> list[np.random.SeedSequence]:
     return np.random.SeedSequence(seed).spawn(5)
 
 
-def run_loop(world: World, policy: Policy, tracker: Tracker, seed: int) -> Episode:
-    """Run the closed loop for every frame of ``world.truth``, with the streams of ``seed``."""
+def run_loop(
+    world: World, policy: Policy, tracker: Tracker, seed: int, observer: StepObserver | None = None
+) -> Episode:
+    """Run the closed loop for every frame of ``world.truth``, with the streams of ``seed``.
+
+    observer : called after every step (:data:`StepObserver`); it draws no random numbers, so the
+    episode is the same with or without it.
+    """
     _, detector_seed, policy_seed, landing_seed, _ = episode_seeds(seed)
     steps = world.truth.positions_m.shape[0]
     frame_seeds = detector_seed.spawn(steps)
@@ -144,6 +156,8 @@ def run_loop(world: World, policy: Policy, tracker: Tracker, seed: int) -> Episo
         }
         for name, value in record.items():
             per_step[name].append(value)
+        if observer is not None:
+            observer(step, context, record)
     arrays = {name: np.asarray(per_step[name]) for name in PER_STEP if name not in ("tracks", "detections")}
     return Episode(
         world.truth,

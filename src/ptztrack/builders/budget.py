@@ -4,11 +4,12 @@ the machine does not have it.
 The terms are the arrays that grow with the scenario's sizes, with coefficients measured on this
 code (peak resident memory of ``run_episode`` at growing sizes, 2 steps unless said):
 
-* the interpreter and libraries: 280 MB (a 2-step synthetic run of ``fix``);
+* the interpreter and libraries: 320 MB (a 2-step synthetic run of ``fix``: 317 MB);
 * the history of a run: 105 kB a step (2000 steps of ``fix``: 490 MB);
-* the simulated detector's occlusion, each person measured in the view centred on them: 4 N^5
-  bytes for N people (30 people: +85 MB, 45: +720 MB);
-* ``smpl``'s occlusion, once per sample: 4 M N^4 bytes for M samples;
+* the simulated detector's occlusion, each person measured in the view centred on them: 160 N^2
+  bytes for N people (1000 people: +159 MB);
+* ``smpl``'s joint draws and their boxes: 230 bytes per sample and track (4000 samples of 400
+  tracks: +362 MB, from the rewards of one decision);
 * the exploration map (``control.beta`` > 0): 160 bytes per action and cell (a 300 m square at
   1 m cells and 280 actions: 4.1 GB; 600 m: 15.7 GB);
 * a view and its upsampled copy for HOG: 12 bytes per pixel, times the upsampling squared.
@@ -20,8 +21,10 @@ import psutil
 
 from ptztrack.config import Scenario, ScenarioError
 
-INTERPRETER_BYTES = 280e6
+INTERPRETER_BYTES = 320e6
 HISTORY_BYTES_PER_STEP = 105e3
+DETECTOR_OCCLUSION_BYTES_PER_PERSON_PAIR = 160.0
+SMPL_BYTES_PER_SAMPLE_TRACK = 230.0
 EXPLORATION_BYTES_PER_ACTION_CELL = 160.0
 IMAGE_BYTES_PER_PIXEL = 12.0
 # The ground of a recording is known only once its calibration is read: a 100 m square bounds
@@ -40,10 +43,12 @@ def estimated_memory_bytes(scenario: Scenario, policies: tuple[str, ...]) -> dic
     terms = {
         "interpreter": INTERPRETER_BYTES,
         "history": HISTORY_BYTES_PER_STEP * scenario.frames,
-        "detector occlusion": 4.0 * people**5 if scenario.recording is None else 0.0,
+        "detector occlusion": DETECTOR_OCCLUSION_BYTES_PER_PERSON_PAIR * people**2
+        if scenario.recording is None
+        else 0.0,
     }
     if "smpl" in policies:
-        terms["smpl occlusion"] = 4.0 * scenario.control.samples * people**4
+        terms["smpl samples"] = SMPL_BYTES_PER_SAMPLE_TRACK * scenario.control.samples * people
     if scenario.control.beta > 0 and set(policies) & set(INFORMATION_POLICIES):
         area_m2 = scenario.area_m[0] * scenario.area_m[1] if scenario.recording is None else RECORDING_AREA_M2
         cells = math.ceil(area_m2 / scenario.control.exploration_cell_m**2)

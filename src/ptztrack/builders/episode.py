@@ -6,7 +6,7 @@ import numpy as np
 
 from ptztrack.builders.world import CameraSpec, DetectorSpec, build_world, resolve
 from ptztrack.config import Scenario
-from ptztrack.loop import Episode, World, episode_seeds, run_loop
+from ptztrack.loop import Episode, StepObserver, World, episode_seeds, run_loop
 from ptztrack.roles import Policy, Tracker
 
 PolicySpec = str | Policy | Callable[[Scenario, World], Policy]
@@ -42,6 +42,7 @@ def run_episode(
     camera: CameraSpec | None = None,
     detector: DetectorSpec | None = None,
     tracker: TrackerSpec | None = None,
+    observer: StepObserver | None = None,
 ) -> Episode:
     """Run one closed-loop episode of the scenario: at most ``scenario.frames`` steps.
 
@@ -51,6 +52,7 @@ def run_episode(
     otherwise, with ``camera`` and ``detector`` in place of the scenario's when given); a caller
     that also draws the episode's views needs it, and building it may mean building a reference index.
     tracker : in place of the scenario's ``tracker.kind``.
+    observer : called after every step (a live view, say): ``ptztrack.loop.StepObserver``.
     """
     world = world or episode_world(scenario, seed, camera, detector)
-    return run_loop(world, make_policy(policy, scenario, world), make_tracker(tracker, scenario, world), seed)
+    return run_loop(world, make_policy(policy, scenario, world), make_tracker(tracker, scenario, world), seed, observer)

@@ -8,16 +8,20 @@ tracker gives other boxes on the same frames from run to run (also with
 """
 
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
+from functools import partial
 
 import numpy as np
 
-from ptztrack.builders.episode import episode_world, run_episode
+from ptztrack.builders.episode import episode_world, make_policy, run_episode
 from ptztrack.builders.follow import follow_parameters, target_scenario, target_source
 from ptztrack.camera.recorded import RecordedPTZ
 from ptztrack.config import Scenario
 from ptztrack.evaluate.follow import follow_metrics, one_pass_scores, target_in_views
-from ptztrack.loop import Episode, World, episode_seeds
+from ptztrack.geometry.calibration import load_calibration, standing_height_px
+from ptztrack.loop import Episode, StepObserver, World, episode_seeds
+from ptztrack.roles import Policy
 from ptztrack.scene.pets import Annotations, RecordedVideo, load_mot_ground_truth
 
 OTB_TRACKS = 5
@@ -47,11 +51,18 @@ def follow_cells(scenario: Scenario, trackers, targets=None, seed: int = 0) -> l
     return [FollowCell(scenario, tracker, int(person), seed) for tracker in trackers for person in people]
 
 
-def follow_run(cell: FollowCell) -> tuple[Scenario, World, Episode]:
-    """The cell's scenario narrowed to its person, its world and its episode."""
+def follow_run(
+    cell: FollowCell, observe: Callable[[World, Policy], StepObserver | None] | None = None
+) -> tuple[Scenario, World, Episode]:
+    """The cell's scenario narrowed to its person, its world and its episode.
+
+    observe : ``observe(world, policy)`` gives the run's step observer (a live view, say).
+    """
     scenario = target_scenario(cell.scenario.model_copy(update={"tracker": _tracker(cell)}), cell.target_id)
     world = episode_world(scenario, cell.seed)
-    return scenario, world, run_episode(scenario, "follow", cell.seed, world)
+    policy = make_policy("follow", scenario, world)
+    observer = None if observe is None else observe(world, policy)
+    return scenario, world, run_episode(scenario, policy, cell.seed, world, observer=observer)
 
 
 def _tracker(cell: FollowCell):
@@ -143,12 +154,14 @@ def run_otb_cell(cell: OnePassCell) -> dict:
     rng = np.random.default_rng(episode_seeds(cell.seed)[4])
     source = target_source(cell.scenario, cell.tracker, rng)
     still = np.eye(3)
+    calibration = load_calibration(recording.calibration, recording.view)
+    standing = partial(standing_height_px, calibration, height_m=cell.scenario.control.person_height_m)
     tracked = np.zeros((len(frames), 4))
     elapsed_s = 0.0
     for index, frame in enumerate(frames):
         image = video.frame(int(frame))
         started = time.perf_counter()
-        estimate = source.start(image, boxes[0]) if index == 0 else source.step(image, still)
+        estimate = source.start(image, boxes[0]) if index == 0 else source.step(image, still, standing)
         elapsed_s += time.perf_counter() - started
         tracked[index] = estimate.box_px
     annotated = np.all(np.isfinite(boxes), axis=1)

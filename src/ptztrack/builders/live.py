@@ -11,6 +11,7 @@ each step taking the truth of the step its image showed.
 
 import threading
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING
 
@@ -23,7 +24,8 @@ from ptztrack.camera.onvif_spaces import AxisSpeeds, CameraSpaces
 from ptztrack.camera.recorded import RecordedPTZ
 from ptztrack.config import VIRTUAL_CAMERA_CALIBRATION, CameraCalibrationFile, Scenario
 from ptztrack.live import LiveEpisode, run_live
-from ptztrack.loop import Episode, World
+from ptztrack.loop import Episode, StepObserver, World
+from ptztrack.roles import Policy
 from ptztrack.types import GroundTruth
 
 if TYPE_CHECKING:
@@ -175,10 +177,15 @@ def run_live_episode(
     time_scale: float,
     seed: int,
     timeout_s: float = 5.0,
+    observe: Callable[[World, Policy], StepObserver | None] | None = None,
 ) -> tuple[World, LiveEpisode]:
     """Connect to the camera at ``address`` and run ``policy`` for ``steps`` steps at the scenario's rate
-    times ``time_scale``; the camera is released at the end (Ctrl-C included)."""
+    times ``time_scale``; the camera is released at the end (Ctrl-C included).
+
+    observe : ``observe(world, policy)`` gives the run's step observer (a live view, say).
+    """
     world = live_world(scenario, calibration, seed)
+    live_policy = make_policy(policy, scenario, world)
 
     def connect() -> ONVIFClient:
         client = ONVIFClient(address, timeout_s)
@@ -193,12 +200,13 @@ def run_live_episode(
     try:
         live = run_live(
             world,
-            make_policy(policy, scenario, world),
+            live_policy,
             make_tracker(None, scenario, world),
             camera,
             steps,
             1.0 / (scenario.frame_rate_hz * time_scale),
             seed,
+            observer=None if observe is None else observe(world, live_policy),
         )
     finally:
         camera.close()

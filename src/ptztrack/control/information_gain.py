@@ -15,7 +15,9 @@ x sample (M), in Numba kernels: each pair costs some sixty scalar operations,
 and as NumPy array operations their per-call overhead, not their arithmetic,
 kept decisions ten times slower than a PTZ head moves. The kernels share one
 camera model: they take the per-action homographies of
-:mod:`ptztrack.geometry.ptz`, computed once per grid.
+:mod:`ptztrack.geometry.ptz`, computed once per grid, and read them at the
+indices of the actions asked for. For 'intg', one pass gives both alpha and
+the information, from one prediction per (action, track).
 """
 
 import math
@@ -51,8 +53,11 @@ class ActionGeometry:
     head_to_image: np.ndarray
     head_from_feet: np.ndarray
 
-    def take(self, actions) -> "ActionGeometry":
-        return ActionGeometry(self.ground_to_image[actions], self.head_to_image[actions], self.head_from_feet[actions])
+    def indices(self, actions) -> np.ndarray:
+        """``actions`` as the flat int64 indices the kernels read the matrices at (None: all of them)."""
+        if actions is None:
+            return np.arange(len(self.ground_to_image))
+        return np.asarray(actions, dtype=np.int64)
 
 
 def action_geometry(camera: PTZCamera, poses, person_height_m: float) -> ActionGeometry:
@@ -64,20 +69,23 @@ def action_geometry(camera: PTZCamera, poses, person_height_m: float) -> ActionG
 
 
 @numba.njit
-def _predict(H, mean_m, cov_m2, V):
+def _predict(H, mean_m, cov_m2, track, V):
     """Equation 9 for one action and track: (u, v, var_u, cov_uv, var_v, w), w > 0 in front.
 
-    H : (3, 3) ground-to-image; mean_m : (2,); cov_m2 : (2, 2). ``C_x(a)`` is
-    the homography's Jacobian at the prediction (zero for the velocity).
+    H : (3, 3) ground-to-image; mean_m : (n, 2); cov_m2 : (n, 2, 2). ``C_x(a)`` is
+    the homography's Jacobian at the prediction (zero for the velocity). The
+    track comes as an index, not as views ``mean_m[track]``: a view per pair
+    cost Numba a reference count each, a third of the kernels' time.
     """
-    x_m, y_m = mean_m[0], mean_m[1]
-    var_x, cov_xy, var_y = cov_m2[0, 0], cov_m2[0, 1], cov_m2[1, 1]
+    x_m, y_m = mean_m[track, 0], mean_m[track, 1]
+    var_x, cov_xy, var_y = cov_m2[track, 0, 0], cov_m2[track, 0, 1], cov_m2[track, 1, 1]
     X = H[0, 0] * x_m + H[0, 1] * y_m + H[0, 2]
     Y = H[1, 0] * x_m + H[1, 1] * y_m + H[1, 2]
     w = H[2, 0] * x_m + H[2, 1] * y_m + H[2, 2]
-    u, v = X / w, Y / w
-    a, b = (H[0, 0] - u * H[2, 0]) / w, (H[0, 1] - u * H[2, 1]) / w
-    c, d = (H[1, 0] - v * H[2, 0]) / w, (H[1, 1] - v * H[2, 1]) / w
+    inverse_w = 1.0 / w
+    u, v = X * inverse_w, Y * inverse_w
+    a, b = (H[0, 0] - u * H[2, 0]) * inverse_w, (H[0, 1] - u * H[2, 1]) * inverse_w
+    c, d = (H[1, 0] - v * H[2, 0]) * inverse_w, (H[1, 1] - v * H[2, 1]) * inverse_w
     var_u = a * a * var_x + 2 * a * b * cov_xy + b * b * var_y + V[0, 0]
     cov_uv = a * c * var_x + (a * d + b * c) * cov_xy + b * d * var_y + V[0, 1]
     var_v = c * c * var_x + 2 * c * d * cov_xy + d * d * var_y + V[1, 1]
@@ -85,76 +93,129 @@ def _predict(H, mean_m, cov_m2, V):
 
 
 @numba.njit
-def _information_if_detected(ground_to_image, mean_m, position_cov_m2, V):
-    L, n = ground_to_image.shape[0], mean_m.shape[0]
-    log_det_V = math.log(V[0, 0] * V[1, 1] - V[0, 1] * V[1, 0])
+def _log_det(V):
+    return math.log(V[0, 0] * V[1, 1] - V[0, 1] * V[1, 0])
+
+
+@numba.njit
+def _information(var_u, cov_uv, var_v, log_det_V):
+    """``1/2 log(det Sigma_o / det V)`` (nats) of equation 7 for one action and track."""
+    return 0.5 * (math.log(var_u * var_v - cov_uv * cov_uv) - log_det_V)
+
+
+@numba.njit
+def _information_if_detected(ground_to_image, actions, mean_m, position_cov_m2, V):
+    L, n = actions.shape[0], mean_m.shape[0]
+    log_det_V = _log_det(V)
     gain = np.zeros((L, n))
-    for action in range(L):
+    for row in range(L):
+        H = ground_to_image[actions[row]]
         for track in range(n):
-            _, _, var_u, cov_uv, var_v, w = _predict(ground_to_image[action], mean_m[track], position_cov_m2[track], V)
+            _, _, var_u, cov_uv, var_v, w = _predict(H, mean_m, position_cov_m2, track, V)
             if w > 0:
-                gain[action, track] = 0.5 * (math.log(var_u * var_v - cov_uv * cov_uv) - log_det_V)
+                gain[row, track] = _information(var_u, cov_uv, var_v, log_det_V)
     return gain
 
 
-def information_if_detected_nats(geometry: ActionGeometry, mean_m, position_cov_m2, V) -> np.ndarray:
+def information_if_detected_nats(geometry: ActionGeometry, mean_m, position_cov_m2, V, actions=None) -> np.ndarray:
     """``H(P-) - H(P+(a)) = 1/2 log(det Sigma_o / det V)`` (nats) for every action and track; (L, n).
 
     0 for a track behind the camera. mean_m : (n, 2); position_cov_m2 : (n, 2, 2); V : (2, 2).
+    actions : the flat indices of the actions of ``geometry`` to evaluate (L of them; None: all).
     """
     return _information_if_detected(
-        geometry.ground_to_image, np.asarray(mean_m, float), np.asarray(position_cov_m2, float), np.asarray(V, float)
+        geometry.ground_to_image,
+        geometry.indices(actions),
+        np.asarray(mean_m, float),
+        np.asarray(position_cov_m2, float),
+        np.asarray(V, float),
     )
 
 
 @numba.njit
-def _detection_weight_integral(
-    ground_to_image, head_from_feet, mean_m, position_cov_m2, V, width_px, height_px, realistic, kd, r0_px
+def _alpha_closed_form(W, u, v, var_u, cov_uv, var_v, width_px, height_px, realistic, kd, r0_px):
+    """Equation 8 in closed form for one action and track (see :func:`detection_weight_integral`).
+
+    W : (3, 3) the action's head-from-feet homology; the rest is :func:`_predict`'s prediction.
+    """
+    head_w = W[2, 0] * u + W[2, 1] * v + W[2, 2]
+    head_u = (W[0, 0] * u + W[0, 1] * v + W[0, 2]) / head_w
+    head_v = (W[1, 0] * u + W[1, 1] * v + W[1, 2]) / head_w
+    slope = (W[1, 1] - head_v * W[2, 1]) / head_w
+    if abs(slope) < 1e-9:
+        slope = 1e-9
+    lean_u = head_u - u
+    head_offset = head_v - slope * v
+    edge_a = -head_offset / slope
+    edge_b = (height_px - head_offset) / slope
+    v_low = max(0.0, min(edge_a, edge_b))
+    v_high = min(height_px, max(edge_a, edge_b))
+    u_low = max(0.0, -lean_u)
+    u_high = min(width_px, width_px - lean_u)
+    height_slope, height_offset = 1.0 - slope, -head_offset
+    if realistic:
+        v_at_r0 = (r0_px - height_offset) / height_slope
+        if height_slope > 0:
+            v_low = max(v_low, v_at_r0)
+        else:
+            v_high = min(v_high, v_at_r0)
+    value = rectangle_probability_scalar(u, v, var_u, cov_uv, var_v, u_low, u_high, v_low, v_high)
+    if realistic and value > 0:
+        b_v = -kd * height_slope
+        log_scale = -kd * (height_offset - r0_px) + b_v * v + 0.5 * b_v * b_v * var_v
+        shifted = rectangle_probability_scalar(
+            u + cov_uv * b_v, v + var_v * b_v, var_u, cov_uv, var_v, u_low, u_high, v_low, v_high
+        )
+        if shifted > 0:
+            value -= math.exp(log_scale + math.log(shifted))
+    return min(max(value, 0.0), 1.0)
+
+
+@numba.njit
+def _integral_terms(
+    ground_to_image, head_from_feet, actions, mean_m, position_cov_m2, V, width_px, height_px, realistic, kd, r0_px
 ):
-    L, n = ground_to_image.shape[0], mean_m.shape[0]
+    L, n = actions.shape[0], mean_m.shape[0]
+    log_det_V = _log_det(V)
     alpha = np.zeros((L, n))
-    for action in range(L):
-        W = head_from_feet[action]
+    gain = np.zeros((L, n))
+    for row in range(L):
+        H, W = ground_to_image[actions[row]], head_from_feet[actions[row]]
         for track in range(n):
-            u, v, var_u, cov_uv, var_v, w = _predict(ground_to_image[action], mean_m[track], position_cov_m2[track], V)
+            u, v, var_u, cov_uv, var_v, w = _predict(H, mean_m, position_cov_m2, track, V)
             if w <= 0:
                 continue
-            head_w = W[2, 0] * u + W[2, 1] * v + W[2, 2]
-            head_u = (W[0, 0] * u + W[0, 1] * v + W[0, 2]) / head_w
-            head_v = (W[1, 0] * u + W[1, 1] * v + W[1, 2]) / head_w
-            slope = (W[1, 1] - head_v * W[2, 1]) / head_w
-            if abs(slope) < 1e-9:
-                slope = 1e-9
-            lean_u = head_u - u
-            head_offset = head_v - slope * v
-            edge_a = -head_offset / slope
-            edge_b = (height_px - head_offset) / slope
-            v_low = max(0.0, min(edge_a, edge_b))
-            v_high = min(height_px, max(edge_a, edge_b))
-            u_low = max(0.0, -lean_u)
-            u_high = min(width_px, width_px - lean_u)
-            height_slope, height_offset = 1.0 - slope, -head_offset
-            if realistic:
-                v_at_r0 = (r0_px - height_offset) / height_slope
-                if height_slope > 0:
-                    v_low = max(v_low, v_at_r0)
-                else:
-                    v_high = min(v_high, v_at_r0)
-            value = rectangle_probability_scalar(u, v, var_u, cov_uv, var_v, u_low, u_high, v_low, v_high)
-            if realistic and value > 0:
-                b_v = -kd * height_slope
-                log_scale = -kd * (height_offset - r0_px) + b_v * v + 0.5 * b_v * b_v * var_v
-                shifted = rectangle_probability_scalar(
-                    u + cov_uv * b_v, v + var_v * b_v, var_u, cov_uv, var_v, u_low, u_high, v_low, v_high
-                )
-                if shifted > 0:
-                    value -= math.exp(log_scale + math.log(shifted))
-            alpha[action, track] = min(max(value, 0.0), 1.0)
-    return alpha
+            gain[row, track] = _information(var_u, cov_uv, var_v, log_det_V)
+            alpha[row, track] = _alpha_closed_form(
+                W, u, v, var_u, cov_uv, var_v, width_px, height_px, realistic, kd, r0_px
+            )
+    return alpha, gain
+
+
+def detection_weight_and_information_integral(
+    camera: PTZCamera, geometry: ActionGeometry, recall: RecallModel, mean_m, position_cov_m2, V, actions=None
+) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`detection_weight_integral` and :func:`information_if_detected_nats` in one pass: (L, n) each.
+
+    Both read the same prediction ``o-, Sigma_o`` (equation 9), computed once per action and track.
+    """
+    return _integral_terms(
+        geometry.ground_to_image,
+        geometry.head_from_feet,
+        geometry.indices(actions),
+        np.asarray(mean_m, float),
+        np.asarray(position_cov_m2, float),
+        np.asarray(V, float),
+        float(camera.image_width_px),
+        float(camera.image_height_px),
+        not recall.perfect,
+        recall.kd_per_px,
+        recall.r0_px,
+    )
 
 
 def detection_weight_integral(
-    camera: PTZCamera, geometry: ActionGeometry, recall: RecallModel, mean_m, position_cov_m2, V
+    camera: PTZCamera, geometry: ActionGeometry, recall: RecallModel, mean_m, position_cov_m2, V, actions=None
 ) -> np.ndarray:
     """``alpha(a)`` of equation 8 in closed form: 'intg'.
 
@@ -176,30 +237,20 @@ def detection_weight_integral(
     Gaussian. The ideal detector has recall 1 and ``alpha = P_rect(N(mu, S))``.
 
     mean_m : (n, 2) predicted ground positions; position_cov_m2 : (n, 2, 2);
-    V : (2, 2) pixel noise. Returns alpha (L, n) in [0, 1], 0 behind the camera.
+    V : (2, 2) pixel noise; actions : flat indices into ``geometry`` (L of them; None: all).
+    Returns alpha (L, n) in [0, 1], 0 behind the camera.
     """
-    return _detection_weight_integral(
-        geometry.ground_to_image,
-        geometry.head_from_feet,
-        np.asarray(mean_m, float),
-        np.asarray(position_cov_m2, float),
-        np.asarray(V, float),
-        float(camera.image_width_px),
-        float(camera.image_height_px),
-        not recall.perfect,
-        recall.kd_per_px,
-        recall.r0_px,
-    )
+    return detection_weight_and_information_integral(camera, geometry, recall, mean_m, position_cov_m2, V, actions)[0]
 
 
 @numba.njit
 def _detection_weight_sampled(
-    ground_to_image, head_to_image, ground_m, visible_fraction, width_px, height_px, realistic, kd, r0_px
+    ground_to_image, head_to_image, actions, ground_m, visible_fraction, width_px, height_px, realistic, kd, r0_px
 ):
-    L, (M, n) = ground_to_image.shape[0], ground_m.shape[:2]
+    L, (M, n) = actions.shape[0], ground_m.shape[:2]
     alpha = np.zeros((L, n))
-    for action in range(L):
-        G, E = ground_to_image[action], head_to_image[action]
+    for row in range(L):
+        G, E = ground_to_image[actions[row]], head_to_image[actions[row]]
         for sample in range(M):
             for track in range(n):
                 x, y = ground_m[sample, track, 0], ground_m[sample, track, 1]
@@ -216,7 +267,7 @@ def _detection_weight_sampled(
                 if not (0 <= feet_v <= height_px and 0 <= head_v <= height_px):
                     continue
                 p = realistic_recall(feet_v - head_v, kd, r0_px) if realistic else 1.0
-                alpha[action, track] += p * visible_fraction[sample, track]
+                alpha[row, track] += p * visible_fraction[sample, track]
     return alpha / M
 
 
@@ -247,6 +298,19 @@ def expected_detection_probability(
     return alpha * (1.0 - occluded_fraction(centred.box_px, centred.range_m, centred.in_front))
 
 
+def joint_position_samples(mean_m, position_cov_m2, rng: np.random.Generator, samples: int) -> np.ndarray:
+    """``samples`` joint draws (M, n, 2) of the tracks' ground positions, by Latin hypercube sampling.
+
+    mean_m : (n, 2); position_cov_m2 : (n, 2, 2). Each track's draws are ``N(mean, cov)``; the
+    M x 2n uniforms are one Latin hypercube, mapped through the normal quantile and the Cholesky factor.
+    """
+    mean_m = np.asarray(mean_m, dtype=float)
+    chol = np.linalg.cholesky(position_cov_m2 + 1e-12 * np.eye(2))
+    uniform = qmc.LatinHypercube(d=mean_m.size, rng=rng).random(samples)
+    standard = norm.ppf(uniform).reshape((samples,) + mean_m.shape)
+    return mean_m + np.einsum("nij,mnj->mni", chol, standard)
+
+
 def detection_weight_sampled(
     camera: PTZCamera,
     geometry: ActionGeometry,
@@ -258,6 +322,7 @@ def detection_weight_sampled(
     reference_pose,
     rng: np.random.Generator,
     samples: int,
+    actions=None,
 ) -> np.ndarray:
     """``alpha(a)`` of equation 19 by Monte Carlo over joint positions: 'smpl'.
 
@@ -279,18 +344,16 @@ def detection_weight_sampled(
     each person in the view centred on that person instead; the two differ
     only through the boxes' perspective distortion (a mean of about 0.01).
 
-    mean_m : (n, 2); position_cov_m2 : (n, 2, 2). Returns alpha (L, n).
+    mean_m : (n, 2); position_cov_m2 : (n, 2, 2); actions : flat indices into
+    ``geometry`` (L of them; None: all). Returns alpha (L, n).
     """
-    mean_m = np.asarray(mean_m, dtype=float)
-    chol = np.linalg.cholesky(position_cov_m2 + 1e-12 * np.eye(2))
-    uniform = qmc.LatinHypercube(d=mean_m.size, rng=rng).random(samples)
-    standard = norm.ppf(uniform).reshape((samples,) + mean_m.shape)
-    ground_m = mean_m + np.einsum("nij,mnj->mni", chol, standard)
+    ground_m = joint_position_samples(mean_m, position_cov_m2, rng, samples)
     at_reference = project_people(camera, reference_pose, ground_m, person_height_m, person_width_m)
     hidden = occluded_fraction(at_reference.box_px, at_reference.range_m, at_reference.in_front)
     return _detection_weight_sampled(
         geometry.ground_to_image,
         geometry.head_to_image,
+        geometry.indices(actions),
         ground_m,
         1.0 - hidden,
         float(camera.image_width_px),

@@ -19,13 +19,33 @@ from ptztrack.control.exploration import ExplorationMap
 from ptztrack.control.information_gain import (
     ActionGeometry,
     action_geometry,
-    detection_weight_integral,
+    detection_weight_and_information_integral,
     detection_weight_sampled,
     information_if_detected_nats,
 )
 from ptztrack.detect.simulated import RecallModel
 from ptztrack.geometry.ptz import PTZCamera, look_at
 from ptztrack.types import DecisionContext, Tracks
+
+
+@dataclass(frozen=True)
+class RewardTerms:
+    """One decision's rewards (nats) term by term.
+
+    actions : (R,) the flat indices scored; track_ids : (n,) the predicted tracks' ids;
+    track_nats : (R, n) each track's expected information gain ``alpha_k(a) I_k(a)``;
+    patrol_nats : (R,) the patrolling term ``beta I_p(a)`` (zeros without one).
+    """
+
+    actions: np.ndarray
+    track_ids: np.ndarray
+    track_nats: np.ndarray
+    patrol_nats: np.ndarray
+
+    @property
+    def total_nats(self) -> np.ndarray:
+        """(R,) the reward of each action, as the policy compares them."""
+        return np.sum(self.track_nats, axis=-1) + self.patrol_nats
 
 
 @dataclass
@@ -36,6 +56,8 @@ class InformationGainPolicy:
     person_height_m, person_width_m : the person the policy expects.
     method : 'intg' (equation 8, closed form) or 'smpl' (equation 19, ``samples`` draws).
     beta, exploration : the patrolling term's weight and map (None: no patrolling term).
+    last_terms : the last choice's rewards term by term (for a live view of the decision; None before
+        the first choice). Kept by reference: the arrays are the ones the choice was made from.
     """
 
     camera: PTZCamera
@@ -49,24 +71,31 @@ class InformationGainPolicy:
     beta: float = 0.0
     exploration: ExplorationMap | None = None
     geometry: ActionGeometry = field(init=False, repr=False)
+    last_terms: RewardTerms | None = field(default=None, init=False, repr=False)
 
     def __post_init__(self):
         self.geometry = action_geometry(self.camera, self.grid.poses, self.person_height_m)
 
     def rewards(self, actions, tracks: Tracks, rng: np.random.Generator) -> np.ndarray:
         """Expected information (nats) of each of ``actions`` (flat indices) about ``tracks``; (len(actions),)."""
-        geometry = self.geometry.take(actions)
-        reward = np.zeros(len(actions))
+        return self.reward_terms(actions, tracks, rng).total_nats
+
+    def reward_terms(self, actions, tracks: Tracks, rng: np.random.Generator) -> RewardTerms:
+        """The rewards of ``actions`` (flat indices) term by term: each track's, and the patrolling term."""
+        actions = np.asarray(actions)
+        track_nats = np.zeros((len(actions), len(tracks)))
         if len(tracks):
             mean_m = tracks.mean[:, :2]
             position_cov_m2 = tracks.covariance[:, :2, :2]
             if self.method == "intg":
-                alpha = detection_weight_integral(self.camera, geometry, self.recall, mean_m, position_cov_m2, self.V)
+                alpha, information = detection_weight_and_information_integral(
+                    self.camera, self.geometry, self.recall, mean_m, position_cov_m2, self.V, actions
+                )
             else:
                 reference_pose = look_at(self.camera, mean_m.mean(axis=0), zoom=1.0)
                 alpha = detection_weight_sampled(
                     self.camera,
-                    geometry,
+                    self.geometry,
                     self.recall,
                     mean_m,
                     position_cov_m2,
@@ -75,15 +104,18 @@ class InformationGainPolicy:
                     reference_pose,
                     rng,
                     self.samples,
+                    actions,
                 )
-            information = information_if_detected_nats(geometry, mean_m, position_cov_m2, self.V)
-            reward += np.sum(alpha * information, axis=-1)
+                information = information_if_detected_nats(self.geometry, mean_m, position_cov_m2, self.V, actions)
+            track_nats = alpha * information
+        patrol_nats = np.zeros(len(actions))
         if self.exploration is not None:
-            reward += self.beta * self.exploration.information_nats(actions)
-        return reward
+            patrol_nats = self.beta * self.exploration.information_nats(actions)
+        return RewardTerms(actions, tracks.ids, track_nats, patrol_nats)
 
     def choose(self, context: DecisionContext) -> int:
-        reward = self.rewards(context.reachable, context.tracks, context.rng)
+        self.last_terms = self.reward_terms(context.reachable, context.tracks, context.rng)
+        reward = self.last_terms.total_nats
         best = int(np.argmax(reward))
         staying = np.flatnonzero(context.reachable == context.current_action)
         if len(staying) and reward[staying[0]] >= reward[best]:

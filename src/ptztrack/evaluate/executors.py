@@ -14,6 +14,8 @@ from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from contextlib import contextmanager
 
+from tqdm import tqdm
+
 EXECUTORS = ("local", "ray", "serial")
 _IGNORE_CTRL_C = (signal.SIGINT, signal.SIG_IGN)
 
@@ -124,9 +126,38 @@ def _run_on_ray(cells: Sequence, report: Callable[[int, int], None], run: Callab
     return rows
 
 
-def print_progress(done: int, total: int, noun: str = "episodes") -> None:
-    """Progress on stderr: one line rewritten in a terminal, a line per tenth in a log."""
-    if sys.stderr.isatty():
-        print(f"\r{done}/{total} {noun}", end="\n" if done == total else "", file=sys.stderr, flush=True)
-    elif done == total or done % max(1, total // 10) == 0:
-        print(f"{done}/{total} {noun}", file=sys.stderr, flush=True)
+class Progress:
+    """A progress bar on stderr (tqdm): how many are done, the rate, the time left; none where stderr
+    is not a terminal (a log, a pipe), or where ``quiet``.
+
+    Call it with (done, total) as things finish (``run_cells``' ``progress``); a count that starts
+    again (passes over several recordings' frames) starts a new bar. As a context manager it closes
+    the bar at the end of the block, a failure or Ctrl-C included.
+
+    noun : what is counted, singular ('episode': the bar reads "episode/s").
+    """
+
+    def __init__(self, noun: str = "episode", quiet: bool = False):
+        self.noun, self.quiet = noun, quiet
+        self._bar: tqdm | None = None
+
+    def __call__(self, done: int, total: int) -> None:
+        if self._bar is None or done < self._bar.n or total != self._bar.total:
+            self.close()
+            self._bar = tqdm(
+                total=total, desc=f"{self.noun}s", unit=self.noun, file=sys.stderr, disable=True if self.quiet else None
+            )
+        self._bar.update(done - self._bar.n)
+        if done >= total:
+            self.close()
+
+    def close(self) -> None:
+        if self._bar is not None:
+            self._bar.close()
+            self._bar = None
+
+    def __enter__(self) -> "Progress":
+        return self
+
+    def __exit__(self, *failure) -> None:
+        self.close()

@@ -18,6 +18,7 @@ and encoded by OpenCV's MPEG-4 Part 2 writer ('mp4v'; its H.264 encoder is
 not in the pip wheels).
 """
 
+import functools
 import os
 import tempfile
 from collections.abc import Callable, Iterable, Iterator
@@ -123,7 +124,7 @@ def map_transform(episode: Episode) -> MapTransform:
 def model_view(camera: PTZCamera, truth: GroundTruth, step: int, pose) -> np.ndarray:
     """The camera model's picture (h, w, 3) uint8 BGR: the present people's boxes, nearer ones on top
     (people of unknown height are not drawn)."""
-    image = np.full((camera.image_height_px, camera.image_width_px, 3), MODEL_BACKGROUND_BGR, np.uint8)
+    image = _model_background(camera.image_height_px, camera.image_width_px).copy()
     present = truth.present[step] & np.isfinite(truth.heights_m)
     people = project_people(
         camera, pose, truth.positions_m[step, present], truth.heights_m[present], truth.widths_m[present]
@@ -134,6 +135,15 @@ def model_view(camera: PTZCamera, truth: GroundTruth, step: int, pose) -> np.nda
             cv2.rectangle(image, corners[0], corners[1], MODEL_PERSON_BGR, cv2.FILLED)
             cv2.rectangle(image, corners[0], corners[1], MODEL_EDGE_BGR, 1)
     return image
+
+
+@functools.cache
+def _model_background(height_px: int, width_px: int) -> np.ndarray:
+    """The synthetic view's background, read-only: a copy of it is some fifty times faster than np.full
+    with a colour (a strided fill), which took a live view's run a millisecond a picture."""
+    background = np.full((height_px, width_px, 3), MODEL_BACKGROUND_BGR, np.uint8)
+    background.flags.writeable = False
+    return background
 
 
 def view_renderer(world: World) -> RenderView:

@@ -119,6 +119,21 @@ def pixel_rays(calibration: PinholeCalibration, pixels_px) -> tuple[np.ndarray, 
     return centre_m, direction / np.linalg.norm(direction, axis=-1, keepdims=True)
 
 
+def standing_height_px(calibration: PinholeCalibration, feet_px, height_m: float) -> np.ndarray:
+    """The image height (N,) px of a person ``height_m`` tall standing on feet pixels (N, 2) of the
+    calibrated (distorted) image: the feet's ray meets the ground, the head above it is projected back.
+    NaN where the ray does not reach the ground ahead of the camera."""
+    centre_m, directions = pixel_rays(calibration, feet_px)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        distance_m = -centre_m[2] / directions[:, 2]
+    ahead = distance_m > 0
+    feet_m = centre_m + np.where(ahead, distance_m, 1.0)[:, None] * directions
+    head_m = feet_m + [0.0, 0.0, height_m]
+    head_px = project_pinhole(calibration, 1000.0 * head_m)
+    height_px = np.linalg.norm(np.asarray(feet_px, dtype=float) - head_px, axis=-1)
+    return np.where(ahead, height_px, np.nan)
+
+
 def pinhole_from_tsai(calibration: TsaiCalibration) -> PinholeCalibration:
     """The pinhole camera with OpenCV distortion that projects like a Tsai camera.
 

@@ -4,9 +4,68 @@ Along a ray, the person nearer the optical centre hides the farther one,
 however the camera is turned; boxes in an image measure how much.
 """
 
+import numba
 import numpy as np
 
 from ptztrack.geometry.ptz import PTZCamera, look_at, project_people
+
+# The kernels are cached on disk: every simulated step measures occlusion, whatever the policy, and
+# compiling them (np.sort above all) cost each command about 3 s of CPU at its start.
+
+
+@numba.njit(cache=True)
+def _covered_area(low, high, count):
+    """Area of the union of ``count`` rectangles ``low[k] <= (x, y) < high[k]``, (count, 2) each.
+
+    Cuts the plane along every rectangle edge into at most (2 count - 1)^2
+    cells and adds the cells whose centre some rectangle covers.
+    """
+    edges_x = np.sort(np.concatenate((low[:count, 0], high[:count, 0])))
+    edges_y = np.sort(np.concatenate((low[:count, 1], high[:count, 1])))
+    area = 0.0
+    for a in range(2 * count - 1):
+        width = edges_x[a + 1] - edges_x[a]
+        if width <= 0:
+            continue
+        mid_x = 0.5 * (edges_x[a] + edges_x[a + 1])
+        for b in range(2 * count - 1):
+            height = edges_y[b + 1] - edges_y[b]
+            if height <= 0:
+                continue
+            mid_y = 0.5 * (edges_y[b] + edges_y[b + 1])
+            for k in range(count):
+                if low[k, 0] <= mid_x < high[k, 0] and low[k, 1] <= mid_y < high[k, 1]:
+                    area += width * height
+                    break
+    return area
+
+
+@numba.njit(cache=True)
+def _occluded_fraction(box_px, depth_m, valid):
+    frames, count = depth_m.shape
+    hidden = np.zeros((frames, count))
+    low = np.empty((count, 2))
+    high = np.empty((count, 2))
+    for frame in range(frames):
+        box = box_px[frame]
+        for target in range(count):
+            box_area = (box[target, 2] - box[target, 0]) * (box[target, 3] - box[target, 1])
+            if not (valid[frame, target] and box_area > 0):
+                continue
+            # only the nearer people whose boxes overlap the target's, clipped to it
+            occluders = 0
+            for other in range(count):
+                if other == target or not valid[frame, other] or not depth_m[frame, other] < depth_m[frame, target]:
+                    continue
+                low_x, low_y = max(box[other, 0], box[target, 0]), max(box[other, 1], box[target, 1])
+                high_x, high_y = min(box[other, 2], box[target, 2]), min(box[other, 3], box[target, 3])
+                if high_x > low_x and high_y > low_y:
+                    low[occluders, 0], low[occluders, 1] = low_x, low_y
+                    high[occluders, 0], high[occluders, 1] = high_x, high_y
+                    occluders += 1
+            if occluders:
+                hidden[frame, target] = min(max(_covered_area(low, high, occluders) / box_area, 0.0), 1.0)
+    return hidden
 
 
 def occluded_fraction(box_px, depth_m, valid) -> np.ndarray:
@@ -15,38 +74,26 @@ def occluded_fraction(box_px, depth_m, valid) -> np.ndarray:
     box_px : (..., N, 4) (left, top, right, bottom); depth_m : (..., N) the
     distance that orders people (nearer hides farther);
     valid : (..., N) bool, people that exist and are in front of the camera.
-    Returns (..., N) in [0, 1]. The union is measured exactly by cutting each
-    box along every occluder edge into at most (2N - 1)^2 cells.
+    Returns (..., N) in [0, 1], 0 for a person not valid. The union over the
+    k boxes that overlap a person's is measured exactly by cutting it along
+    their edges into at most (2k - 1)^2 cells. Cutting every box along the
+    edges of all N boxes at once, as whole arrays, cost O(N^4) per frame in
+    time and memory: 96 % of an 'smpl' decision at 20 tracks, and 4 N^5 bytes
+    for the simulated detector's N views of N people.
     """
     box_px = np.asarray(box_px, dtype=float)
-    depth_m = np.asarray(depth_m, dtype=float)
-    valid = np.asarray(valid, dtype=bool)
-    count = box_px.shape[-2]
-    target = box_px[..., :, None, :]
-    occluder = box_px[..., None, :, :]
-    occludes = (
-        valid[..., None, :]
-        & valid[..., :, None]
-        & (depth_m[..., None, :] < depth_m[..., :, None])
-        & ~np.eye(count, dtype=bool)
+    left, depth_m, valid = np.broadcast_arrays(
+        box_px[..., 0], np.asarray(depth_m, dtype=float), np.asarray(valid, dtype=bool)
     )
-    low = np.maximum(occluder[..., :2], target[..., :2])
-    high = np.minimum(occluder[..., 2:], target[..., 2:])
-    high = np.where(occludes[..., None], np.maximum(high, low), low)
-
-    def cells(axis):
-        edges = np.sort(np.concatenate([low[..., axis], high[..., axis]], axis=-1), axis=-1)
-        return 0.5 * (edges[..., 1:] + edges[..., :-1]), np.diff(edges, axis=-1)
-
-    mid_x, width_x = cells(0)
-    mid_y, width_y = cells(1)
-    inside_x = (low[..., None, :, 0] <= mid_x[..., :, None]) & (mid_x[..., :, None] < high[..., None, :, 0])
-    inside_y = (low[..., None, :, 1] <= mid_y[..., :, None]) & (mid_y[..., :, None] < high[..., None, :, 1])
-    covered = np.any(inside_x[..., :, None, :] & inside_y[..., None, :, :], axis=-1)
-    covered_area = np.einsum("...ab,...a,...b->...", covered, width_x, width_y)
-    box_area = (box_px[..., 2] - box_px[..., 0]) * (box_px[..., 3] - box_px[..., 1])
-    with np.errstate(invalid="ignore", divide="ignore"):
-        return np.where(box_area > 0, np.clip(covered_area / box_area, 0.0, 1.0), 0.0)
+    if left.size == 0:
+        return np.zeros(left.shape)
+    count = left.shape[-1]
+    hidden = _occluded_fraction(
+        np.broadcast_to(box_px, left.shape + (4,)).reshape(-1, count, 4),
+        depth_m.reshape(-1, count),
+        valid.reshape(-1, count),
+    )
+    return hidden.reshape(left.shape)
 
 
 def occlusion_in_centred_views(camera: PTZCamera, ground_xy, height_m, width_m, present) -> np.ndarray:

@@ -146,6 +146,18 @@ def pixels_to_ground(camera: PTZCamera, pose, pixels) -> np.ndarray:
     return camera.centre_m[:2] + rays[:, :2] * distance[:, None]
 
 
+def standing_height_px(camera: PTZCamera, pose, height_m: float, feet_px) -> np.ndarray:
+    """The image height (N,) px of a person ``height_m`` tall standing on feet pixels (N, 2) at ``pose``
+    (3,): the distance from the feet to the projected head; NaN where the feet's ray meets the ground
+    behind the camera (above the horizon) or the head is behind it."""
+    feet_px = np.asarray(feet_px, dtype=float)
+    ground_m = apply_homography(image_to_ground(camera, pose), feet_px)
+    head_px = apply_homography(plane_homography(camera, pose, height_m), ground_m)
+    feet_m, head_m = (np.c_[ground_m, np.full(len(ground_m), z)] for z in (0.0, height_m))
+    in_front = (camera_depth_m(camera, pose, feet_m) > 0) & (camera_depth_m(camera, pose, head_m) > 0)
+    return np.where(in_front, np.linalg.norm(head_px - feet_px, axis=-1), np.nan)
+
+
 def homography_jacobian(H, points) -> np.ndarray:
     """Jacobian of ``p -> H p`` (inhomogeneous) at ``points``.
 

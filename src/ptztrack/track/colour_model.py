@@ -98,6 +98,35 @@ def bhattacharyya_distance(reference, histograms) -> np.ndarray:
     return np.sqrt(np.clip(1.0 - coefficient, 0.0, 1.0))
 
 
+def background_weights(bin_image, box_px, total_bins: int, ring_scale: float) -> np.ndarray:
+    """Weights (total_bins,) in [0, 1] that play down the colours of the background around a box.
+
+    Comaniciu, Ramesh and Meer, "Kernel-based object tracking" (PAMI 2003), section 6.2: with ``o``
+    the histogram of the ring between the box (left, top, width, height) px and the same box scaled by
+    ``ring_scale`` about its centre (clipped to the bin image (h, w)), bin ``u`` weighs
+    ``min(o* / o_u, 1)``, ``o*`` the smallest non-zero ``o_u``; a bin absent from the ring weighs 1.
+    """
+    height, width = bin_image.shape
+    left, top, box_width, box_height = (float(value) for value in box_px)
+    centre = np.array([left + box_width / 2, top + box_height / 2])
+    half_outer = np.array([box_width, box_height]) * ring_scale / 2
+    col0, row0 = np.clip(np.floor(centre - half_outer), 0, [width, height]).astype(int)
+    col1, row1 = np.clip(np.ceil(centre + half_outer), 0, [width, height]).astype(int)
+    rows, cols = np.mgrid[row0:row1, col0:col1] + 0.5
+    in_box = (cols >= left) & (cols < left + box_width) & (rows >= top) & (rows < top + box_height)
+    ring = np.bincount(bin_image[row0:row1, col0:col1][~in_box], minlength=total_bins)[:total_bins]
+    if not ring.any():
+        return np.ones(total_bins)
+    smallest = ring[ring > 0].min()
+    return np.where(ring > 0, smallest / np.maximum(ring, 1), 1.0)
+
+
+def weigh_histograms(histograms, bin_weights) -> np.ndarray:
+    """Histograms (..., B) times the bin weights (B,), normalised again (a histogram of zeros stays so)."""
+    weighted = np.asarray(histograms) * bin_weights
+    return weighted / np.maximum(weighted.sum(axis=-1, keepdims=True), np.finfo(float).tiny)
+
+
 def colour_log_likelihood(distances, lambda_colour: float) -> np.ndarray:
     """The log of equation 3, ``-sum_p B_p^2 / lambda_col``, of distances (..., K); returns (...)."""
     return -np.sum(np.asarray(distances) ** 2, axis=-1) / lambda_colour

@@ -53,12 +53,18 @@ an exponential average, with weight ``velocity_gain``, of the estimate's
 steps. ``velocity_gain`` 0 is the paper's walk; while lost, and when the
 track is back, the velocity is 0.
 
+Height prior (not in the paper). Where the view is calibrated, a box's height is weighed against
+the height of a person standing on its bottom centre: a log-normal prior, ``ln(h / h_standing)``
+with spread ``height_log_sigma``. Background-weighted histograms no longer count the background a
+box takes in, so without it nothing stops a box from growing; the paper's prior on h is none.
+
 Likelihoods: colour from the patches' hue-saturation histograms, motion
 ``exp(-E^2 / lambda_mot)`` with E the fraction of non-moving pixels under the
 patches (the paper's count of non-motion pixels, divided by the pixels there
 so that smaller boxes are not favoured).
 """
 
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 from typing import NamedTuple
 
@@ -73,6 +79,12 @@ from ptztrack.track.motion_image import MotionImage, first_motion_image, next_mo
 MIN_HEIGHT_PX = 8.0
 # The reference histograms are sampled this much more densely per axis than the particles' ones.
 REFERENCE_OVERSAMPLING = 4
+# The height prior treats a box no one could stand in as this many spreads off, not as impossible: were
+# every particle so, their weights would otherwise all vanish.
+MAX_HEIGHT_Z = 10.0
+
+# The height (n,) px of a person standing on feet pixels (n, 2) of a view, NaN where no one can stand.
+StandingHeight = Callable[[np.ndarray], np.ndarray]
 
 
 @dataclass(frozen=True)
@@ -84,8 +96,12 @@ class ParticleFilterParameters:
     patches : (K, 4) (left, top, width, height) in box units (:mod:`ptztrack.track.colour_model`).
     bins : N of the N x N hue-saturation histograms; achromatic : N more bins by value for greys
     (:func:`ptztrack.track.colour_model.colour_bins`); samples : grid points per patch axis.
+    background_ring_scale : the background-weighted histograms' ring, the box scaled by this much
+    (:func:`ptztrack.track.colour_model.background_weights`); None: unweighted, the paper's.
     lambda_colour, lambda_motion : equations 3 and 4.
     lambda_loss : the colour likelihood's lambda in the loss test (``likelihood``, ``P_ref``).
+    height_log_sigma : the spread of ``ln(h / h_standing)``, h_standing the calibrated height of a
+    person standing on the box's feet (the height prior, see the module); None: no prior, the paper's.
     walk_sigma : random-walk step of x and y in box heights; scale_sigma : relative step of h.
     velocity_gain : the weight of the last step in the velocity's exponential average; 0: no velocity.
     loss_fraction, adapt_fraction, reference_rate : the loss test and the adaptation of ``P_ref``.
@@ -99,9 +115,11 @@ class ParticleFilterParameters:
     bins: int
     achromatic: bool
     samples: int
+    background_ring_scale: float | None
     lambda_colour: float
     lambda_motion: float
     lambda_loss: float
+    height_log_sigma: float | None
     walk_sigma: float
     scale_sigma: float
     velocity_gain: float
@@ -121,7 +139,8 @@ class ParticleFilter:
 
     particles : (P, 3) states (x_px, y_px, h_px) in the current view; weights : (P,), summing to 1.
     estimate : (3,) the weighted mean (equation 6); likelihood : its colour likelihood P(z_col | s_t).
-    reference : (K, B) the patches' reference histograms (B bins); aspect : box width / height.
+    reference : (K, B) the patches' reference histograms (B bins), weighted by ``bin_weights`` (B,)
+    as every candidate's are; aspect : box width / height.
     reference_likelihood : P_ref (None before the first step); lost_steps : steps lost (0 while tracking).
     motion : the motion history image; velocity_px : (2,) the estimate's velocity, px per step.
     """
@@ -131,6 +150,7 @@ class ParticleFilter:
     estimate: np.ndarray
     likelihood: float
     reference: np.ndarray
+    bin_weights: np.ndarray
     aspect: float
     reference_likelihood: float | None
     lost_steps: int
@@ -178,12 +198,18 @@ def start_filter(image_bgr, box_px, parameters: ParticleFilterParameters) -> Par
     patches = colour_model.patch_boxes(np.asarray(box_px, dtype=float), parameters.patches)
     total_bins = colour_model.bin_count(parameters.bins, parameters.achromatic)
     reference = colour_model.patch_histograms(bins, patches, total_bins, REFERENCE_OVERSAMPLING * parameters.samples)
+    bin_weights = (
+        np.ones(total_bins)
+        if parameters.background_ring_scale is None
+        else colour_model.background_weights(bins, box_px, total_bins, parameters.background_ring_scale)
+    )
     return ParticleFilter(
         particles=np.tile(state, (parameters.particles, 1)),
         weights=np.full(parameters.particles, 1.0 / parameters.particles),
         estimate=state,
         likelihood=1.0,
-        reference=reference,
+        reference=colour_model.weigh_histograms(reference, bin_weights),
+        bin_weights=bin_weights,
         aspect=width / height,
         reference_likelihood=None,
         lost_steps=0,
@@ -193,9 +219,17 @@ def start_filter(image_bgr, box_px, parameters: ParticleFilterParameters) -> Par
 
 
 def step_filter(
-    state: ParticleFilter, image_bgr, homography, parameters: ParticleFilterParameters, rng: np.random.Generator
+    state: ParticleFilter,
+    image_bgr,
+    homography,
+    parameters: ParticleFilterParameters,
+    rng: np.random.Generator,
+    standing_height_px: StandingHeight | None = None,
 ) -> ParticleFilter:
-    """One step on the next view (h, w, 3) uint8 BGR, into which the previous view maps by ``homography``."""
+    """One step on the next view (h, w, 3) uint8 BGR, into which the previous view maps by ``homography``.
+
+    standing_height_px : the view's calibration, for the height prior (with ``height_log_sigma``).
+    """
     motion = next_motion_image(
         state.motion, image_bgr, homography, parameters.motion_threshold, parameters.motion_decay
     )
@@ -216,14 +250,16 @@ def step_filter(
         particles = _random_walk(chosen, parameters.walk_sigma, parameters.scale_sigma, rng)
     # The weighted mean's box lies within the particles' boxes' extent: one region of bins serves both.
     region = _ColourRegion.of(image_bgr, particles, state.aspect, parameters)
-    colour = region.log_likelihood(particles, state.reference, state.aspect, parameters)
+    colour = region.log_likelihood(particles, state, parameters)
     log_weights = colour + _motion_log_likelihood(motion, particles, state.aspect, parameters)
+    if standing_height_px is not None and parameters.height_log_sigma is not None:
+        log_weights += height_log_prior(particles, standing_height_px, parameters.height_log_sigma)
     weights = np.exp(log_weights - log_weights.max())
     weights /= weights.sum()
     estimate = weights @ particles
     # The loss test's likelihoods: the same sum of squared distances over lambda_loss.
     to_loss = parameters.lambda_colour / parameters.lambda_loss
-    estimate_colour = region.log_likelihood(estimate[None], state.reference, state.aspect, parameters)[0]
+    estimate_colour = region.log_likelihood(estimate[None], state, parameters)[0]
     likelihood = float(np.exp(to_loss * estimate_colour))
     reference = state.reference_likelihood
     if reference is None:  # the first step: P_ref is the best particle's likelihood
@@ -251,6 +287,16 @@ def step_filter(
         motion=motion,
         velocity_px=velocity_px,
     )
+
+
+def height_log_prior(states, standing_height_px: StandingHeight, log_sigma: float) -> np.ndarray:
+    """Log prior (n,) of states (n, 3): ``-z^2 / 2``, ``z = ln(h / h_standing) / log_sigma``, h_standing the
+    height of a person standing on the box's bottom centre; a box whose feet no one can stand on
+    (beyond the horizon) counts as ``MAX_HEIGHT_Z`` spreads off."""
+    feet_px = states[:, :2] + np.c_[np.zeros(len(states)), states[:, 2] / 2]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        z = np.log(states[:, 2] / standing_height_px(feet_px)) / log_sigma
+    return -0.5 * np.minimum(np.nan_to_num(z, nan=MAX_HEIGHT_Z) ** 2, MAX_HEIGHT_Z**2)
 
 
 def _random_walk(states, walk_sigma: float, scale_sigma: float, rng: np.random.Generator) -> np.ndarray:
@@ -294,17 +340,19 @@ class _ColourRegion(NamedTuple):
         )
         return cls(bins, np.array([col0, row0]))
 
-    def log_likelihood(self, states, reference, aspect: float, parameters) -> np.ndarray:
-        """Log colour likelihoods (n,) of states (n, 3) whose patches lie within the region."""
-        boxes = colour_model.box_of_states(states, aspect)
+    def log_likelihood(self, states, target: ParticleFilter, parameters) -> np.ndarray:
+        """Log colour likelihoods (n,) of states (n, 3) whose patches lie within the region, against the
+        target's reference histograms."""
+        boxes = colour_model.box_of_states(states, target.aspect)
         boxes = colour_model.patch_boxes(boxes, parameters.patches) - [*self.origin, 0, 0]
         total_bins = colour_model.bin_count(parameters.bins, parameters.achromatic)
         if self.bins.size:
             histograms = colour_model.patch_histograms(self.bins, boxes, total_bins, parameters.samples)
         else:
             histograms = np.zeros(boxes.shape[:-1] + (total_bins,))
+        histograms = colour_model.weigh_histograms(histograms, target.bin_weights)
         return colour_model.colour_log_likelihood(
-            colour_model.bhattacharyya_distance(reference, histograms), parameters.lambda_colour
+            colour_model.bhattacharyya_distance(target.reference, histograms), parameters.lambda_colour
         )
 
 

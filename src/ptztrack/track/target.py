@@ -33,6 +33,7 @@ position.
 
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
+from functools import partial
 from typing import Protocol
 
 import cv2
@@ -44,9 +45,16 @@ from ptztrack.geometry.ptz import (
     homography_jacobian,
     plane_homography,
     rotation_homography,
+    standing_height_px,
 )
 from ptztrack.roles import ImageSource
-from ptztrack.track.particle_filter import ParticleFilter, ParticleFilterParameters, start_filter, step_filter
+from ptztrack.track.particle_filter import (
+    ParticleFilter,
+    ParticleFilterParameters,
+    StandingHeight,
+    start_filter,
+    step_filter,
+)
 from ptztrack.types import Detections, Tracks, TrackUpdate
 
 TRACK_ID = 0
@@ -76,8 +84,10 @@ class TargetSource(Protocol):
         """Begin on the person in ``box_px`` (left, top, width, height) of the first view (h, w, 3) uint8 BGR."""
         ...
 
-    def step(self, image_bgr: np.ndarray, homography: np.ndarray) -> TargetEstimate:
-        """The person in the next view, into which the previous view maps by ``homography`` (3, 3)."""
+    def step(self, image_bgr: np.ndarray, homography: np.ndarray, standing_height_px: StandingHeight) -> TargetEstimate:
+        """The person in the next view, into which the previous view maps by ``homography`` (3, 3);
+        ``standing_height_px`` is the view's calibration (the height of a person standing on given feet
+        pixels), for a source that uses it."""
         ...
 
 
@@ -102,10 +112,10 @@ class ParticleSource:
         self.filter = start_filter(image_bgr, box_px, self.parameters)
         return self._estimate()
 
-    def step(self, image_bgr, homography) -> TargetEstimate:
+    def step(self, image_bgr, homography, standing_height_px: StandingHeight) -> TargetEstimate:
         if self.filter is None:
             raise RuntimeError("the particle filter steps before it started")
-        self.filter = step_filter(self.filter, image_bgr, homography, self.parameters, self.rng)
+        self.filter = step_filter(self.filter, image_bgr, homography, self.parameters, self.rng, standing_height_px)
         return self._estimate()
 
     def _estimate(self) -> TargetEstimate:
@@ -136,7 +146,9 @@ class OpenCVSource:
         self.tracker.init(image_bgr, (left, top, width, height))
         return self._estimate(lost=False)
 
-    def step(self, image_bgr, homography) -> TargetEstimate:
+    def step(self, image_bgr, homography, standing_height_px: StandingHeight) -> TargetEstimate:
+        """The tracker's box in the next view; OpenCV's trackers take neither the homography nor the
+        calibration."""
         if self.tracker is None:
             raise RuntimeError("the OpenCV tracker steps before it started")
         found, box = self.tracker.update(image_bgr)
@@ -202,7 +214,8 @@ class TargetTracker:
             )
             estimate = self.source.start(image, carried)
         else:
-            estimate = self.source.step(image, rotation_homography(self.camera, self.pose, pose))
+            standing = partial(standing_height_px, self.camera, pose, self.person_height_m)
+            estimate = self.source.step(image, rotation_homography(self.camera, self.pose, pose), standing)
         self.pose = pose
         box = np.asarray(estimate.box_px, dtype=float)
         position, covariance = self._ground(box[:2] + box[2:] / 2, estimate.centre_covariance_px2, pose)
