@@ -23,7 +23,9 @@ def main() -> None:
     grid = world.grid
     poses = grid.poses[np.all(np.abs(grid.axis_indices[:, :2] - [3, 2]) <= [2, 1], axis=1)]
     steps = range(0, world.truth.positions_m.shape[0], 20)
-    heights, detected = detection_trials(world.backend, world.detector, poses, steps, scenario.recording.occluded_above)
+    occluded_above = scenario.required_recording("the recall fit").occluded_above
+    trials = detection_trials(world.backend, world.detector, world.camera, world.truth, poses, steps, occluded_above)
+    heights, detected = trials.height_px, trials.detected
     kd, r0 = fit_recall(heights, detected)
     print(f"{len(heights)} annotated people in view, {detected.sum()} found by HOG")
     print(f"fitted Kd = {kd:.4f} per px, r0 = {r0:.2f} px (paper, Caltech HOG: 0.0098, 21.29)")

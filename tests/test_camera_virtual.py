@@ -1,3 +1,4 @@
+import pickle
 from pathlib import Path
 
 import numpy as np
@@ -77,6 +78,19 @@ def test_a_map_interpolated_over_a_grid_of_8_px_is_the_exact_one_to_a_hundredth_
     coarse_u, coarse_v = coarse.sampling_maps(pose)
     assert coarse_u.shape == exact_u.shape == (480, 640)
     assert np.max(np.hypot(coarse_u - exact_u, coarse_v - exact_v)) < 0.01
+
+
+def test_a_poses_sampling_maps_are_computed_once_and_the_oldest_are_dropped_beyond_the_budget(monkeypatch):
+    virtual, pose = virtual_ptz(RECORDING)
+    first = virtual.sampling_maps(pose)
+    assert virtual.sampling_maps(list(pose)) is first and not first[0].flags.writeable
+    np.testing.assert_array_equal(first[0], VIRTUAL._computed_maps(pose)[0])
+    # Room for the maps of two poses: a third pose drops the first one's.
+    monkeypatch.setattr("ptztrack.camera.virtual.MAP_CACHE_BYTES", 2 * 2 * first[0].nbytes)
+    virtual.sampling_maps(pose + [1.0, 0.0, 0.0])
+    virtual.sampling_maps(pose + [2.0, 0.0, 0.0])
+    assert virtual.sampling_maps(pose) is not first
+    assert pickle.loads(pickle.dumps(virtual)).sampling_maps(pose)[0].shape == (120, 160)
 
 
 def test_a_person_standing_on_the_recorded_ground_is_as_tall_as_the_projection_of_their_head():

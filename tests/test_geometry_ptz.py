@@ -16,6 +16,7 @@ from ptztrack.geometry.ptz import (
     image_to_ground,
     inside_image,
     look_at,
+    pixels_to_ground,
     plane_homography,
     project_people,
     projection_matrix,
@@ -90,6 +91,17 @@ def test_ground_image_round_trip(sample):
     # H is invertible and image_to_ground really is its inverse.
     np.testing.assert_allclose(H @ H_inv, np.eye(3), atol=1e-9)
     np.testing.assert_allclose(H_inv @ H, np.eye(3), atol=1e-9)
+
+
+@PROPERTY
+@given(pose_and_ground_points(), st.lists(st.tuples(unit, unit), min_size=1, max_size=4))
+def test_pixels_to_ground_is_image_to_ground_below_the_horizon_and_nan_above(sample, fractions):
+    pose, pixels, ground_xy = sample
+    np.testing.assert_allclose(pixels_to_ground(CAMERA, pose, pixels), ground_xy, rtol=1e-9, atol=1e-7)
+    horizon = horizon_row_px(pose)
+    assume(horizon > 1.0)
+    above = np.array(fractions) * [CAMERA.image_width_px, horizon - 1.0]
+    assert np.all(np.isnan(pixels_to_ground(CAMERA, pose, above)))
 
 
 @PROPERTY

@@ -242,6 +242,10 @@ class Detector(_Strict):
 
     The policies plan with recall 1 for 'ideal' and with the recall curve ``recall_kd``,
     ``recall_r0_px`` (the paper's equation 13) for every other kind.
+
+    hog_search : 'ground' scans only the windows where a standing person ``hog_person_height_m``
+    (shortest, tallest) tall could be seen on the walkable area, at their sizes; 'image' scans every
+    window of the pyramid, as OpenCV's ``detectMultiScale`` (:mod:`ptztrack.detect.hog`).
     """
 
     kind: Annotated[str, _registered("detectors")] = "realistic"
@@ -255,6 +259,15 @@ class Detector(_Strict):
     hog_upsample: Annotated[PositiveFloat, at_most(16, "memory: the view is upsampled this much each way")] = 6.0
     hog_hit_threshold: float = 0.0
     hog_nms_iou: float = Field(0.4, gt=0, le=1)
+    hog_search: Literal["ground", "image"] = "ground"
+    hog_person_height_m: tuple[_Height, _Height] = (1.5, 2.0)
+
+    @model_validator(mode="after")
+    def _heights_ordered(self):
+        low, high = self.hog_person_height_m
+        if high < low:
+            raise ValueError(f"hog_person_height_m must be [low, high] with low <= high (got {[low, high]})")
+        return self
 
 
 class Tracker(_Strict):

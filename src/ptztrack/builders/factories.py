@@ -16,7 +16,7 @@ from ptztrack.control.baselines import FixPolicy, PatrolPolicy, RandomPolicy, pa
 from ptztrack.control.exploration import exploration_map
 from ptztrack.control.information_gain import expected_detection_probability
 from ptztrack.control.information_policy import InformationGainPolicy
-from ptztrack.detect.hog import HogPeopleDetector
+from ptztrack.detect.hog import GroundSearch, HogPeopleDetector
 from ptztrack.detect.simulated import AnnotationDetector, RecallDetector, RecallModel
 from ptztrack.loop import World
 from ptztrack.scene.pets import RecordedVideo
@@ -145,8 +145,13 @@ def realistic_detector(scenario: Scenario, scene):
 
 
 def hog_detector(scenario: Scenario, scene) -> HogPeopleDetector:
+    """OpenCV's HOG; with ``hog_search`` 'ground', only where the scene's camera can show a standing person
+    on its walkable area."""
     detector = scenario.detector
-    return HogPeopleDetector(detector.hog_upsample, detector.hog_hit_threshold, detector.hog_nms_iou)
+    search = None
+    if detector.hog_search == "ground":
+        search = GroundSearch(scene.camera, scene.area_polygon_m, detector.hog_person_height_m)
+    return HogPeopleDetector(detector.hog_upsample, detector.hog_hit_threshold, detector.hog_nms_iou, search)
 
 
 def simulated_camera(scenario: Scenario, scene) -> SimulatedPTZ:

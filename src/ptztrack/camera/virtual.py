@@ -13,7 +13,7 @@ through the virtual camera's own homography.
 Units: the recording's calibration is in millimetres, ptztrack's world in metres.
 """
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import cv2
 import numpy as np
@@ -22,6 +22,9 @@ from ptztrack.geometry.calibration import PinholeCalibration
 from ptztrack.geometry.ptz import PTZCamera, intrinsics, rotation_world_to_camera
 
 MM_PER_M = 1000.0
+# The sampling maps of the last poses rendered are kept, up to this many bytes: a PTZ camera comes back to
+# the same poses (the 140 of the PETS grid take 21 MB at 160 x 120 px).
+MAP_CACHE_BYTES = 32 * 2**20
 
 
 @dataclass(frozen=True)
@@ -41,6 +44,7 @@ class VirtualPTZ:
     recording: PinholeCalibration
     recorded_size_px: tuple[int, int]
     map_grid_px: int = 1
+    _maps: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
     def pixel_centres(self) -> np.ndarray:
         """(h * w, 2) centres of the virtual pixels, row by row: pixel (row, col) at (col + 0.5, row + 0.5)."""
@@ -49,7 +53,20 @@ class VirtualPTZ:
         return np.c_[u.ravel(), v.ravel()]
 
     def sampling_maps(self, pose) -> tuple[np.ndarray, np.ndarray]:
-        """Where each virtual pixel (centre) reads the recorded frame: two (h, w) float32 maps for cv2.remap."""
+        """Where each virtual pixel (centre) reads the recorded frame: two (h, w) float32 maps for cv2.remap
+        (read-only: the maps of the last poses are kept, see ``MAP_CACHE_BYTES``)."""
+        key = tuple(np.asarray(pose, dtype=float).tolist())
+        maps = self._maps.get(key)
+        if maps is None:
+            maps = self._computed_maps(key)
+            for single in maps:
+                single.setflags(write=False)
+            if (len(self._maps) + 1) * 2 * maps[0].nbytes > MAP_CACHE_BYTES and self._maps:
+                del self._maps[next(iter(self._maps))]
+            self._maps[key] = maps
+        return maps
+
+    def _computed_maps(self, pose) -> tuple[np.ndarray, np.ndarray]:
         width, height, step = self.camera.image_width_px, self.camera.image_height_px, self.map_grid_px
         if step == 1:
             centres, shape = self.pixel_centres(), (height, width)

@@ -127,6 +127,25 @@ def head_from_feet_homology(camera: PTZCamera, poses, height_m) -> np.ndarray:
     return plane_homography(camera, poses, height_m) @ image_to_ground(camera, poses)
 
 
+def pixels_to_ground(camera: PTZCamera, pose, pixels) -> np.ndarray:
+    """The ground points (N, 2) m that the pixels (N, 2) of the view at ``pose`` (3,) see; NaN where a
+    pixel's ray does not come down to the ground (at or above the horizon).
+
+    :func:`image_to_ground` maps a pixel above the horizon to the point behind the camera where its
+    ray, extended backwards, meets the ground; here such pixels see no ground.
+    """
+    pixels = np.asarray(pixels, dtype=float).reshape(-1, 2)
+    pose = np.asarray(pose, dtype=float)
+    homogeneous = np.c_[pixels, np.ones(len(pixels))]
+    rays = (
+        homogeneous @ np.linalg.inv(intrinsics(camera, pose[ZOOM])).T @ rotation_world_to_camera(pose[PAN], pose[TILT])
+    )
+    down = rays[:, 2] < 0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        distance = np.where(down, -camera.centre_m[2] / rays[:, 2], np.nan)
+    return camera.centre_m[:2] + rays[:, :2] * distance[:, None]
+
+
 def standing_height_px(camera: PTZCamera, pose, height_m: float, feet_px) -> np.ndarray:
     """The image height (N,) px of a person ``height_m`` tall standing on feet pixels (N, 2) at ``pose``
     (3,): the distance from the feet to the projected head; NaN where the feet's ray meets the ground
