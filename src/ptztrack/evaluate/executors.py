@@ -14,19 +14,10 @@ from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from contextlib import contextmanager
 
-import cv2
 from tqdm import tqdm
 
 EXECUTORS = ("local", "ray", "serial")
-
-
-def _start_worker() -> None:
-    """A local worker ignores Ctrl-C (the whole process group gets it: the parent stops the workers) and
-    gives OpenCV one thread: the workers fill the cores already, and a second thread per worker only
-    competes with the other workers (the HOG Table 4 a priori: 4 min 14 s and 493 s of CPU with one
-    thread a worker, 4 min 32 s and 505 s with two, the same rows)."""
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    cv2.setNumThreads(1)
+_IGNORE_CTRL_C = (signal.SIGINT, signal.SIG_IGN)
 
 
 def run_cells(
@@ -53,7 +44,8 @@ def run_cells(
             rows[index] = run(cell)
             report(index + 1, len(cells))
     elif executor == "local":
-        pool = ProcessPoolExecutor(workers or os.cpu_count(), initializer=_start_worker)
+        # Ctrl-C reaches the whole process group: the workers ignore it, and this process stops them.
+        pool = ProcessPoolExecutor(workers or os.cpu_count(), initializer=signal.signal, initargs=_IGNORE_CTRL_C)
         try:
             futures = {pool.submit(run, cell): index for index, cell in enumerate(cells)}
             for done, future in enumerate(as_completed(futures), start=1):
