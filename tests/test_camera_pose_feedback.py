@@ -12,6 +12,7 @@ from ptztrack.config import LiveView, PoseError, ScenarioError, pets_scenario, s
 from ptztrack.evaluate.metrics import episode_metrics
 from ptztrack.evaluate.registration import summarise_registration
 from ptztrack.geometry.registration import register
+from ptztrack.types import Detections
 
 # Small enough to build in seconds, large enough to register most views (13 references at 480 x 360).
 SMALL_REGISTRATION = {
@@ -178,3 +179,24 @@ def test_the_camera_stays_put_while_the_command_does_not_change():
     episode = run_episode(scenario, "fix", 0)
     assert len(np.unique(episode.poses, axis=0)) == 1
     assert np.abs(episode.poses - episode.tracker_poses).max() > 0
+
+
+class PoseRecordingDetector:
+    """Sees nobody; records the pose of each view and the pose the system believed."""
+
+    def __init__(self):
+        self.poses, self.believed = [], []
+
+    def detect(self, camera, step, pose, rng, believed_pose=None):
+        self.poses.append(np.array(pose))
+        self.believed.append(np.array(believed_pose))
+        return Detections.empty()
+
+
+def test_the_detector_sees_the_view_where_the_camera_landed_and_is_told_only_the_trackers_pose():
+    scenario = scenario_from_dict({"frames": 8, "camera": {"pose_error": {"pan_tilt_sigma_deg": 1.0}}})
+    detector = PoseRecordingDetector()
+    episode = run_episode(scenario, "fix", 0, detector=detector)
+    np.testing.assert_array_equal(detector.poses, episode.poses)
+    np.testing.assert_array_equal(detector.believed, episode.tracker_poses)
+    assert np.abs(np.array(detector.poses) - np.array(detector.believed)).max() > 0

@@ -273,3 +273,19 @@ def test_scanning_the_levels_on_threads_finds_the_same_windows(hog_world):
     assert len(alone[0]) > 0
     np.testing.assert_array_equal(threaded[0], alone[0])
     np.testing.assert_array_equal(threaded[1], alone[1])
+
+
+def test_the_search_is_planned_at_the_believed_pose_not_at_the_pose_the_camera_took(hog_world, monkeypatch):
+    """The camera is where it was told to be (the view holds people), but the system believes it is
+    looking 40 degrees off in tilt, where no walkable ground is in view: a search planned there scans
+    nothing and finds nobody."""
+    monkeypatch.setattr("ptztrack.detect.hog._BOXES_SEEN", {})
+    backend, detector = hog_world.backend, hog_world.detector
+    pose = whole_frame_at_zoom(hog_world, 0)
+    skyward = pose - [0.0, 40.0, 0.0]
+    assert detector.search.bands(skyward, 6.0, (960, 720)) == []
+    found = detector.detect(backend, 3, pose, np.random.default_rng(0))
+    believed_sky = detector.detect(backend, 3, pose, np.random.default_rng(0), believed_pose=skyward)
+    believed_true = detector.detect(backend, 3, pose, np.random.default_rng(0), believed_pose=pose)
+    assert len(found) >= 1 and len(believed_sky) == 0
+    np.testing.assert_array_equal(believed_true.feet_px, found.feet_px)

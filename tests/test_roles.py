@@ -59,7 +59,7 @@ class DarkBlobDetector:
 
     name = "dark blobs"
 
-    def detect(self, camera, step, pose, rng):
+    def detect(self, camera, step, pose, rng, believed_pose=None):
         image = camera.image(step, pose)
         dark = (image[..., 0] < (BACKGROUND + PERSON) // 2).astype(np.uint8)
         count, _, stats, _ = cv2.connectedComponentsWithStats(dark)

@@ -141,7 +141,9 @@ def run_loop(
         tracker_pose = commanded if believed is None else believed
         detections = None
         if tracker.wants_detections(step):
-            detections = world.detector.detect(world.backend, step, pose, np.random.default_rng(frame_seeds[step]))
+            detections = world.detector.detect(
+                world.backend, step, pose, np.random.default_rng(frame_seeds[step]), believed_pose=tracker_pose
+            )
         update = tracker.update(detections, tracker_pose, partial(world.backend.image, step, pose))
         measured = update.measurements if update.measurements is not None else detections
         record = {

@@ -38,8 +38,18 @@ class CameraBackend(Protocol):
 class Detector(Protocol):
     """Finds people in what a camera shows."""
 
-    def detect(self, camera: CameraBackend, step: int, pose: np.ndarray, rng: np.random.Generator) -> Detections:
-        """Detections at ``pose``; ``rng`` is the step's own stream (draw only from it)."""
+    def detect(
+        self,
+        camera: CameraBackend,
+        step: int,
+        pose: np.ndarray,
+        rng: np.random.Generator,
+        believed_pose: np.ndarray | None = None,
+    ) -> Detections:
+        """Detections in the view at ``pose``, where the camera is; ``rng`` is the step's own stream (draw
+        only from it). ``believed_pose`` is the pose the system takes the camera to be at (its pose
+        source's, else the commanded one; None: ``pose``): a detector that plans where to look plans
+        there, since only a simulation knows ``pose``."""
         ...
 
 

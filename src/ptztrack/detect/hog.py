@@ -168,18 +168,23 @@ class HogPeopleDetector:
         self._hog.setSVMDetector(cv2.HOGDescriptor.getDefaultPeopleDetector())
         self._settings = (self.upsample, self.hit_threshold, self.nms_iou, self.search and self.search.key)
 
-    def detect(self, camera: CameraBackend, step: int, pose, rng: np.random.Generator) -> Detections:
-        """People in the camera's view at ``pose``: feet and heights from the boxes, SVM scores. A view
-        seen before (the same image at the same pose) gives the boxes found then (``MEMO_VIEWS``)."""
+    def detect(
+        self, camera: CameraBackend, step: int, pose, rng: np.random.Generator, believed_pose=None
+    ) -> Detections:
+        """People in the camera's view at ``pose``: feet and heights from the boxes, SVM scores. The
+        search is planned at ``believed_pose`` (None: ``pose``), the pose the system takes the camera
+        to be at. A view seen before (the same image, searched from the same pose) gives the boxes
+        found then (``MEMO_VIEWS``)."""
         image = camera.image(step, pose)
         if image is None:
             raise RuntimeError("the HOG detector needs a camera backend that renders images")
+        planned_at = pose if believed_pose is None else believed_pose
         image = np.ascontiguousarray(image)
         digest = hashlib.blake2b(image.data, digest_size=16).digest()
-        key = (self._settings, np.asarray(pose, dtype=float).tobytes(), image.shape, digest)
+        key = (self._settings, np.asarray(planned_at, dtype=float).tobytes(), image.shape, digest)
         found = _BOXES_SEEN.get(key)
         if found is None:
-            found = self.boxes(image, pose)
+            found = self.boxes(image, planned_at)
             if len(_BOXES_SEEN) >= MEMO_VIEWS:
                 del _BOXES_SEEN[next(iter(_BOXES_SEEN))]
             _BOXES_SEEN[key] = found

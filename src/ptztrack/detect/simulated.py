@@ -82,7 +82,9 @@ class RecallDetector:
     false_positives_per_frame: float
     image_size_px: tuple[int, int]
 
-    def detect(self, camera: CameraBackend, step: int, pose, rng: np.random.Generator) -> Detections:
+    def detect(
+        self, camera: CameraBackend, step: int, pose, rng: np.random.Generator, believed_pose=None
+    ) -> Detections:
         """The draws for every person are made whether or not it is in view, in a fixed order, so that
         for one generator state the luck of each person does not depend on the pose (common random
         numbers across policies)."""
@@ -110,7 +112,9 @@ class AnnotationDetector:
     pixel_noise_px: float
     occluded_above: float
 
-    def detect(self, camera: CameraBackend, step: int, pose, rng: np.random.Generator) -> Detections:
+    def detect(
+        self, camera: CameraBackend, step: int, pose, rng: np.random.Generator, believed_pose=None
+    ) -> Detections:
         people = _need_people(camera, step, pose)
         noise_px = rng.normal(0.0, self.pixel_noise_px, size=people.feet_px.shape)
         seen = np.flatnonzero(people.in_view & (people.hidden <= self.occluded_above))
