@@ -293,7 +293,7 @@ def height_log_prior(states, standing_height_px: StandingHeight, log_sigma: floa
     """Log prior (n,) of states (n, 3): ``-z^2 / 2``, ``z = ln(h / h_standing) / log_sigma``, h_standing the
     height of a person standing on the box's bottom centre; a box whose feet no one can stand on
     (beyond the horizon) counts as ``MAX_HEIGHT_Z`` spreads off."""
-    feet_px = states[:, :2] + np.c_[np.zeros(len(states)), states[:, 2] / 2]
+    feet_px = np.c_[states[:, 0], states[:, 1] + states[:, 2] / 2]
     with np.errstate(divide="ignore", invalid="ignore"):
         z = np.log(states[:, 2] / standing_height_px(feet_px)) / log_sigma
     return -0.5 * np.minimum(np.nan_to_num(z, nan=MAX_HEIGHT_Z) ** 2, MAX_HEIGHT_Z**2)
