@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from ptztrack.builders.experiments import recording_cells
+from ptztrack.builders.experiments import recording_cells, shared_views_key
 from ptztrack.builders.pets import fit_detector, halves, protocol_folds
 from ptztrack.builders.world import build_scene
 from ptztrack.geometry.area import inside
@@ -63,3 +63,20 @@ def test_only_runs_that_depend_on_their_seed_run_several_seeds(tmp_path):
     ]  # fmt: skip
     ideal = recording_cells(excerpt_scenario(tmp_path), [1.0], ["fix"], seeds=3)
     assert [cell.seed for cell in ideal] == [0, 1, 2]
+
+
+def test_the_information_gain_runs_of_one_fold_and_beta_share_their_views_and_no_other_runs_do(tmp_path):
+    hog = excerpt_scenario(tmp_path, **{"detector.kind": "hog", "recording.video": str(EXCERPT / "View_001.avi")})
+    cells = [
+        cell for fold in (0, 1) for cell in recording_cells(hog, [9.0, 1.0], ["fix", "rnd", "intg", "smpl"], 3, fold)
+    ]
+    groups: dict = {}
+    for cell in cells:
+        groups.setdefault(shared_views_key(cell), []).append((cell.fold, cell.column, cell.seed))
+    shared = sorted(group for group in groups.values() if len(group) > 1)
+    assert shared == [
+        [(fold, f"{strategy} b{beta}", seed) for strategy, seed in [("intg", 0), ("smpl", 0), ("smpl", 1), ("smpl", 2)]]
+        for fold in (0, 1)
+        for beta in (1, 9)
+    ]
+    assert sum(map(len, groups.values())) == len(cells) == 2 * (1 + 3 + 2 * 4)

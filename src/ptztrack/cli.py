@@ -24,6 +24,7 @@ from ptztrack.builders.experiments import (
     registration_views,
     run_cell,
     run_closed_loop_cell,
+    shared_views_key,
     synthetic_cells,
 )
 from ptztrack.builders.follow import FOLLOW_TRACKERS
@@ -351,10 +352,11 @@ def serve_camera_command(args: argparse.Namespace) -> int:
     return 0
 
 
-def _run_cells(args: argparse.Namespace, cells: list, run, noun: str = "episode") -> list:
-    """An experiment's cells on ``--executor``, with a progress bar (none with ``--quiet`` or off a terminal)."""
+def _run_cells(args: argparse.Namespace, cells: list, run, noun: str = "episode", together=None) -> list:
+    """An experiment's cells on ``--executor``, with a progress bar (none with ``--quiet`` or off a terminal);
+    ``together`` as :func:`run_cells`'."""
     with Progress(noun, args.quiet) as progress:
-        return run_cells(cells, run, args.executor, args.workers, progress)
+        return run_cells(cells, run, args.executor, args.workers, progress, together)
 
 
 def msg_experiment_command(args: argparse.Namespace) -> int:
@@ -500,16 +502,21 @@ def pets_experiment_command(args: argparse.Namespace) -> int:
         f"{args.seeds} seeds where a run depends on its seed (MOTA +- standard deviation over seeds and folds)"
     )
     extra = {"protocol": args.protocol, "fitted": [fold.fitted for fold in folds]}
-    return _run_table(args, cells, title, "mota_sd", extra)
+    return _run_table(args, cells, title, "mota_sd", extra, together=shared_views_key)
 
 
 def _run_table(
-    args: argparse.Namespace, cells: list, title: str, spread: str = "mota_se", extra: dict | None = None
+    args: argparse.Namespace,
+    cells: list,
+    title: str,
+    spread: str = "mota_se",
+    extra: dict | None = None,
+    together=None,
 ) -> int:
     print(f"{len(cells)} episodes, {args.executor} executor", file=sys.stderr)
     runs_at_once = 1 if args.executor == "serial" else min(len(cells), args.workers or os.cpu_count() or 1)
     refuse_if_too_large(cells[0].scenario, tuple(args.strategies), runs_at_once)
-    summary = summarise(_run_cells(args, cells, run_cell))
+    summary = summarise(_run_cells(args, cells, run_cell, together=together))
     summary = [{**row, **(extra or {})} for row in summary]
     print(format_table(summary, title, spread))
     labels = {row["label"] for row in summary}

@@ -121,6 +121,17 @@ def recording_cells(
     ]
 
 
+def shared_views_key(cell: Cell) -> tuple:
+    """A key that the cells of a recording table which look at mostly the same views share (for
+    ``run_cells``' ``together``): the information-gain strategies of one fold and beta, whose runs differ
+    only in their seed (smpl's Monte Carlo samples) or in how the same objective is computed (intg), so
+    that most of their steps choose the same action as each other. Every other cell has a key of its own.
+    """
+    if cell.strategy in INFORMATION_STRATEGIES:
+        return (cell.fold, cell.scenario.control.beta)
+    return (cell.fold, cell.column, cell.seed)
+
+
 def cell_policy(cell: Cell) -> PolicySpec:
     """The policy spec a cell runs: its registered name, or a fresh copy of its object."""
     if isinstance(cell.strategy, str):

@@ -10,10 +10,11 @@ import multiprocessing
 import os
 import signal
 import sys
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Hashable, Iterator, Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from contextlib import contextmanager
 
+import cv2
 from tqdm import tqdm
 
 EXECUTORS = ("local", "ray", "serial")
@@ -26,40 +27,77 @@ def run_cells(
     executor: str = "local",
     workers: int | None = None,
     progress: Callable[[int, int], None] | None = None,
+    together: Callable[[object], Hashable] | None = None,
 ) -> list:
     """Run every cell with ``run`` (a module-level function, so that it pickles) and return the results
     in cell order.
 
-    executor : 'local' (a process pool of ``workers``, default all cores),
-    'ray' (tasks on the Ray cluster ``ray.init()`` connects to, a local one
-    by default; needs the ``ray`` extra), or 'serial' (this process).
+    executor : 'local' (a process pool of ``workers``, default all cores), 'ray' (tasks on the Ray
+    cluster ``ray.init()`` connects to, a local one by default; needs the ``ray`` extra), or 'serial'
+    (this process).
     progress : called with (cells done, cells in all) as cells finish.
+    together : a key of a cell (None: every cell on its own). The cells of one key run one after the
+    other in one task, so in one process, which keeps what they share (the HOG detector's memo of the
+    views it has searched); the tasks with the most cells start first.
     """
     if executor not in EXECUTORS:
         raise ValueError(f"unknown executor {executor!r}; expected one of {', '.join(EXECUTORS)}")
     report = progress or (lambda done, total: None)
+    groups: dict[Hashable, list[int]] = {}
+    for index, cell in enumerate(cells):
+        groups.setdefault(index if together is None else together(cell), []).append(index)
+    tasks = sorted(groups.values(), key=len, reverse=True)
     rows: list = [None] * len(cells)
-    if executor == "serial":
-        for index, cell in enumerate(cells):
-            rows[index] = run(cell)
-            report(index + 1, len(cells))
-    elif executor == "local":
-        # Ctrl-C reaches the whole process group: the workers ignore it, and this process stops them.
-        pool = ProcessPoolExecutor(workers or os.cpu_count(), initializer=signal.signal, initargs=_IGNORE_CTRL_C)
-        try:
-            futures = {pool.submit(run, cell): index for index, cell in enumerate(cells)}
-            for done, future in enumerate(as_completed(futures), start=1):
-                rows[futures[future]] = future.result()
-                report(done, len(cells))
-        except BaseException:
-            pool.shutdown(wait=False, cancel_futures=True)
-            for worker in multiprocessing.active_children():
-                worker.terminate()
-            raise
-        pool.shutdown()
-    else:
-        rows = _run_on_ray(cells, report, run)
+    done = 0
+    for task, task_rows in _run_tasks([[cells[index] for index in task] for task in tasks], run, executor, workers):
+        for index, row in zip(tasks[task], task_rows, strict=True):
+            rows[index] = row
+        done += len(task_rows)
+        report(done, len(cells))
     return rows
+
+
+def _run_together(run: Callable, cells: Sequence) -> list:
+    """One task of :func:`run_cells`: its cells, one after the other."""
+    return [run(cell) for cell in cells]
+
+
+def _run_tasks(tasks: list[list], run: Callable, executor: str, workers: int | None) -> Iterator[tuple[int, list]]:
+    """(task index, its rows) for every task of :func:`run_cells`, as the tasks finish."""
+    if executor == "serial":
+        for task, cells in enumerate(tasks):
+            yield task, _run_together(run, cells)
+    elif executor == "local":
+        yield from _run_on_processes(tasks, run, workers)
+    else:
+        yield from _run_on_ray(tasks, run)
+
+
+def _run_on_processes(tasks: list[list], run: Callable, workers: int | None) -> Iterator[tuple[int, list]]:
+    """The tasks on a pool of forked processes, each with one OpenCV thread.
+
+    The pool fills the cores with processes, so OpenCV's own threads in each would only compete for
+    them. A forked worker cannot set its own: ``cv2.setNumThreads`` there waits forever for the
+    parent's thread pool, which the fork did not copy (it hung whenever this process had used OpenCV's
+    threads before the pool, as the two-fold PETS fits do). So this process sets one thread while it
+    forks the workers, which inherit it, and sets its own back after.
+    """
+    threads = cv2.getNumThreads()
+    cv2.setNumThreads(1)
+    # Ctrl-C reaches the whole process group: the workers ignore it, and this process stops them.
+    pool = ProcessPoolExecutor(workers or os.cpu_count(), initializer=signal.signal, initargs=_IGNORE_CTRL_C)
+    try:
+        futures = {pool.submit(_run_together, run, cells): task for task, cells in enumerate(tasks)}
+        for future in as_completed(futures):
+            yield futures[future], future.result()
+    except BaseException:
+        pool.shutdown(wait=False, cancel_futures=True)
+        for worker in multiprocessing.active_children():
+            worker.terminate()
+        raise
+    finally:
+        cv2.setNumThreads(threads)
+    pool.shutdown()
 
 
 # A local Ray cluster started by ptztrack stays on the loopback interface.
@@ -91,7 +129,7 @@ def _environment(values: dict[str, str]) -> Iterator[None]:
         os.environ.update(saved)
 
 
-def _run_on_ray(cells: Sequence, report: Callable[[int, int], None], run: Callable) -> list:
+def _run_on_ray(tasks: list[list], run: Callable) -> Iterator[tuple[int, list]]:
     """Run on the Ray cluster of ``RAY_ADDRESS`` or of an earlier ``ray.init()``; else start a local one.
 
     A local cluster is kept on the loopback interface only if Ray is first
@@ -115,15 +153,12 @@ def _run_on_ray(cells: Sequence, report: Callable[[int, int], None], run: Callab
                 )
             else:
                 ray.init(log_to_driver=False)
-    remote_cell = ray.remote(run)
-    pending = {remote_cell.remote(cell): index for index, cell in enumerate(cells)}
-    rows: list = [None] * len(cells)
+    remote_task = ray.remote(_run_together)
+    pending = {remote_task.remote(run, cells): task for task, cells in enumerate(tasks)}
     remaining = list(pending)
     while remaining:
         finished, remaining = ray.wait(remaining, num_returns=1)
-        rows[pending[finished[0]]] = ray.get(finished[0])
-        report(len(cells) - len(remaining), len(cells))
-    return rows
+        yield pending[finished[0]], ray.get(finished[0])
 
 
 class Progress:
