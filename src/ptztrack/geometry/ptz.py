@@ -135,15 +135,10 @@ def pixels_to_ground(camera: PTZCamera, pose, pixels) -> np.ndarray:
     ray, extended backwards, meets the ground; here such pixels see no ground.
     """
     pixels = np.asarray(pixels, dtype=float).reshape(-1, 2)
-    pose = np.asarray(pose, dtype=float)
-    homogeneous = np.c_[pixels, np.ones(len(pixels))]
-    rays = (
-        homogeneous @ np.linalg.inv(intrinsics(camera, pose[ZOOM])).T @ rotation_world_to_camera(pose[PAN], pose[TILT])
-    )
-    down = rays[:, 2] < 0
     with np.errstate(divide="ignore", invalid="ignore"):
-        distance = np.where(down, -camera.centre_m[2] / rays[:, 2], np.nan)
-    return camera.centre_m[:2] + rays[:, :2] * distance[:, None]
+        ground_m = apply_homography(image_to_ground(camera, pose), pixels)
+        in_front = camera_depth_m(camera, pose, np.c_[ground_m, np.zeros(len(ground_m))]) > 0
+    return np.where(in_front[:, None], ground_m, np.nan)
 
 
 def standing_height_px(camera: PTZCamera, pose, height_m: float, feet_px) -> np.ndarray:
@@ -151,11 +146,10 @@ def standing_height_px(camera: PTZCamera, pose, height_m: float, feet_px) -> np.
     (3,): the distance from the feet to the projected head; NaN where the feet's ray meets the ground
     behind the camera (above the horizon) or the head is behind it."""
     feet_px = np.asarray(feet_px, dtype=float)
-    ground_m = apply_homography(image_to_ground(camera, pose), feet_px)
+    ground_m = pixels_to_ground(camera, pose, feet_px)
     head_px = apply_homography(plane_homography(camera, pose, height_m), ground_m)
-    feet_m, head_m = (np.c_[ground_m, np.full(len(ground_m), z)] for z in (0.0, height_m))
-    in_front = (camera_depth_m(camera, pose, feet_m) > 0) & (camera_depth_m(camera, pose, head_m) > 0)
-    return np.where(in_front, np.linalg.norm(head_px - feet_px, axis=-1), np.nan)
+    head_in_front = camera_depth_m(camera, pose, np.c_[ground_m, np.full(len(ground_m), height_m)]) > 0
+    return np.where(head_in_front, np.linalg.norm(head_px - feet_px, axis=-1), np.nan)
 
 
 def homography_jacobian(H, points) -> np.ndarray:
