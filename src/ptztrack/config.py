@@ -411,8 +411,13 @@ class Follow(_Strict):
     walking person (K / 3: 1.0 chosen for three patches on the even-numbered PETS people; see the README).
     walk_heights_per_s : random-walk spread of the box position, box heights per second;
     scale_change_per_s : relative random-walk spread of its height per second.
-    prediction : 'constant_velocity' (the random walk about the person's image velocity, averaged
-    with the output filter's cut-off ``smoothing_cutoff_hz``) or 'random_walk' (the paper's, no drift).
+    prediction : 'particle_velocity' (every particle carries its own image velocity, changed each step
+    by a white acceleration: the nearly-constant-velocity model), 'constant_velocity' (the random walk
+    about the estimate's image velocity, averaged with the output filter's cut-off
+    ``smoothing_cutoff_hz``) or 'random_walk' (the paper's, no drift).
+    acceleration_heights_per_s2 : the particles' white acceleration (with 'particle_velocity'), box
+    heights per second squared; initial_speed_heights_per_s : the spread of their velocities per axis
+    when the person's velocity is not known (the first step, the diffuse prior after a loss).
     loss_fraction, adapt_fraction : the loss test (P < loss_fraction P_ref) and when P_ref adapts.
     reference_time_constant_s : how slowly P_ref adapts.
     search_heights : spread of the diffuse prior after a loss, in box heights; search_scale : of its height.
@@ -448,7 +453,9 @@ class Follow(_Strict):
     lambda_motion: Annotated[PositiveFloat, at_most(1e6, "a likelihood scale")] = 0.434
     walk_heights_per_s: Annotated[PositiveFloat, at_most(1000, "box heights per second")] = 1.0
     scale_change_per_s: Annotated[PositiveFloat, at_most(100, "per second")] = 0.2
-    prediction: Literal["constant_velocity", "random_walk"] = "constant_velocity"
+    prediction: Literal["constant_velocity", "particle_velocity", "random_walk"] = "particle_velocity"
+    acceleration_heights_per_s2: Annotated[PositiveFloat, at_most(1000, "box heights per second squared")] = 1.0
+    initial_speed_heights_per_s: Annotated[PositiveFloat, at_most(1000, "box heights per second")] = 0.75
     loss_fraction: Fraction = 0.1
     adapt_fraction: Fraction = 0.6
     reference_time_constant_s: Annotated[PositiveFloat, at_most(86_400, "seconds")] = 2.0

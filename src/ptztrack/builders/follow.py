@@ -41,6 +41,10 @@ def particle_filter_parameters(scenario: Scenario) -> ParticleFilterParameters:
         walk_sigma=follow.walk_heights_per_s * step_s,
         scale_sigma=follow.scale_change_per_s * step_s,
         velocity_gain=1.0 - smoothing_pole(scenario) if follow.prediction == "constant_velocity" else 0.0,
+        acceleration_sigma=(
+            follow.acceleration_heights_per_s2 * step_s**2 if follow.prediction == "particle_velocity" else None
+        ),
+        initial_speed_sigma=follow.initial_speed_heights_per_s * step_s,
         loss_fraction=follow.loss_fraction,
         adapt_fraction=follow.adapt_fraction,
         reference_rate=min(1.0, step_s / follow.reference_time_constant_s),

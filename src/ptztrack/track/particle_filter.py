@@ -104,6 +104,10 @@ class ParticleFilterParameters:
     person standing on the box's feet (the height prior, see the module); None: no prior, the paper's.
     walk_sigma : random-walk step of x and y in box heights; scale_sigma : relative step of h.
     velocity_gain : the weight of the last step in the velocity's exponential average; 0: no velocity.
+    acceleration_sigma : box heights per step^2: every particle carries its own velocity, changed each
+    step by this white acceleration (the nearly-constant-velocity model); None: the particles share the
+    estimate's velocity (``velocity_gain``). initial_speed_sigma : box heights per step, the spread of
+    the particles' velocities at the first step and of the diffuse prior's.
     loss_fraction, adapt_fraction, reference_rate : the loss test and the adaptation of ``P_ref``.
     search_sigma, search_scale_sigma : the diffuse prior after a loss (see the module).
     motion_threshold : grey levels; motion_decay : per step; motion_scale : resolution of the motion image.
@@ -123,6 +127,8 @@ class ParticleFilterParameters:
     walk_sigma: float
     scale_sigma: float
     velocity_gain: float
+    acceleration_sigma: float | None
+    initial_speed_sigma: float
     loss_fraction: float
     adapt_fraction: float
     reference_rate: float
@@ -142,7 +148,8 @@ class ParticleFilter:
     reference : (K, B) the patches' reference histograms (B bins), weighted by ``bin_weights`` (B,)
     as every candidate's are; aspect : box width / height.
     reference_likelihood : P_ref (None before the first step); lost_steps : steps lost (0 while tracking).
-    motion : the motion history image; velocity_px : (2,) the estimate's velocity, px per step.
+    motion : the motion history image; velocity_px : (2,) the estimate's velocity, px per step;
+    particle_velocities_px : (P, 2) each particle's velocity, px per step (with ``acceleration_sigma``).
     """
 
     particles: np.ndarray
@@ -156,6 +163,7 @@ class ParticleFilter:
     lost_steps: int
     motion: MotionImage
     velocity_px: np.ndarray
+    particle_velocities_px: np.ndarray
 
     @property
     def lost(self) -> bool:
@@ -215,6 +223,7 @@ def start_filter(image_bgr, box_px, parameters: ParticleFilterParameters) -> Par
         lost_steps=0,
         motion=first_motion_image(image_bgr, parameters.motion_scale),
         velocity_px=np.zeros(2),
+        particle_velocities_px=np.zeros((parameters.particles, 2)),
     )
 
 
@@ -235,19 +244,24 @@ def step_filter(
     )
     last = carry_states(state.estimate, homography)
     carried = carry_states(state.particles, homography)
-    # The velocity carried into this view: where the estimate's next position maps, less where it maps.
+    # A velocity carried into this view: where the next position maps, less where the position maps.
     velocity_px = carry_states(state.estimate + np.r_[state.velocity_px, 0.0], homography)[:2] - last[:2]
+    moved = np.c_[state.particles[:, :2] + state.particle_velocities_px, state.particles[:, 2]]
+    velocities = carry_states(moved, homography)[:, :2] - carried[:, :2]
+    if state.reference_likelihood is None:  # the first step: the person's velocity is not known yet
+        velocities = _initial_velocities(carried, parameters, rng)
     if state.lost:
-        kept = parameters.search_particles // 2
-        chosen = carried[systematic_resample(state.weights, kept, rng)]
+        kept = systematic_resample(state.weights, parameters.search_particles // 2, rng)
         image_size_px = image_bgr.shape[1::-1]
         fresh = _diffuse_prior(
-            last, state.lost_steps, parameters.search_particles - kept, image_size_px, parameters, rng
+            last, state.lost_steps, parameters.search_particles - len(kept), image_size_px, parameters, rng
         )
-        particles = np.vstack([_random_walk(chosen, parameters.walk_sigma, parameters.scale_sigma, rng), fresh])
+        particles, velocities = predict_states(carried[kept], velocities[kept], np.zeros(2), parameters, rng)
+        particles = np.vstack([particles, fresh])
+        velocities = np.vstack([velocities, _initial_velocities(fresh, parameters, rng)])
     else:
-        chosen = carried[systematic_resample(state.weights, parameters.particles, rng)] + np.r_[velocity_px, 0.0]
-        particles = _random_walk(chosen, parameters.walk_sigma, parameters.scale_sigma, rng)
+        chosen = systematic_resample(state.weights, parameters.particles, rng)
+        particles, velocities = predict_states(carried[chosen], velocities[chosen], velocity_px, parameters, rng)
     # The weighted mean's box lies within the particles' boxes' extent: one region of bins serves both.
     region = _ColourRegion.of(image_bgr, particles, state.aspect, parameters)
     colour = region.log_likelihood(particles, state, parameters)
@@ -270,12 +284,15 @@ def step_filter(
     lost_steps = 0 if found else state.lost_steps + 1
     if state.lost or lost_steps:
         velocity_px = np.zeros(2)
+    elif parameters.acceleration_sigma is not None:
+        velocity_px = weights @ velocities
     else:
         gain = parameters.velocity_gain
         velocity_px = gain * (estimate[:2] - last[:2]) + (1 - gain) * velocity_px
     if state.lost and found:
         survivors = systematic_resample(weights, parameters.particles, rng)
-        particles, weights = particles[survivors], np.full(parameters.particles, 1.0 / parameters.particles)
+        particles, velocities = particles[survivors], velocities[survivors]
+        weights = np.full(parameters.particles, 1.0 / parameters.particles)
     return replace(
         state,
         particles=particles,
@@ -286,6 +303,7 @@ def step_filter(
         lost_steps=lost_steps,
         motion=motion,
         velocity_px=velocity_px,
+        particle_velocities_px=velocities,
     )
 
 
@@ -297,6 +315,26 @@ def height_log_prior(states, standing_height_px: StandingHeight, log_sigma: floa
     with np.errstate(divide="ignore", invalid="ignore"):
         z = np.log(states[:, 2] / standing_height_px(feet_px)) / log_sigma
     return -0.5 * np.minimum(np.nan_to_num(z, nan=MAX_HEIGHT_Z) ** 2, MAX_HEIGHT_Z**2)
+
+
+def predict_states(states, velocities, shared_velocity_px, parameters, rng: np.random.Generator):
+    """States (P, 3) and their velocities (P, 2) one step on. With ``acceleration_sigma``, each particle
+    moves by its own velocity, which a white acceleration changes (the nearly-constant-velocity model);
+    otherwise every particle moves by the shared velocity (2,) plus equation 1's random walk."""
+    if parameters.acceleration_sigma is None:
+        moved = states + np.r_[shared_velocity_px, 0.0]
+        return _random_walk(moved, parameters.walk_sigma, parameters.scale_sigma, rng), np.zeros_like(velocities)
+    acceleration_px = parameters.acceleration_sigma * states[:, 2:] * rng.standard_normal(velocities.shape)
+    moved = np.c_[states[:, :2] + velocities + acceleration_px / 2, states[:, 2]]
+    return _random_walk(moved, 0.0, parameters.scale_sigma, rng), velocities + acceleration_px
+
+
+def _initial_velocities(states, parameters, rng: np.random.Generator) -> np.ndarray:
+    """Velocities (n, 2) px per step for states (n, 3) whose person's velocity is not known: a walking
+    speed's spread, ``initial_speed_sigma`` box heights per step per axis (zero without own velocities)."""
+    if parameters.acceleration_sigma is None:
+        return np.zeros((len(states), 2))
+    return parameters.initial_speed_sigma * states[:, 2:] * rng.standard_normal((len(states), 2))
 
 
 def _random_walk(states, walk_sigma: float, scale_sigma: float, rng: np.random.Generator) -> np.ndarray:
