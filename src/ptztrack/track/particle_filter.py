@@ -14,9 +14,10 @@ Each step (:func:`step_filter`):
 
 1. resample the particles by their previous weights, deterministically
    (systematic resampling: one uniform draw, then evenly spaced);
-2. predict by a random walk (equation 1): Gaussian steps of ``walk_sigma``
-   box heights in x and y and a relative ``scale_sigma`` in h, about the
-   particles moved by the person's image velocity (see below);
+2. predict: every particle moves by its own image velocity, which a white
+   acceleration changes, and h by a relative ``scale_sigma`` (see below;
+   or the paper's random walk, equation 1: Gaussian steps of ``walk_sigma``
+   box heights in x and y);
 3. weigh by the product of the colour and motion likelihoods (equations 3-5;
    :mod:`ptztrack.track.colour_model`, :mod:`ptztrack.track.motion_image`),
    computed in logarithms so that no weight underflows;
@@ -47,11 +48,20 @@ The diffuse prior is Gaussian in x and y around the last estimate,
 
 Velocity. The paper's walk has no drift: a person who walks past another of
 similar colours leaves the particles to whichever of the two the random
-walk favours. Here the random walk is centred on a constant-velocity
-prediction: every particle moves by the estimate's velocity (px per step),
-an exponential average, with weight ``velocity_gain``, of the estimate's
-steps. ``velocity_gain`` 0 is the paper's walk; while lost, and when the
-track is back, the velocity is 0.
+walk favours. With ``acceleration_sigma`` every particle carries its own
+image velocity (``particle_velocities_px``), the nearly-constant-velocity
+model: each step a white acceleration, drawn per particle, changes its
+velocity and moves it by half as much more than its velocity
+(:func:`predict_states`). One velocity shared by all particles, the
+estimate's, would turn with the boxes a passer-by shares with the person
+and carry every particle his way; a particle's own velocity goes on with
+whichever of the two it followed, so the posterior splits and the
+person's particles stay. The velocities are spread over a walking speed
+(``initial_speed_sigma``) at the first step and for the diffuse prior's
+particles. Without ``acceleration_sigma`` the particles move by the
+estimate's velocity, an exponential average, with weight
+``velocity_gain``, of the estimate's steps (0 while lost and after a
+recovery), plus the random walk; ``velocity_gain`` 0 is the paper's walk.
 
 Height prior (not in the paper). Where the view is calibrated, a box's height is weighed against
 the height of a person standing on its bottom centre: a log-normal prior, ``ln(h / h_standing)``
