@@ -205,6 +205,15 @@ def carry_states(states, homography) -> np.ndarray:
     return np.concatenate([(top + bottom) / 2, np.linalg.norm(bottom - top, axis=-1, keepdims=True)], axis=-1)
 
 
+def carry_velocities(states, velocities_px, homography, carried_states) -> np.ndarray:
+    """Velocities (..., 2) px per step of states (..., 3) in the view that ``homography`` (3, 3) maps
+    them into, where they are ``carried_states`` (:func:`carry_states`): where the next position
+    maps, less where the position maps."""
+    states = np.asarray(states, dtype=float)
+    moved = np.concatenate([states[..., :2] + velocities_px, states[..., 2:]], axis=-1)
+    return carry_states(moved, homography)[..., :2] - carried_states[..., :2]
+
+
 def start_filter(image_bgr, box_px, parameters: ParticleFilterParameters) -> ParticleFilter:
     """A filter on the person in ``box_px`` (left, top, width, height) of the view (h, w, 3) uint8 BGR.
 
@@ -254,10 +263,8 @@ def step_filter(
     )
     last = carry_states(state.estimate, homography)
     carried = carry_states(state.particles, homography)
-    # A velocity carried into this view: where the next position maps, less where the position maps.
-    velocity_px = carry_states(state.estimate + np.r_[state.velocity_px, 0.0], homography)[:2] - last[:2]
-    moved = np.c_[state.particles[:, :2] + state.particle_velocities_px, state.particles[:, 2]]
-    velocities = carry_states(moved, homography)[:, :2] - carried[:, :2]
+    velocity_px = carry_velocities(state.estimate, state.velocity_px, homography, last)
+    velocities = carry_velocities(state.particles, state.particle_velocities_px, homography, carried)
     if state.reference_likelihood is None:  # the first step: the person's velocity is not known yet
         velocities = _initial_velocities(carried, parameters, rng)
     if state.lost:
