@@ -99,6 +99,7 @@ from ptztrack.loop import StepObserver
 from ptztrack.scene.roads import walk_roads
 
 RUN_FOLDER_FILES = (*RUN_FILES, VIEW_STATES_FILE)  # what run, follow and live write into --out
+DETECTOR_MODEL_FILE = "detector_model.json"  # and what run adds: the detector model as the run ended
 RUN_FIGURES = ("mota", "motp_m", "idf1", "height_px", "detections", "zoom", "switches")
 
 
@@ -109,16 +110,23 @@ def build_scenario(
     recording_paths: dict | None = None,
     association: str | None = None,
     measurement_source: str | None = None,
+    detector_model: str | None = None,
+    prior_shift_px: float | None = None,
 ) -> Scenario:
     """The built-in synthetic or PETS scene or a YAML file, with command-line overrides applied.
 
     recording_paths : {'video' | 'calibration' | 'ground_truth': path} replacing the recording's files.
     association : 'hungarian' or 'cjpdaf', replacing ``tracker.association``.
     measurement_source : 'detector' or 'spatiogram', replacing ``tracker.measurement_source``.
+    detector_model, prior_shift_px : replacing ``detector.model`` and ``detector.prior_shift_px``.
     """
     overrides: dict[str, object] = {
         f"recording.{key}": str(path) for key, path in (recording_paths or {}).items() if path is not None
     }
+    if detector_model is not None:
+        overrides["detector.model"] = detector_model
+    if prior_shift_px is not None:
+        overrides["detector.prior_shift_px"] = prior_shift_px
     if association is not None:
         overrides["tracker.association"] = association
     if measurement_source is not None:
@@ -145,7 +153,14 @@ def format_metrics(metrics: dict) -> str:
 
 def run_command(args: argparse.Namespace) -> int:
     scenario = build_scenario(
-        args.scenario, args.detector, args.frames, recording_paths(args), args.association, args.measurement_source
+        args.scenario,
+        args.detector,
+        args.frames,
+        recording_paths(args),
+        args.association,
+        args.measurement_source,
+        args.detector_model,
+        args.prior_shift_px,
     )
     refuse_if_too_large(scenario, (args.policy,))
     world = episode_world(scenario, args.seed)
@@ -164,7 +179,9 @@ def run_command(args: argparse.Namespace) -> int:
         with run_folder(args.out, args.overwrite) as folder:
             write_outputs(folder, episode, metrics, title, view_renderer(world))
             watch.write(folder)
-        print(f"wrote {', '.join(RUN_FOLDER_FILES)} into {args.out}")
+            if world.detector_model is not None:
+                world.detector_model.save(folder / DETECTOR_MODEL_FILE)
+        print(f"wrote {', '.join((*RUN_FOLDER_FILES, DETECTOR_MODEL_FILE))} into {args.out}")
     return 0
 
 
@@ -247,7 +264,7 @@ def _credentials(args: argparse.Namespace) -> dict | None:
 
 
 def live_command(args: argparse.Namespace) -> int:
-    scenario = build_scenario(args.scenario, args.detector)
+    scenario = build_scenario(args.scenario, args.detector, detector_model=args.detector_model)
     calibration = virtual_calibration() if args.calibration == "virtual" else load_camera_calibration(args.calibration)
     address = camera_address(args.camera, _credentials(args))
     steps = args.steps or scenario.frames
@@ -393,6 +410,7 @@ def registration_experiment_command(args: argparse.Namespace) -> int:
         recording_paths(args),
         args.association,
         args.measurement_source,
+        args.detector_model,
     )
     if scenario.recording is None or scenario.recording.video is None:
         raise ScenarioError(f"{args.scenario}: the registration experiment needs a recording with a video")
@@ -472,19 +490,33 @@ def _unless_failed(error: float | None) -> str:
 
 def synthetic_experiment_command(args: argparse.Namespace) -> int:
     scenario = build_scenario(
-        args.scenario, args.detector, args.frames, association=args.association, measurement_source=None
+        args.scenario,
+        args.detector,
+        args.frames,
+        association=args.association,
+        measurement_source=None,
+        detector_model=args.detector_model,
+        prior_shift_px=args.prior_shift_px,
     )
     cells = synthetic_cells(scenario, args.sequences, args.strategies)
     title = (
         f"{args.scenario} scene, {scenario.detector.kind} detector, beta {scenario.control.beta:g}, "
+        f"detector model {scenario.detector.model} (prior shifted {scenario.detector.prior_shift_px:g} px), "
         f"{args.sequences} sequences of {scenario.frames} frames (means over sequences)"
     )
-    return _run_table(args, cells, title)
+    model = {"detector_model": scenario.detector.model, "prior_shift_px": scenario.detector.prior_shift_px}
+    return _run_table(args, cells, title, extra=model)
 
 
 def pets_experiment_command(args: argparse.Namespace) -> int:
     scenario = build_scenario(
-        "pets", args.detector, args.frames, recording_paths(args), args.association, args.measurement_source
+        "pets",
+        args.detector,
+        args.frames,
+        recording_paths(args),
+        args.association,
+        args.measurement_source,
+        args.detector_model,
     )
     folds = protocol_folds(scenario, args.protocol)
     for fold in folds:
@@ -498,10 +530,15 @@ def pets_experiment_command(args: argparse.Namespace) -> int:
         for cell in recording_cells(fold.scenario, betas, args.strategies, args.seeds, fold.index)
     ]
     title = (
-        f"PETS 2009 S2.L1 View_001, {scenario.detector.kind} detector, every 2nd frame, protocol {args.protocol}, "
+        f"PETS 2009 S2.L1 View_001, {scenario.detector.kind} detector ({scenario.detector.model} model), every 2nd "
+        f"frame, protocol {args.protocol}, "
         f"{args.seeds} seeds where a run depends on its seed (MOTA +- standard deviation over seeds and folds)"
     )
-    extra = {"protocol": args.protocol, "fitted": [fold.fitted for fold in folds]}
+    extra = {
+        "protocol": args.protocol,
+        "fitted": [fold.fitted for fold in folds],
+        "detector_model": scenario.detector.model,
+    }
     return _run_table(args, cells, title, "mota_sd", extra, together=shared_views_key)
 
 
@@ -657,6 +694,17 @@ def parser() -> argparse.ArgumentParser:
     )
     run.add_argument("--policy", choices=policies, default="smpl")
     run.add_argument("--detector", choices=detectors, help="overrides the scenario's detector")
+    run.add_argument(
+        "--prior-shift-px",
+        type=float,
+        help="shifts the prior recall curve's r0 by this many pixels from the detector's own (a test of the learning)",
+    )
+    run.add_argument(
+        "--detector-model",
+        help="what the policies and the tracker know of the detector: online (learned as the camera runs; the "
+        "default), a-priori (the prior curve, kept), true (a simulation's own curve) or an earlier run's "
+        "detector_model.json as the prior",
+    )
     run.add_argument("--seed", type=_non_negative_int, default=0)
     run.add_argument("--frames", type=_positive_int, help="overrides the scenario's number of frames")
     _add_tracker_arguments(run)
@@ -683,6 +731,17 @@ def parser() -> argparse.ArgumentParser:
     synthetic = experiments.add_parser("synthetic", help="the PTZ paper's Tables 1-2 on the synthetic scene")
     synthetic.add_argument("--scenario", default="synthetic", help="'synthetic' (built in) or a scenario YAML file")
     synthetic.add_argument("--detector", choices=detectors, default="realistic")
+    synthetic.add_argument(
+        "--prior-shift-px",
+        type=float,
+        help="shifts the prior recall curve's r0 by this many pixels from the detector's own (a test of the learning)",
+    )
+    synthetic.add_argument(
+        "--detector-model",
+        help="what the policies and the tracker know of the detector: online (learned as the camera runs; the "
+        "default), a-priori (the prior curve, kept), true (a simulation's own curve) or an earlier run's "
+        "detector_model.json as the prior",
+    )
     synthetic.add_argument("--sequences", type=_positive_int, default=12)
     synthetic.add_argument("--frames", type=_positive_int, help="overrides the scenario's number of frames")
     synthetic.add_argument("--strategies", nargs="+", choices=_strategies(policies), default=list(STRATEGIES))
@@ -692,6 +751,12 @@ def parser() -> argparse.ArgumentParser:
 
     pets = experiments.add_parser("pets", help="the PTZ paper's Tables 3-4 on PETS 2009 S2.L1")
     pets.add_argument("--detector", default="ideal", help="ideal (the annotations) or hog")
+    pets.add_argument(
+        "--detector-model",
+        help="what the policies and the tracker know of the detector: online (learned as the camera runs; the "
+        "default), a-priori (the prior curve, kept), true (a simulation's own curve) or an earlier run's "
+        "detector_model.json as the prior",
+    )
     pets.add_argument(
         "--beta",
         type=_non_negative_float,
@@ -737,6 +802,12 @@ def parser() -> argparse.ArgumentParser:
         help="exact pinhole views instead of the scenario's camera.live_view (default: the realistic model)",
     )
     registration.add_argument("--detector", choices=detectors, default="hog", help="closed-loop detector")
+    registration.add_argument(
+        "--detector-model",
+        help="what the policies and the tracker know of the detector: online (learned as the camera runs; the "
+        "default), a-priori (the prior curve, kept), true (a simulation's own curve) or an earlier run's "
+        "detector_model.json as the prior",
+    )
     registration.add_argument("--policy", choices=policies, default="smpl", help="closed-loop policy")
     registration.add_argument(
         "--pose-sources", nargs="+", choices=POSE_SOURCES, default=list(POSE_SOURCES), help="closed-loop pose sources"
@@ -774,6 +845,12 @@ def _add_camera_commands(commands, policies: list[str]) -> None:
     live.add_argument("--policy", choices=policies, default="smpl")
     live.add_argument("--scenario", default="pets", help="'pets' (built in) or a scenario YAML file")
     live.add_argument("--detector", default="hog", help="the scenario's detector (default hog)")
+    live.add_argument(
+        "--detector-model",
+        help="what the policies and the tracker know of the detector: online (learned as the camera runs; the "
+        "default), a-priori (the prior curve, kept), true (a simulation's own curve) or an earlier run's "
+        "detector_model.json as the prior",
+    )
     live.add_argument("--steps", type=_positive_int, help="at most this many steps (default: the scenario's frames)")
     live.add_argument("--time-scale", type=_positive_float, default=1.0, help="steps at the scenario's rate times this")
     live.add_argument("--timeout-s", type=_positive_float, default=5.0, help="the longest wait for any camera call")

@@ -236,12 +236,20 @@ class Actions(_Strict):
         return self
 
 
+# How the policies and the tracker know the detector: its prior curve fixed, learned from the run, or the
+# simulation's own curve (for comparison only); anything else names a detector_model.json to start from.
+DETECTOR_MODELS = ("a-priori", "online", "true")
+
+
 class Detector(_Strict):
     """The detector: simulated (ideal, realistic), OpenCV's HOG on a recording's virtual view, or any
     detector registered by another package (``options`` are its parameters).
 
-    The policies plan with recall 1 for 'ideal' and with the recall curve ``recall_kd``,
-    ``recall_r0_px`` (the paper's equation 13) for every other kind.
+    The policies plan with recall 1 for 'ideal'; for every other kind they start from the recall
+    curve ``recall_kd``, ``recall_r0_px`` (the paper's equation 13), its r0 shifted by
+    ``prior_shift_px``, and with ``model`` 'online' (the default) learn the curve as the camera runs
+    (:mod:`ptztrack.detect.detector_model`); 'a-priori' keeps the prior, 'true' plans with the
+    simulation's own curve, and a file path starts from what an earlier run learned.
 
     hog_search : 'ground' scans only the windows where a standing person ``hog_person_height_m``
     (shortest, tallest) tall could be seen on the walkable area, at their sizes; 'image' scans every
@@ -261,12 +269,28 @@ class Detector(_Strict):
     hog_nms_iou: float = Field(0.4, gt=0, le=1)
     hog_search: Literal["ground", "image"] = "ground"
     hog_person_height_m: tuple[_Height, _Height] = (1.5, 2.0)
+    model: str = "online"
+    prior_shift_px: Annotated[float, Field(ge=-1000, le=1000)] = 0.0
 
     @model_validator(mode="after")
     def _heights_ordered(self):
         low, high = self.hog_person_height_m
         if high < low:
             raise ValueError(f"hog_person_height_m must be [low, high] with low <= high (got {[low, high]})")
+        return self
+
+    @model_validator(mode="after")
+    def _model_known(self):
+        if self.model in DETECTOR_MODELS:
+            if self.model == "true" and self.kind not in ("ideal", "realistic"):
+                raise ValueError(
+                    f"model 'true' (the simulation's own curve) needs a simulated detector, not kind {self.kind!r}"
+                )
+            return self
+        if not Path(self.model).is_file():
+            raise ValueError(
+                f"model {self.model!r} is neither one of {', '.join(DETECTOR_MODELS)} nor a detector model file"
+            )
         return self
 
 
@@ -324,8 +348,8 @@ class Control(_Strict):
     beta: Annotated[NonNegativeFloat, at_most(1e6, "a weight")] = 0.0
     person_height_m: _Height = 1.75
     exploration_cell_m: Annotated[float, Field(ge=0.05), at_most(1000, "metres")] = 1.0
-    prior_occupancy: float = Field(0.05, ge=0, lt=1)
-    arrival_rate_per_m2_s: Annotated[NonNegativeFloat, at_most(10, "people per square metre and second")] = 0.002
+    prior_untracked_people: Annotated[NonNegativeFloat, at_most(10_000, "people")] = 1.0
+    arrival_rate_per_s: Annotated[NonNegativeFloat, at_most(1000, "people per second")] = 0.1
 
 
 _VideoFrame = Annotated[int, Field(ge=0), at_most(10_000_000, "video frames: 4 days at 30 Hz")]

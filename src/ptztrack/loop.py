@@ -20,6 +20,7 @@ import numpy as np
 
 from ptztrack.camera.actions import ActionGrid
 from ptztrack.camera.pose_feedback import LandingError, landed_pose
+from ptztrack.detect.detector_model import OnlineDetectorModel
 from ptztrack.geometry.ptz import PTZCamera
 from ptztrack.roles import CameraBackend, Detector, Policy, PoseSource, Tracker
 from ptztrack.types import DecisionContext, Detections, GroundTruth, Tracks
@@ -37,6 +38,8 @@ class World:
     pose_source : the pose the tracker maps detections with (:mod:`ptztrack.camera.pose_feedback`).
     landing_error : where the camera lands when sent to a pose.
     tracker_seed : the episode's stream for a tracker that draws (its factory seeds it from this).
+    detector_model : what the policies and the tracker know of the detector, learned as the run goes
+        (:mod:`ptztrack.detect.detector_model`); None for a world built without one.
     """
 
     camera: PTZCamera
@@ -49,6 +52,7 @@ class World:
     pose_source: PoseSource
     landing_error: LandingError
     tracker_seed: np.random.SeedSequence | None = None
+    detector_model: OnlineDetectorModel | None = None
 
 
 @dataclass(frozen=True)

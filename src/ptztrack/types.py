@@ -43,6 +43,30 @@ class Detections:
 
 
 @dataclass(frozen=True)
+class TrackerEvidence:
+    """What one tracker step tells about its detector, without any annotation.
+
+    pose : (3,) the pose the detections were mapped with.
+    mean_m : (n, 2) and position_cov_m2 : (n, 2, 2) the tracks' predicted ground positions before the update.
+    existence : (n,) their existence probabilities before the update; hits : (n,) their detections so far.
+    detected : (n,) bool, whether a detection was assigned to each.
+    excess_px2 : (m,) for each detected track, ``|nu|^2 - tr(C P C^T)``: the squared innovation less the
+        share the prediction's own spread explains (its mean is ``tr V``, twice the pixel noise's variance).
+    false_births : tracks started by one detection and deleted, unconfirmed, because the detector would
+        have found their person again and did not (the evidence of the detector's false positives).
+    """
+
+    pose: np.ndarray
+    mean_m: np.ndarray
+    position_cov_m2: np.ndarray
+    existence: np.ndarray
+    hits: np.ndarray
+    detected: np.ndarray
+    excess_px2: np.ndarray
+    false_births: int
+
+
+@dataclass(frozen=True)
 class PeopleInView:
     """Who a simulated camera sees at a pose: the truth a simulated detector draws its detections from.
 

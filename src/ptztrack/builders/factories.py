@@ -9,6 +9,7 @@ from functools import partial
 from typing import Literal
 
 from ptztrack.builders.registration import live_view_model
+from ptztrack.builders.world import recall_model
 from ptztrack.camera.recorded import RecordedPTZ
 from ptztrack.camera.simulated import SimulatedPTZ
 from ptztrack.config import Scenario
@@ -17,7 +18,7 @@ from ptztrack.control.exploration import exploration_map
 from ptztrack.control.information_gain import expected_detection_probability
 from ptztrack.control.information_policy import InformationGainPolicy
 from ptztrack.detect.hog import GroundSearch, HogPeopleDetector
-from ptztrack.detect.simulated import AnnotationDetector, RecallDetector, RecallModel
+from ptztrack.detect.simulated import AnnotationDetector, RecallCurve, RecallDetector, RecallModel
 from ptztrack.loop import World
 from ptztrack.scene.pets import RecordedVideo
 from ptztrack.track.kalman import constant_velocity_model
@@ -37,11 +38,10 @@ TRACKER_FIELDS = (
 )
 
 
-def recall_model(scenario: Scenario) -> RecallModel:
-    """The detector model the policies plan with: perfect for the ideal detector, else the scenario's
-    recall curve (HOG included)."""
-    detector = scenario.detector
-    return RecallModel(detector.recall_kd, detector.recall_r0_px, perfect=detector.kind == "ideal")
+def planning_model(scenario: Scenario, world: World) -> RecallCurve:
+    """The detector model the policies plan with and the tracker expects: the world's (learned as the
+    run goes), or for a world built without one the scenario's curve."""
+    return world.detector_model if world.detector_model is not None else recall_model(scenario)
 
 
 def pixel_noise(scenario: Scenario):
@@ -68,7 +68,7 @@ def detection_model(scenario: Scenario, world: World) -> DetectionModel:
     return partial(
         expected_detection_probability,
         world.camera,
-        recall_model(scenario),
+        planning_model(scenario, world),
         pixel_noise(scenario),
         scenario.control.person_height_m,
         scenario.people.width_m,
@@ -88,7 +88,7 @@ def random_policy(scenario: Scenario, world: World) -> RandomPolicy:
 
 
 def _information_policy(scenario: Scenario, world: World, method: Literal["intg", "smpl"]) -> InformationGainPolicy:
-    control, recall = scenario.control, recall_model(scenario)
+    control, recall = scenario.control, planning_model(scenario, world)
     exploration = None
     if control.beta > 0:
         exploration = exploration_map(
@@ -98,8 +98,8 @@ def _information_policy(scenario: Scenario, world: World, method: Literal["intg"
             recall,
             control.person_height_m,
             control.exploration_cell_m,
-            control.prior_occupancy,
-            control.arrival_rate_per_m2_s,
+            control.prior_untracked_people,
+            control.arrival_rate_per_s,
             1.0 / scenario.frame_rate_hz,
         )
     return InformationGainPolicy(
@@ -174,7 +174,8 @@ def ekf_tracker(scenario: Scenario, world: World) -> EkfTracker | TemplateTracke
     config = scenario.tracker
     F, U = constant_velocity_model(1.0 / scenario.frame_rate_hz, config.acceleration_sigma_m_s2)
     parameters, model = tracker_parameters(scenario), detection_model(scenario, world)
-    tracker = EkfTracker(world.camera, F, U, pixel_noise(scenario), parameters, model)
+    learner = None if world.detector_model is None else world.detector_model.observe
+    tracker = EkfTracker(world.camera, F, U, pixel_noise(scenario), parameters, model, learner=learner)
     if config.measurement_source == "detector":
         return tracker
     height_m, width_m = scenario.control.person_height_m, scenario.people.width_m

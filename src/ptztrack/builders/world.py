@@ -13,6 +13,8 @@ from ptztrack.camera.pose_feedback import LandingError, commanded_pose, true_pos
 from ptztrack.camera.virtual import VirtualPTZ, virtual_ptz
 from ptztrack.config import Scenario, ScenarioError
 from ptztrack.control.baselines import widest_view_action
+from ptztrack.detect.detector_model import OnlineDetectorModel, read_detector_model_file
+from ptztrack.detect.simulated import RecallModel
 from ptztrack.geometry.area import rectangle_m
 from ptztrack.geometry.calibration import load_calibration
 from ptztrack.geometry.ptz import PTZCamera, ground_footprint
@@ -133,6 +135,34 @@ def landing_error(scenario: Scenario) -> LandingError:
     return LandingError(**scenario.camera.pose_error.model_dump())
 
 
+def recall_model(scenario: Scenario) -> RecallModel:
+    """The detector's own recall curve as the scenario gives it: perfect for the ideal detector."""
+    detector = scenario.detector
+    return RecallModel(detector.recall_kd, detector.recall_r0_px, perfect=detector.kind == "ideal")
+
+
+def detector_model(scenario: Scenario, camera: PTZCamera) -> OnlineDetectorModel:
+    """What the policies and the tracker know of the detector (``detector.model``): the scenario's curve with
+    its r0 shifted by ``detector.prior_shift_px`` as the prior, learned as the run goes ('online') or kept
+    ('a-priori'); the unshifted curve kept ('true'); or an earlier run's ``detector_model.json`` as the prior.
+    The ideal detector's model is perfect and kept."""
+    detector = scenario.detector
+    true_curve = recall_model(scenario)
+    people = (camera, scenario.control.person_height_m, scenario.people.width_m)
+    clutter, noise = detector.false_positives_per_frame, detector.pixel_noise_px
+    if true_curve.perfect or detector.model == "true":
+        return OnlineDetectorModel(
+            *people, true_curve, learning=False, false_positives_per_view=clutter, pixel_noise_px=noise
+        )
+    if detector.model in ("online", "a-priori"):
+        shifted = RecallModel(true_curve.kd_per_px, max(true_curve.r0_px + detector.prior_shift_px, 0.0))
+        learning = detector.model == "online"
+        return OnlineDetectorModel(
+            *people, shifted, learning=learning, false_positives_per_view=clutter, pixel_noise_px=noise
+        )
+    return OnlineDetectorModel(*people, **read_detector_model_file(detector.model))
+
+
 def build_world(
     scenario: Scenario,
     scene_rng: np.random.Generator,
@@ -161,4 +191,5 @@ def build_world(
         pose_source=pose_source(scenario, scene),
         landing_error=landing_error(scenario),
         tracker_seed=tracker_seed,
+        detector_model=detector_model(scenario, scene.camera),
     )

@@ -2,12 +2,17 @@
 
 The paper cites this term without defining it; here it is derived.
 
-The ground is cut into cells. Let ``b_c`` be the event "cell c holds a person
-the tracker does not know yet", with belief ``p_c``. New people arrive as a
-Poisson process of rate ``lambda`` per m^2 per second, so between two steps
-(``dt``) a cell of area ``A`` gains
+The ground is cut into C cells. Let ``b_c`` be the event "cell c holds a person
+the tracker does not know yet", with belief ``p_c``. At the start, ``N0``
+people nobody has seen yet are expected somewhere on the area, ``p_c = N0 / C``;
+new people arrive as a Poisson process of ``lambda`` people per second over
+the whole area, each in any cell alike, so between two steps (``dt``) a cell gains
 
-    p_c <- 1 - (1 - p_c) exp(-lambda A dt).
+    p_c <- 1 - (1 - p_c) exp(-lambda dt / C).
+
+Both are totals over the area, not densities: the area is what the camera can
+see, which may reach far beyond where anybody walks, and a density would make
+the number of unseen people grow with the camera's reach.
 
 Looking with action ``a``, a person in cell c is detected with probability
 ``q_c(a) = recall(r_c(a))`` if it stands fully in view (head and feet in the
@@ -38,7 +43,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ptztrack.detect.simulated import RecallModel
+from ptztrack.detect.simulated import RecallCurve
 from ptztrack.geometry.area import bounds_m, grid_inside
 from ptztrack.geometry.ptz import PTZCamera, person_in_view, project_people
 
@@ -48,35 +53,35 @@ def binary_entropy_nats(p) -> np.ndarray:
     return -(p * np.log(p) + (1 - p) * np.log1p(-p))
 
 
-def cell_detection_probability(
-    camera: PTZCamera, poses, cell_centres_m, recall: RecallModel, person_height_m: float
-) -> np.ndarray:
-    """``q_c(a)``: (L, C) probability of detecting an unoccluded person standing at each cell."""
-    people = project_people(camera, poses, cell_centres_m, person_height_m, 0.0)
-    return np.where(person_in_view(camera, people), recall(people.height_px), 0.0)
-
-
 @dataclass
 class ExplorationMap:
     """Beliefs that cells hold people not yet tracked, and how each action would observe them.
 
-    detection_probability : (L, C) ``q_c(a)`` for every action of the grid.
+    height_px : (L, C) the height of a person standing at each cell's centre in each action's view;
+    in_view : (L, C) whether that person stands fully in view.
+    recall : the detector model, read at every decision (a learned model changes as the camera runs).
     occupancy : (C,) current beliefs ``p_c``.
     arrival_probability : (C,) chance that a person arrives in a cell during one step.
     """
 
-    detection_probability: np.ndarray
+    height_px: np.ndarray = field(repr=False)
+    in_view: np.ndarray = field(repr=False)
+    recall: RecallCurve
     occupancy: np.ndarray
     arrival_probability: np.ndarray = field(repr=False)
 
+    def detection_probability(self, actions) -> np.ndarray:
+        """``q_c(a)`` (len(actions), C) for flat action indices ``actions`` (a scalar index: (C,))."""
+        return np.where(self.in_view[actions], self.recall(self.height_px[actions]), 0.0)
+
     def information_nats(self, actions) -> np.ndarray:
         """``I_p(a)`` for the given flat action indices; (len(actions),)."""
-        return self.detection_probability[actions] @ binary_entropy_nats(self.occupancy)
+        return self.detection_probability(actions) @ binary_entropy_nats(self.occupancy)
 
     def advance(self, action: int) -> None:
         """One step: people may arrive anywhere, then the camera looks with ``action``."""
         self.occupancy = 1.0 - (1.0 - self.occupancy) * (1.0 - self.arrival_probability)
-        q = self.detection_probability[action]
+        q = self.detection_probability(action)
         self.occupancy = self.occupancy * (1.0 - q) / (1.0 - self.occupancy * q)
 
 
@@ -84,22 +89,26 @@ def exploration_map(
     camera: PTZCamera,
     poses,
     area_polygon_m,
-    recall: RecallModel,
+    recall: RecallCurve,
     person_height_m: float,
     cell_m: float,
-    prior_occupancy: float,
-    arrival_rate_per_m2_s: float,
+    prior_untracked_people: float,
+    arrival_rate_per_s: float,
     dt_s: float,
 ) -> ExplorationMap:
-    """A fresh map over the area (a polygon (K, 2)) with square cells ``cell_m`` wide, every cell
-    believed occupied with ``prior_occupancy``, people arriving at ``arrival_rate_per_m2_s``, steps of ``dt_s``."""
+    """A fresh map over the area (a polygon (K, 2)) with square cells ``cell_m`` wide: ``N0 =
+    prior_untracked_people`` expected somewhere on it (``p_c = min(N0 / C, 1/2)``), people arriving at
+    ``arrival_rate_per_s`` over the whole area, steps of ``dt_s``."""
     (x0, y0), (x1, y1) = bounds_m(area_polygon_m)
     centres = grid_inside(
         area_polygon_m, np.arange(x0 + cell_m / 2, x1, cell_m), np.arange(y0 + cell_m / 2, y1, cell_m)
     )
-    arrival = -np.expm1(-arrival_rate_per_m2_s * cell_m**2 * dt_s)
+    cells = max(len(centres), 1)
+    people = project_people(camera, poses, centres, person_height_m, 0.0)
     return ExplorationMap(
-        detection_probability=cell_detection_probability(camera, poses, centres, recall, person_height_m),
-        occupancy=np.full(len(centres), prior_occupancy),
-        arrival_probability=np.full(len(centres), arrival),
+        height_px=people.height_px,
+        in_view=person_in_view(camera, people),
+        recall=recall,
+        occupancy=np.full(len(centres), min(prior_untracked_people / cells, 0.5)),
+        arrival_probability=np.full(len(centres), -np.expm1(-arrival_rate_per_s * dt_s / cells)),
     )

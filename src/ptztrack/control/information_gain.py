@@ -28,7 +28,7 @@ import numpy as np
 from scipy.stats import norm, qmc
 
 from ptztrack.control.gaussian_rectangle import rectangle_probability_scalar
-from ptztrack.detect.simulated import RecallModel, realistic_recall
+from ptztrack.detect.simulated import RecallCurve, realistic_recall
 from ptztrack.geometry.occlusion import occluded_fraction
 from ptztrack.geometry.ptz import (
     PTZCamera,
@@ -133,7 +133,7 @@ def information_if_detected_nats(geometry: ActionGeometry, mean_m, position_cov_
 
 
 @numba.njit
-def _alpha_closed_form(W, u, v, var_u, cov_uv, var_v, width_px, height_px, realistic, kd, r0_px):
+def _alpha_closed_form(W, u, v, var_u, cov_uv, var_v, width_px, height_px, realistic, kd, r0_px, plateau):
     """Equation 8 in closed form for one action and track (see :func:`detection_weight_integral`).
 
     W : (3, 3) the action's head-from-feet homology; the rest is :func:`_predict`'s prediction.
@@ -168,12 +168,24 @@ def _alpha_closed_form(W, u, v, var_u, cov_uv, var_v, width_px, height_px, reali
         )
         if shifted > 0:
             value -= math.exp(log_scale + math.log(shifted))
+        value *= plateau
     return min(max(value, 0.0), 1.0)
 
 
 @numba.njit
 def _integral_terms(
-    ground_to_image, head_from_feet, actions, mean_m, position_cov_m2, V, width_px, height_px, realistic, kd, r0_px
+    ground_to_image,
+    head_from_feet,
+    actions,
+    mean_m,
+    position_cov_m2,
+    V,
+    width_px,
+    height_px,
+    realistic,
+    kd,
+    r0_px,
+    plateau,
 ):
     L, n = actions.shape[0], mean_m.shape[0]
     log_det_V = _log_det(V)
@@ -187,13 +199,13 @@ def _integral_terms(
                 continue
             gain[row, track] = _information(var_u, cov_uv, var_v, log_det_V)
             alpha[row, track] = _alpha_closed_form(
-                W, u, v, var_u, cov_uv, var_v, width_px, height_px, realistic, kd, r0_px
+                W, u, v, var_u, cov_uv, var_v, width_px, height_px, realistic, kd, r0_px, plateau
             )
     return alpha, gain
 
 
 def detection_weight_and_information_integral(
-    camera: PTZCamera, geometry: ActionGeometry, recall: RecallModel, mean_m, position_cov_m2, V, actions=None
+    camera: PTZCamera, geometry: ActionGeometry, recall: RecallCurve, mean_m, position_cov_m2, V, actions=None
 ) -> tuple[np.ndarray, np.ndarray]:
     """:func:`detection_weight_integral` and :func:`information_if_detected_nats` in one pass: (L, n) each.
 
@@ -211,11 +223,12 @@ def detection_weight_and_information_integral(
         not recall.perfect,
         recall.kd_per_px,
         recall.r0_px,
+        recall.plateau,
     )
 
 
 def detection_weight_integral(
-    camera: PTZCamera, geometry: ActionGeometry, recall: RecallModel, mean_m, position_cov_m2, V, actions=None
+    camera: PTZCamera, geometry: ActionGeometry, recall: RecallCurve, mean_m, position_cov_m2, V, actions=None
 ) -> np.ndarray:
     """``alpha(a)`` of equation 8 in closed form: 'intg'.
 
@@ -231,7 +244,7 @@ def detection_weight_integral(
     The pixel height ``r = v - v_head = D v + d`` is linear in ``v`` (equation
     13); recall is zero below ``r0``, which only moves ``v_low``, and above it
 
-        alpha = P_rect(N(mu, S)) - exp(-Kd (d - r0) + b.mu + b.S.b / 2) P_rect(N(mu + S b, S)),
+        alpha = plateau [P_rect(N(mu, S)) - exp(-Kd (d - r0) + b.mu + b.S.b / 2) P_rect(N(mu + S b, S))],
 
     with ``b = (0, -Kd D)``: an exponential times a Gaussian is a scaled
     Gaussian. The ideal detector has recall 1 and ``alpha = P_rect(N(mu, S))``.
@@ -245,7 +258,17 @@ def detection_weight_integral(
 
 @numba.njit
 def _detection_weight_sampled(
-    ground_to_image, head_to_image, actions, ground_m, visible_fraction, width_px, height_px, realistic, kd, r0_px
+    ground_to_image,
+    head_to_image,
+    actions,
+    ground_m,
+    visible_fraction,
+    width_px,
+    height_px,
+    realistic,
+    kd,
+    r0_px,
+    plateau,
 ):
     L, (M, n) = actions.shape[0], ground_m.shape[:2]
     alpha = np.zeros((L, n))
@@ -266,14 +289,14 @@ def _detection_weight_sampled(
                     continue
                 if not (0 <= feet_v <= height_px and 0 <= head_v <= height_px):
                     continue
-                p = realistic_recall(feet_v - head_v, kd, r0_px) if realistic else 1.0
+                p = plateau * realistic_recall(feet_v - head_v, kd, r0_px) if realistic else 1.0
                 alpha[row, track] += p * visible_fraction[sample, track]
     return alpha / M
 
 
 def expected_detection_probability(
     camera: PTZCamera,
-    recall: RecallModel,
+    recall: RecallCurve,
     V,
     person_height_m: float,
     person_width_m: float,
@@ -314,7 +337,7 @@ def joint_position_samples(mean_m, position_cov_m2, rng: np.random.Generator, sa
 def detection_weight_sampled(
     camera: PTZCamera,
     geometry: ActionGeometry,
-    recall: RecallModel,
+    recall: RecallCurve,
     mean_m,
     position_cov_m2,
     person_height_m: float,
@@ -361,4 +384,5 @@ def detection_weight_sampled(
         not recall.perfect,
         recall.kd_per_px,
         recall.r0_px,
+        recall.plateau,
     )

@@ -23,7 +23,7 @@ from ptztrack.control.information_gain import (
     detection_weight_sampled,
     information_if_detected_nats,
 )
-from ptztrack.detect.simulated import RecallModel
+from ptztrack.detect.simulated import RecallCurve
 from ptztrack.geometry.ptz import PTZCamera, look_at
 from ptztrack.types import DecisionContext, Tracks
 
@@ -62,7 +62,7 @@ class InformationGainPolicy:
 
     camera: PTZCamera
     grid: ActionGrid
-    recall: RecallModel
+    recall: RecallCurve
     V: np.ndarray
     person_height_m: float
     person_width_m: float

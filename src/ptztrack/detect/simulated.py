@@ -21,6 +21,7 @@ not more than a threshold hidden.
 
 import math
 from dataclasses import dataclass
+from typing import Protocol
 
 import numba
 import numpy as np
@@ -37,23 +38,44 @@ def realistic_recall(height_px, recall_kd, recall_r0_px):
     return -math.expm1(-recall_kd * (height_px - recall_r0_px))
 
 
+class RecallCurve(Protocol):
+    """What the policies and the tracker read of a detector model: the curve of :class:`RecallModel`
+    (a learned model, :class:`ptztrack.detect.detector_model.OnlineDetectorModel`, reads as its current one)."""
+
+    @property
+    def kd_per_px(self) -> float: ...
+
+    @property
+    def r0_px(self) -> float: ...
+
+    @property
+    def perfect(self) -> bool: ...
+
+    @property
+    def plateau(self) -> float: ...
+
+    def __call__(self, height_px) -> np.ndarray: ...
+
+
 @dataclass(frozen=True)
 class RecallModel:
     """The probability of detecting a fully visible person by pixel height (the paper's equation 13).
 
-    kd_per_px, r0_px : ``recall(r) = 1 - exp(-kd (r - r0))`` for ``r >= r0``, else 0.
-    perfect : recall 1 at every height (the ideal detector); kd and r0 are then not used.
+    kd_per_px, r0_px, plateau : ``recall(r) = plateau (1 - exp(-kd (r - r0)))`` for ``r >= r0``, else 0;
+        the plateau (1 in the paper) is the share of people a detector finds however large they look.
+    perfect : recall 1 at every height (the ideal detector); kd, r0 and plateau are then not used.
     """
 
     kd_per_px: float
     r0_px: float
     perfect: bool = False
+    plateau: float = 1.0
 
     def __call__(self, height_px) -> np.ndarray:
         height_px = np.asarray(height_px, dtype=float)
         if self.perfect:
             return np.ones_like(height_px)
-        return realistic_recall(height_px, self.kd_per_px, self.r0_px)
+        return self.plateau * realistic_recall(height_px, self.kd_per_px, self.r0_px)
 
 
 def detection_probability(people: PeopleInView, recall: RecallModel) -> np.ndarray:

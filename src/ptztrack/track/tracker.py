@@ -45,7 +45,7 @@ from ptztrack.geometry.ptz import (
 )
 from ptztrack.roles import ImageSource
 from ptztrack.track import jpdaf, kalman
-from ptztrack.types import Detections, Tracks, TrackUpdate
+from ptztrack.types import Detections, TrackerEvidence, Tracks, TrackUpdate
 
 # Feet are found on a pixel grid: the tracker trusts them to half a pixel at
 # best, which also keeps the innovation covariance invertible for a
@@ -381,13 +381,42 @@ def update_own_tracks(
     return updated.select(updated.position_sigma_m <= max_position_sigma_m)
 
 
+def tracker_evidence(
+    tracks: Tracks, update: TrackUpdate, feet_px, camera: PTZCamera, pose, detectable, parameters: TrackerParameters
+) -> TrackerEvidence:
+    """What the step that took the predicted ``tracks`` to ``update`` tells about the detector
+    (:class:`~ptztrack.types.TrackerEvidence`); ``detectable`` (n,) as :func:`update_tracks` was given it."""
+    detected = np.isin(tracks.ids, update.track_ids)
+    feet_px = np.asarray(feet_px, dtype=float).reshape(-1, 2)
+    measurement_of = dict(zip(update.track_ids.tolist(), update.measurement_index.tolist(), strict=True))
+    index = np.flatnonzero(detected)
+    predicted_px, _ = predicted_feet_px(camera, pose, tracks.mean[index])
+    C = observation_matrix(camera, pose, tracks.mean[index])
+    spread_px2 = np.trace(C @ tracks.covariance[index] @ np.swapaxes(C, -1, -2), axis1=-2, axis2=-1)
+    measured_px = feet_px[[measurement_of[track_id] for track_id in tracks.ids[index].tolist()]].reshape(-1, 2)
+    excess_px2 = np.sum((measured_px - predicted_px) ** 2, axis=-1) - spread_px2
+    missed_away = ~detected & (existence_after_miss(tracks.existence, detectable) < parameters.existence_to_delete)
+    return TrackerEvidence(
+        pose=np.asarray(pose, dtype=float),
+        mean_m=tracks.mean[:, :2],
+        position_cov_m2=tracks.covariance[:, :2, :2],
+        existence=tracks.existence,
+        hits=tracks.hits,
+        detected=detected,
+        excess_px2=excess_px2,
+        false_births=int(np.sum(missed_away & (tracks.hits == 1))),
+    )
+
+
 @dataclass
 class EkfTracker:
     """The ground-plane tracker as a role of the loop (:class:`ptztrack.roles.Tracker`).
 
     camera : the camera model; F, U : the motion model (:func:`ptztrack.track.kalman.constant_velocity_model`);
     V : (2, 2) px^2 the detections' noise; parameters : see :func:`update_tracks`;
-    detection_model : what the detector would find (see :data:`DetectionModel`).
+    detection_model : what the detector would find (see :data:`DetectionModel`);
+    learner : given every step's :class:`~ptztrack.types.TrackerEvidence` (a detector model that
+        learns from it, say; None: nobody).
     """
 
     camera: PTZCamera
@@ -397,6 +426,7 @@ class EkfTracker:
     parameters: TrackerParameters
     detection_model: DetectionModel
     tracks: Tracks = field(default_factory=Tracks.empty)
+    learner: Callable[[TrackerEvidence], None] | None = None
 
     def predict(self) -> Tracks:
         self.tracks = predict_tracks(self.tracks, self.F, self.U)
@@ -411,6 +441,10 @@ class EkfTracker:
         detectable = self.detection_model(tracks.mean[:, :2], tracks.covariance[:, :2, :2], pose)
         update = update_tracks(tracks, detections.feet_px, self.camera, pose, self.V, self.parameters, detectable)
         self.tracks = update.tracks
+        if self.learner is not None:
+            self.learner(
+                tracker_evidence(tracks, update, detections.feet_px, self.camera, pose, detectable, self.parameters)
+            )
         return update
 
     def reported(self) -> Tracks:
