@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from ptztrack.builders.episode import episode_world, run_episode
-from ptztrack.cli import main
+from ptztrack.cli import DETECTOR_MODEL_FILE, main
 from ptztrack.config import scenario_from_dict
 from ptztrack.evaluate.report import RUN_FILES
 from ptztrack.evaluate.video import (
@@ -43,7 +43,7 @@ def test_run_out_writes_an_mp4_with_one_frame_per_step(tmp_path, capsys):
     frames, frame_rate_hz = read_video(tmp_path / "episode.mp4")
     assert frames.shape == (10, FRAME_SIZE_PX[1], FRAME_SIZE_PX[0], 3)
     assert frame_rate_hz == pytest.approx(5.0)
-    assert sorted(os.listdir(tmp_path)) == sorted([*RUN_FILES, VIEW_STATES_FILE])
+    assert sorted(os.listdir(tmp_path)) == sorted([*RUN_FILES, VIEW_STATES_FILE, DETECTOR_MODEL_FILE])
     assert len((tmp_path / VIEW_STATES_FILE).read_text().splitlines()) == 10  # a state per step, for `ptztrack view`
 
 
