@@ -95,7 +95,7 @@ def run_live(
     LiveEpisode fields, its ``actions`` (flat index, -1 off the grid) and the captured ``image``
     (None where nothing was captured).
     """
-    _, detector_seed, policy_seed, _, _ = episode_seeds(seed)
+    _, detector_seed, policy_seed, _, _, _ = episode_seeds(seed)
     frame_seeds = detector_seed.spawn(steps)
     policy_rng = np.random.default_rng(policy_seed)
     grid = world.grid

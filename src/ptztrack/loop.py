@@ -106,12 +106,13 @@ def command(grid: ActionGrid, choice: int | np.ndarray) -> tuple[int, np.ndarray
 
 
 def episode_seeds(seed: int) -> list[np.random.SeedSequence]:
-    """The independent streams of an episode: scene, detector, policy, the camera's landing errors, tracker.
+    """The independent streams of an episode: scene, detector, policy, the camera's landing errors, tracker,
+    and the detector model's draws.
 
-    The first four are those of a seed before the tracker's was added (spawning more children does
-    not change the earlier ones).
+    Each is the stream it was before later ones were added (spawning more children does not change
+    the earlier ones).
     """
-    return np.random.SeedSequence(seed).spawn(5)
+    return np.random.SeedSequence(seed).spawn(6)
 
 
 def run_loop(
@@ -122,7 +123,7 @@ def run_loop(
     observer : called after every step (:data:`StepObserver`); it draws no random numbers, so the
     episode is the same with or without it.
     """
-    _, detector_seed, policy_seed, landing_seed, _ = episode_seeds(seed)
+    _, detector_seed, policy_seed, landing_seed, _, _ = episode_seeds(seed)
     steps = world.truth.positions_m.shape[0]
     frame_seeds = detector_seed.spawn(steps)
     policy_rng = np.random.default_rng(policy_seed)

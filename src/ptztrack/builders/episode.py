@@ -20,7 +20,8 @@ def episode_world(
 ) -> World:
     """The world that ``run_episode(scenario, any_policy, seed)`` runs in: the same people."""
     streams = episode_seeds(seed)
-    return build_world(scenario, np.random.default_rng(streams[0]), camera, detector, tracker_seed=streams[4])
+    scene_rng = np.random.default_rng(streams[0])
+    return build_world(scenario, scene_rng, camera, detector, tracker_seed=streams[4], model_seed=streams[5])
 
 
 def make_policy(spec: PolicySpec, scenario: Scenario, world: World) -> Policy:

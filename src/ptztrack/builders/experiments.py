@@ -94,9 +94,15 @@ def synthetic_cells(
 
 
 def seed_matters(scenario: Scenario, strategy: PolicySpec) -> bool:
-    """Whether a run of ``strategy`` depends on its seed: a strategy that draws, or a detector that does
-    (every one but OpenCV's HOG, which finds the same people in the same image)."""
-    return strategy in RANDOM_STRATEGIES or scenario.detector.kind != "hog"
+    """Whether a run of ``strategy`` depends on its seed: a strategy that draws, a detector that does
+    (every one but OpenCV's HOG, which finds the same people in the same image), or an information-gain
+    strategy planning with draws of a detector model it learns."""
+    learning = scenario.detector.model not in ("a-priori", "true") and scenario.detector.kind != "ideal"
+    return (
+        strategy in RANDOM_STRATEGIES
+        or scenario.detector.kind != "hog"
+        or (strategy in INFORMATION_STRATEGIES and learning)
+    )
 
 
 def recording_cells(

@@ -38,10 +38,15 @@ TRACKER_FIELDS = (
 )
 
 
-def planning_model(scenario: Scenario, world: World) -> RecallCurve:
-    """The detector model the policies plan with and the tracker expects: the world's (learned as the
-    run goes), or for a world built without one the scenario's curve."""
+def expected_model(scenario: Scenario, world: World) -> RecallCurve:
+    """The detector model the tracker expects: the world's (its posterior mode as the run goes), or for
+    a world built without one the scenario's curve."""
     return world.detector_model if world.detector_model is not None else recall_model(scenario)
+
+
+def planning_model(scenario: Scenario, world: World) -> RecallCurve:
+    """The detector model the policies plan with: the world's latest draw, or the scenario's curve."""
+    return world.detector_model.planner() if world.detector_model is not None else recall_model(scenario)
 
 
 def pixel_noise(scenario: Scenario):
@@ -68,7 +73,7 @@ def detection_model(scenario: Scenario, world: World) -> DetectionModel:
     return partial(
         expected_detection_probability,
         world.camera,
-        planning_model(scenario, world),
+        expected_model(scenario, world),
         pixel_noise(scenario),
         scenario.control.person_height_m,
         scenario.people.width_m,

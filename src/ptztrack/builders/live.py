@@ -18,13 +18,14 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ptztrack.builders.episode import episode_world, make_policy, make_tracker
+from ptztrack.builders.world import detector_model
 from ptztrack.camera.live_camera import ReconnectingCamera
 from ptztrack.camera.onvif_client import CameraAddress, CameraError, ONVIFClient
 from ptztrack.camera.onvif_spaces import AxisSpeeds, CameraSpaces
 from ptztrack.camera.recorded import RecordedPTZ
 from ptztrack.config import VIRTUAL_CAMERA_CALIBRATION, CameraCalibrationFile, Scenario
 from ptztrack.live import LiveEpisode, run_live
-from ptztrack.loop import Episode, StepObserver, World
+from ptztrack.loop import Episode, StepObserver, World, episode_seeds
 from ptztrack.roles import Policy
 from ptztrack.types import GroundTruth
 
@@ -165,7 +166,7 @@ def live_world(scenario: Scenario, calibration: CameraCalibrationFile, seed: int
         camera = replace(camera, position_m=calibration.position_m)
     if calibration.f_min_px is not None:
         camera = replace(camera, f_min_px=calibration.f_min_px)
-    return replace(world, camera=camera)
+    return replace(world, camera=camera, detector_model=detector_model(scenario, camera, episode_seeds(seed)[5]))
 
 
 def run_live_episode(

@@ -141,7 +141,9 @@ def recall_model(scenario: Scenario) -> RecallModel:
     return RecallModel(detector.recall_kd, detector.recall_r0_px, perfect=detector.kind == "ideal")
 
 
-def detector_model(scenario: Scenario, camera: PTZCamera) -> OnlineDetectorModel:
+def detector_model(
+    scenario: Scenario, camera: PTZCamera, seed: np.random.SeedSequence | None = None
+) -> OnlineDetectorModel:
     """What the policies and the tracker know of the detector (``detector.model``): the scenario's curve with
     its r0 shifted by ``detector.prior_shift_px`` as the prior, learned as the run goes ('online') or kept
     ('a-priori'); the unshifted curve kept ('true'); or an earlier run's ``detector_model.json`` as the prior.
@@ -169,12 +171,13 @@ def build_world(
     camera: CameraSpec | None = None,
     detector: DetectorSpec | None = None,
     tracker_seed: np.random.SeedSequence | None = None,
+    model_seed: np.random.SeedSequence | None = None,
 ) -> World:
     """The world of ``scenario``: its scene, camera backend, detector and pose source.
 
     camera : the backend, by default ``camera.backend`` of the scenario ('simulated' for the
     synthetic scene, 'virtual' for a recording); detector : by default ``detector.kind``;
-    tracker_seed : the stream of a tracker that draws.
+    tracker_seed : the stream of a tracker that draws; model_seed : the detector model's draws.
     """
     scene = build_scene(scenario, scene_rng)
     default_backend = "virtual" if scenario.recording is not None else "simulated"
@@ -191,5 +194,5 @@ def build_world(
         pose_source=pose_source(scenario, scene),
         landing_error=landing_error(scenario),
         tracker_seed=tracker_seed,
-        detector_model=detector_model(scenario, scene.camera),
+        detector_model=detector_model(scenario, scene.camera, model_seed),
     )

@@ -21,7 +21,15 @@ likelihood,
 
 over a fixed grid that holds the prior curve's own parameters, so that with
 no evidence the model is the prior. Each bin's Beta posterior gives the
-reported recall and its standard deviation.
+reported recall and its standard deviation. The tracker reads this mode.
+
+The policies plan with a draw instead (Thompson sampling): after every
+step, one recall per bin from its Beta posterior, with Jeffreys' half a
+success and half a failure added so that no bin is ever certain, and the
+curve fitted to the draws as to counts. A prior that says people smaller
+than its r0 are never found would otherwise confirm itself: the camera
+would never look where they are that small, and never see that they are
+found. Once a bin holds evidence, its draws stay near its recall.
 
 False positives per view: a Gamma-Poisson posterior, with the prior mean
 weighted as ``PRIOR_VIEWS`` views, on the tracks that one detection started
@@ -99,9 +107,11 @@ class OnlineDetectorModel:
     prior_trials: np.ndarray | None = None
     prior_views: float = PRIOR_VIEWS
     prior_innovations: float = PRIOR_INNOVATIONS
+    rng: np.random.Generator = field(default_factory=lambda: np.random.default_rng(0), repr=False)
     successes: np.ndarray = field(init=False, repr=False)
     trials: np.ndarray = field(init=False, repr=False)
     curve: RecallModel = field(init=False)
+    planning_curve: RecallModel = field(init=False)
     false_births: float = field(default=0.0, init=False)
     views: int = field(default=0, init=False)
     excess_sum_px2: float = field(default=0.0, init=False)
@@ -118,6 +128,8 @@ class OnlineDetectorModel:
         self._parameters, self._log_recall, self._log_miss = _curve_grid(self.prior, self.centres_px)
         self.curve = self.prior
         self._refit()
+        self.planning_curve = self.curve
+        self._draw()
 
     # The RecallModel the policies and the tracker read.
     @property
@@ -149,6 +161,7 @@ class OnlineDetectorModel:
         self.innovations += len(evidence.excess_px2)
         index, height_px, weight = self.trials_of(evidence)
         if len(index) == 0:
+            self._draw()
             return
         which = np.digitize(height_px, HEIGHT_BIN_EDGES_PX) - 1
         inside = (which >= 0) & (which < len(self.centres_px))
@@ -156,6 +169,7 @@ class OnlineDetectorModel:
         found = weight * evidence.detected[index]
         self.successes += np.bincount(which[inside], found[inside], len(self.centres_px))
         self._refit()
+        self._draw()
 
     def trials_of(self, evidence: TrackerEvidence) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The established tracks predicted fully in view: their indices (k,), heights (k,) px and
@@ -186,10 +200,28 @@ class OnlineDetectorModel:
         if self.prior.perfect:
             return
         successes = self.prior_successes + self.successes
-        failures = self.prior_trials + self.trials - successes
+        self.curve = self._fitted(successes, self.prior_trials + self.trials - successes)
+
+    def _fitted(self, successes, failures) -> RecallModel:
+        """The grid's curve of highest binned likelihood for these counts (B,) each."""
         score = self._log_recall @ successes + self._log_miss @ failures
         kd, r0, plateau = self._parameters[int(np.argmax(score))]
-        self.curve = RecallModel(float(kd), float(r0), plateau=float(plateau))
+        return RecallModel(float(kd), float(r0), plateau=float(plateau))
+
+    def _draw(self) -> None:
+        """A new planning curve from the posterior (see the module's docstring); the mode's when not learning."""
+        if not self.learning or self.prior.perfect:
+            self.planning_curve = self.curve
+            return
+        successes = self.prior_successes + self.successes + 0.5
+        failures = self.prior_trials + self.trials - self.prior_successes - self.successes + 0.5
+        drawn = self.rng.beta(successes, failures)
+        total = successes + failures
+        self.planning_curve = self._fitted(total * drawn, total * (1.0 - drawn))
+
+    def planner(self) -> "PlanningCurve":
+        """The curve the policies plan with, as a :class:`RecallCurve` that follows the model's draws."""
+        return PlanningCurve(self)
 
     def recall_by_bin(self) -> tuple[np.ndarray, np.ndarray]:
         """Each bin's Beta posterior mean and standard deviation of recall; (B,) each."""
@@ -232,6 +264,32 @@ class OnlineDetectorModel:
     def save(self, path: str | Path) -> None:
         """Write :meth:`as_dict` to ``path`` (a temporary file beside it, then renamed)."""
         write_json(path, self.as_dict())
+
+
+@dataclass(frozen=True)
+class PlanningCurve:
+    """The latest draw of an :class:`OnlineDetectorModel`, read as a :class:`RecallCurve`."""
+
+    model: OnlineDetectorModel
+
+    @property
+    def kd_per_px(self) -> float:
+        return self.model.planning_curve.kd_per_px
+
+    @property
+    def r0_px(self) -> float:
+        return self.model.planning_curve.r0_px
+
+    @property
+    def plateau(self) -> float:
+        return self.model.planning_curve.plateau
+
+    @property
+    def perfect(self) -> bool:
+        return self.model.planning_curve.perfect
+
+    def __call__(self, height_px) -> np.ndarray:
+        return self.model.planning_curve(height_px)
 
 
 class DetectorModelFileError(InputError):
