@@ -7,15 +7,18 @@ from ptztrack.geometry.ptz import PTZCamera, apply_homography, feet_jacobian, gr
 from ptztrack.track import kalman
 from ptztrack.track.kalman import constant_velocity_model
 from ptztrack.track.tracker import (
+    EkfTracker,
     TrackerParameters,
+    existence_after_detection,
     existence_after_miss,
+    innovation_likelihood,
     observation_matrix,
     predict_tracks,
     start_tracks,
     update_own_tracks,
     update_tracks,
 )
-from ptztrack.types import Tracks
+from ptztrack.types import Detections, Tracks
 
 CAMERA = PTZCamera((7.5, -4.0, 7.0), 640, 480, 400.0)
 POSE = look_at(CAMERA, [7.5, 6.0], 1.0)
@@ -187,3 +190,49 @@ def test_a_measurement_of_a_dead_track_is_refused():
     tracks = start_tracks(feet_px(np.array([[7.0, 6.0]])), CAMERA, POSE, V, CONFIG.initial_speed_sigma_m_s, 0)
     with pytest.raises(ValueError, match=r"measurements of tracks \[5\], which are not alive"):
         update_own_tracks(tracks, [5], feet_px(np.array([[7.0, 6.0]])), CAMERA, POSE, V, CONFIG.max_position_sigma_m)
+
+
+def test_the_innovation_likelihood_is_the_gaussian_density():
+    from scipy.stats import multivariate_normal
+
+    S = np.array([[[4.0, 1.0], [1.0, 3.0]], [[9.0, 0.0], [0.0, 1.0]]])
+    innovation = np.array([[1.0, -2.0], [3.0, 0.5]])
+    expected = [multivariate_normal(np.zeros(2), S[k]).pdf(innovation[k]) for k in range(2)]
+    np.testing.assert_allclose(innovation_likelihood(innovation, S), expected, rtol=1e-12)
+
+
+def test_a_detection_raises_existence_by_its_likelihood_against_the_clutter():
+    # Worked by hand: ratio 1 - q + q g / kappa = 0.2 + 0.8 x 40 = 32.2; r' = 0.5 x 32.2 / (0.5 + 16.1).
+    assert existence_after_detection([0.5], [0.8], [0.04], 0.001, 0.99)[0] == pytest.approx(16.1 / 16.6)
+    # A detection that is likelier clutter than this person lowers the existence.
+    assert existence_after_detection([0.5], [0.8], [1e-5], 0.001, 0.99)[0] == pytest.approx(0.104 / 0.604)
+    # Never above the cap; with no clutter at all, the cap.
+    assert existence_after_detection([0.98], [1.0], [1.0], 1e-9, 0.99)[0] == 0.99
+    assert existence_after_detection([0.3], [0.5], [0.01], 0.0, 0.99)[0] == 0.99
+    # Where the detector could not have found the person (q = 0) the detection says nothing.
+    assert existence_after_detection([0.3], [0.0], [0.04], 0.001, 0.99)[0] == pytest.approx(0.3)
+
+
+def test_the_tracker_reports_only_tracks_sure_enough_to_exist():
+    fields = {"existence_at_birth": 0.4, "existence_to_report": 0.5}
+    params = parameters(**fields)
+    start = feet_px([[7.5, 6.0]])
+    first = update_tracks(Tracks.empty(), start, CAMERA, POSE, V, params, np.zeros(0)).tracks
+    assert first.existence[0] == pytest.approx(0.4)
+    tracker = EkfTracker(
+        CAMERA, *constant_velocity_model(0.2, ACCELERATION_SIGMA_M_S2), V, params, lambda *a: np.ones(len(a[0]))
+    )
+    tracker.tracks = first
+    assert len(tracker.reported()) == 0
+    fixed = EkfTracker(
+        CAMERA,
+        *constant_velocity_model(0.2, ACCELERATION_SIGMA_M_S2),
+        V,
+        parameters(**fields, existence_update="fixed"),
+        lambda *a: np.ones(len(a[0])),
+    )
+    fixed.tracks = first
+    assert len(fixed.reported()) == 1
+    tracker.predict()
+    tracker.update(Detections(start, np.array([np.nan]), np.array([-1])), POSE, None)
+    assert len(tracker.reported()) == 1 and tracker.tracks.existence[0] == pytest.approx(0.99)

@@ -318,7 +318,10 @@ class Tracker(_Strict):
     :mod:`ptztrack.track.templates`). Needs a recording with a video.
     kind : a registered tracker (another package's, with ``options`` its parameters).
     existence_at_birth, existence_when_detected, existence_to_delete : the track lifecycle, by the
-    probability that a track's person exists (:mod:`ptztrack.track.tracker`).
+    probability that a track's person exists (:mod:`ptztrack.track.tracker`); existence_update 'bayes'
+    weighs each detection against the clutter (the learned rate where the detector model learns,
+    else ``clutter_density_per_px2``) and reports tracks of existence ``existence_to_report`` or more;
+    'fixed' is the lifecycle before issue 28.
     max_position_sigma_m : where people can leave the scene (a recording, or ``people.enter_leave``),
     a track this uncertain is deleted; where they never leave, uncertainty deletes nobody.
     report_position_sigma_m : a track more uncertain than this is kept but not reported.
@@ -335,6 +338,8 @@ class Tracker(_Strict):
     max_position_sigma_m: Annotated[PositiveFloat, at_most(10_000, "metres")] = 2.0
     confirmation_hits: Annotated[int, Field(ge=1), at_most(_MAX_FRAMES, "steps")] = 1
     report_position_sigma_m: Annotated[PositiveFloat, at_most(10_000, "metres")] = 1.0
+    existence_update: Literal["bayes", "fixed"] = "bayes"
+    existence_to_report: float = Field(0.5, gt=0, lt=1)
     association: Literal["hungarian", "cjpdaf"] = "hungarian"
     clutter_density_per_px2: Annotated[NonNegativeFloat, at_most(1, "detections per pixel")] = 0.0
     measurement_source: Literal["detector", "spatiogram"] = "detector"

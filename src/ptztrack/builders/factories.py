@@ -35,6 +35,8 @@ TRACKER_FIELDS = (
     "report_position_sigma_m",
     "association",
     "clutter_density_per_px2",
+    "existence_update",
+    "existence_to_report",
 )
 
 
@@ -179,8 +181,17 @@ def ekf_tracker(scenario: Scenario, world: World) -> EkfTracker | TemplateTracke
     config = scenario.tracker
     F, U = constant_velocity_model(1.0 / scenario.frame_rate_hz, config.acceleration_sigma_m_s2)
     parameters, model = tracker_parameters(scenario), detection_model(scenario, world)
-    learner = None if world.detector_model is None else world.detector_model.observe
-    tracker = EkfTracker(world.camera, F, U, pixel_noise(scenario), parameters, model, learner=learner)
+    learned = world.detector_model
+    tracker = EkfTracker(
+        world.camera,
+        F,
+        U,
+        pixel_noise(scenario),
+        parameters,
+        model,
+        learner=None if learned is None else learned.observe,
+        clutter_per_view=None if learned is None or not learned.learning else lambda: learned.clutter_per_view,
+    )
     if config.measurement_source == "detector":
         return tracker
     height_m, width_m = scenario.control.person_height_m, scenario.people.width_m

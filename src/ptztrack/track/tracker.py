@@ -12,19 +12,28 @@ gain policies come back to exactly such people. So a track is not deleted
 because it is uncertain (except, where people can leave the scene, beyond
 ``max_position_sigma_m``) but on evidence that its person is not there: each
 track carries the probability that its person exists, ``existence``, updated
-by Bayes' rule every step. Detected, it is ``existence_when_detected``. Not
-detected, while the detector would have found the person with probability
-``q`` (the detector model's prediction at the pose: the person's predicted
-feet and head in the image, recall at their size, and not hidden by other
-tracked people), it becomes ``r (1 - q) / (1 - r q)``: a miss where the
-detector could not have seen anybody changes nothing, a miss where it surely
-would have is strong evidence. Below ``existence_to_delete`` the track goes.
-A new track starts at ``existence_at_birth`` (one detection: a new person,
-a false positive or somebody already tracked). Every track is kept for the
-policy and for re-association; the tracker reports those detected at least
-``confirmation_hits`` times and localised to within ``report_position_sigma_m``
-(beyond that, a reported track is more often a false positive and a miss at
-once than a match).
+by Bayes' rule every step, as the integrated PDA and the Bernoulli filter
+update it. Not detected, while the detector would have found the person with
+probability ``q`` (the detector model's prediction at the pose: the person's
+predicted feet and head in the image, recall at their size, and not hidden
+by other tracked people), it becomes ``r (1 - q) / (1 - r q)``: a miss where
+the detector could not have seen anybody changes nothing, a miss where it
+surely would have is strong evidence. Detected with innovation ``nu`` of
+covariance ``S``, against false detections of density ``kappa`` per px^2,
+
+    r' = r (1 - q + q g / kappa) / (1 - r q + r q g / kappa),   g = N(nu; 0, S),
+
+the ratio of the detection's likelihood as this person's to its likelihood as
+clutter; at most ``existence_when_detected`` (a detection never makes a track
+certain: a false positive can repeat). ``existence_update`` 'fixed' sets
+it to ``existence_when_detected`` instead (the lifecycle before issue 28).
+Below ``existence_to_delete`` the track goes. A new track starts at
+``existence_at_birth`` (one detection: a new person, a false positive or
+somebody already tracked). Every track is kept for the policy and for
+re-association; the tracker reports those whose existence is at least
+``existence_to_report``, detected at least ``confirmation_hits`` times and
+localised to within ``report_position_sigma_m`` (beyond that, a reported
+track is more often a false positive and a miss at once than a match).
 """
 
 from collections.abc import Callable
@@ -69,7 +78,9 @@ class TrackerParameters:
     max_position_sigma_m : a track more uncertain than this is deleted (inf where people never leave).
     confirmation_hits, report_position_sigma_m : what the tracker reports (see the module's docstring).
     association : 'hungarian' or 'cjpdaf' (:mod:`ptztrack.track.jpdaf`).
-    clutter_density_per_px2 : the CJPDAF's C.
+    clutter_density_per_px2 : the CJPDAF's C, and the false detections' density ``kappa`` of the existence
+        update (a tracker given a learned clutter rate uses that instead).
+    existence_update : 'bayes' (the module's docstring) or 'fixed'; existence_to_report : see there.
     """
 
     initial_speed_sigma_m_s: float
@@ -82,6 +93,8 @@ class TrackerParameters:
     report_position_sigma_m: float
     association: Literal["hungarian", "cjpdaf"]
     clutter_density_per_px2: float
+    existence_update: Literal["bayes", "fixed"] = "bayes"
+    existence_to_report: float = 0.5
 
 
 DetectionModel = Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray]
@@ -251,7 +264,11 @@ def update_tracks(
         updated_index = track_index
     if detectable is None:
         detectable = (in_front & inside_image(camera, predicted_px)).astype(float)
-    survivors, keep = _after_update(tracks, mean, covariance, updated_index, detectable, parameters)
+    likelihood_px2 = np.zeros(len(tracks))
+    likelihood_px2[track_index] = innovation_likelihood(
+        feet_px[detection_index] - predicted_px[track_index], S[track_index]
+    )
+    survivors, keep = _after_update(tracks, mean, covariance, updated_index, detectable, parameters, likelihood_px2)
     if parameters.association == "cjpdaf":
         unmatched = np.flatnonzero(~gated[keep].any(axis=0))
     else:
@@ -335,6 +352,27 @@ def _with_births(tracks: Tracks, survivors: Tracks, keep, born: Tracks, track_in
     )
 
 
+def innovation_likelihood(innovation, S) -> np.ndarray:
+    """``N(nu; 0, S)`` for innovations (k, d) of covariances (k, d, d), in the inverse units of ``S``'s
+    determinant's square root (1/px^2 for feet pixels); (k,)."""
+    innovation, S = np.asarray(innovation, dtype=float), np.asarray(S, dtype=float)
+    if len(innovation) == 0:
+        return np.zeros(0)
+    d2 = np.einsum("ki,kij,kj->k", innovation, np.linalg.inv(S), innovation)
+    return np.exp(-0.5 * d2) / np.sqrt(np.linalg.det(2 * np.pi * S))
+
+
+def existence_after_detection(existence, detectable, likelihood, clutter_density, cap: float) -> np.ndarray:
+    """Bayes' rule for a detected track (the module's docstring): ``r (1 - q + q g / kappa) / (1 - r q +
+    r q g / kappa)`` for existence ``r``, detection probability ``q`` and the detection's likelihood ``g``
+    (all (n,)) against clutter of density ``kappa``, at most ``cap``; ``cap`` where ``kappa`` is 0."""
+    r, q, g = (np.asarray(value, dtype=float) for value in (existence, detectable, likelihood))
+    if clutter_density <= 0:
+        return np.full(r.shape, cap)
+    ratio = 1.0 - q + q * g / clutter_density
+    return np.minimum(r * ratio / (1.0 - r + r * ratio), cap)
+
+
 def existence_after_miss(existence, detectable) -> np.ndarray:
     """Bayes' rule for a track not detected: ``r (1 - q) / (1 - r q)`` for existence ``r`` and the
     probability ``q`` that the detector would have found the person were it there (both (n,))."""
@@ -342,11 +380,23 @@ def existence_after_miss(existence, detectable) -> np.ndarray:
     return existence * (1.0 - detectable) / (1.0 - existence * detectable)
 
 
-def _after_update(tracks: Tracks, mean, covariance, track_index, detectable, parameters: TrackerParameters):
+def _after_update(
+    tracks: Tracks, mean, covariance, track_index, detectable, parameters: TrackerParameters, likelihood=None
+):
     """The updated tracks' existence, hits and deletions (see :func:`update_tracks`); returns the
-    survivors and which of the tracks survived (n,) bool."""
+    survivors and which of the tracks survived (n,) bool. likelihood : (n,) each detected track's
+    detection likelihood ``g`` (None: the fixed update)."""
     existence = existence_after_miss(tracks.existence, detectable)
-    existence[track_index] = parameters.existence_when_detected
+    if parameters.existence_update == "fixed" or likelihood is None:
+        existence[track_index] = parameters.existence_when_detected
+    else:
+        existence[track_index] = existence_after_detection(
+            tracks.existence[track_index],
+            np.broadcast_to(detectable, len(tracks))[track_index],
+            likelihood[track_index],
+            parameters.clutter_density_per_px2,
+            parameters.existence_when_detected,
+        )
     hits = tracks.hits.copy()
     hits[track_index] += 1
     updated = replace(tracks, mean=mean, covariance=covariance, existence=existence, hits=hits)
@@ -417,6 +467,8 @@ class EkfTracker:
     detection_model : what the detector would find (see :data:`DetectionModel`);
     learner : given every step's :class:`~ptztrack.types.TrackerEvidence` (a detector model that
         learns from it, say; None: nobody).
+    clutter_per_view : the false detections expected in a view, read every step (a learned model's
+        estimate); its density over the image replaces ``parameters.clutter_density_per_px2``.
     """
 
     camera: PTZCamera
@@ -427,6 +479,7 @@ class EkfTracker:
     detection_model: DetectionModel
     tracks: Tracks = field(default_factory=Tracks.empty)
     learner: Callable[[TrackerEvidence], None] | None = None
+    clutter_per_view: Callable[[], float] | None = None
 
     def predict(self) -> Tracks:
         self.tracks = predict_tracks(self.tracks, self.F, self.U)
@@ -439,7 +492,11 @@ class EkfTracker:
         detections = Detections.empty() if detections is None else detections
         tracks, pose = self.tracks, np.asarray(pose, dtype=float)
         detectable = self.detection_model(tracks.mean[:, :2], tracks.covariance[:, :2, :2], pose)
-        update = update_tracks(tracks, detections.feet_px, self.camera, pose, self.V, self.parameters, detectable)
+        parameters = self.parameters
+        if self.clutter_per_view is not None:
+            image_area_px2 = self.camera.image_width_px * self.camera.image_height_px
+            parameters = replace(parameters, clutter_density_per_px2=self.clutter_per_view() / image_area_px2)
+        update = update_tracks(tracks, detections.feet_px, self.camera, pose, self.V, parameters, detectable)
         self.tracks = update.tracks
         if self.learner is not None:
             self.learner(
@@ -448,6 +505,10 @@ class EkfTracker:
         return update
 
     def reported(self) -> Tracks:
-        """The tracks detected ``confirmation_hits`` times or more and localised within ``report_position_sigma_m``."""
+        """The tracks whose existence is ``existence_to_report`` or more (with the 'bayes' update), detected
+        ``confirmation_hits`` times or more and localised within ``report_position_sigma_m``."""
         confirmed = self.tracks.confirmed(self.parameters.confirmation_hits)
-        return confirmed.select(confirmed.position_sigma_m <= self.parameters.report_position_sigma_m)
+        sure = confirmed.position_sigma_m <= self.parameters.report_position_sigma_m
+        if self.parameters.existence_update == "bayes":
+            sure &= confirmed.existence >= self.parameters.existence_to_report
+        return confirmed.select(sure)
