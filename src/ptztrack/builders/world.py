@@ -147,22 +147,25 @@ def detector_model(
     """What the policies and the tracker know of the detector (``detector.model``): the scenario's curve with
     its r0 shifted by ``detector.prior_shift_px`` as the prior, learned as the run goes ('online') or kept
     ('a-priori'); the unshifted curve kept ('true'); or an earlier run's ``detector_model.json`` as the prior.
-    The ideal detector's model is perfect and kept."""
+    The ideal detector's model is perfect and kept. seed : the stream of the model's draws."""
     detector = scenario.detector
     true_curve = recall_model(scenario)
     people = (camera, scenario.control.person_height_m, scenario.people.width_m)
-    clutter, noise = detector.false_positives_per_frame, detector.pixel_noise_px
-    if true_curve.perfect or detector.model == "true":
-        return OnlineDetectorModel(
-            *people, true_curve, learning=False, false_positives_per_view=clutter, pixel_noise_px=noise
-        )
-    if detector.model in ("online", "a-priori"):
-        shifted = RecallModel(true_curve.kd_per_px, max(true_curve.r0_px + detector.prior_shift_px, 0.0))
+    rng = np.random.default_rng(seed if seed is not None else 0)
+    if detector.model not in ("online", "a-priori", "true"):
+        return OnlineDetectorModel(*people, **read_detector_model_file(detector.model), rng=rng)
+    prior, learning = true_curve, False
+    if not true_curve.perfect and detector.model != "true":
+        prior = RecallModel(true_curve.kd_per_px, max(true_curve.r0_px + detector.prior_shift_px, 0.0))
         learning = detector.model == "online"
-        return OnlineDetectorModel(
-            *people, shifted, learning=learning, false_positives_per_view=clutter, pixel_noise_px=noise
-        )
-    return OnlineDetectorModel(*people, **read_detector_model_file(detector.model))
+    return OnlineDetectorModel(
+        *people,
+        prior,
+        learning=learning,
+        false_positives_per_view=detector.false_positives_per_frame,
+        pixel_noise_px=detector.pixel_noise_px,
+        rng=rng,
+    )
 
 
 def build_world(
