@@ -45,8 +45,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--json", type=Path, help="write the bins here")
     args = parser.parse_args()
-    import os, json as _j
-    scenario = pets_scenario("hog", **{"control.beta": 1.0, "detector.model": "online", **_j.loads(os.environ.get("OVR", "{}"))})
+    scenario = pets_scenario("hog", **{"control.beta": 1.0, "detector.model": "online"})
     world = episode_world(scenario, 0)
     episode = run_episode(scenario, "smpl", 0, world)
     model = world.detector_model.as_dict()
