@@ -4,8 +4,12 @@ Runs `smpl` (beta 1, seed 0, the a-priori protocol) with OpenCV's HOG on the
 PETS 2009 S2.L1 virtual views and the online detector model, then, only for
 this report, matches each step's detections to the annotated people fully in
 view and hidden at most ``recording.occluded_above`` (a detection's feet
-within 0.3 of the person's height of theirs, as the recall fit does) and
-prints, per height bin, the learned recall beside the annotated one.
+within 0.3 of the person's annotated height of theirs, as the recall fit
+does) and prints, per height bin, the learned recall beside the annotated
+one. Both bin a person by the height the model gives a track: that of a
+person of the policies' height (1.75 m) standing at the ground point, here
+the annotated one (an annotated box is taller or shorter by the person's
+own height and the box's margins).
 
     python benchmarks/detector_model.py [--json PATH]
 """
@@ -21,13 +25,15 @@ from ptztrack.config import pets_scenario
 from ptztrack.detect.detector_model import HEIGHT_BIN_EDGES_PX
 from ptztrack.detect.recall_fit import MATCH_FRACTION_OF_HEIGHT
 from ptztrack.evaluate.metrics import episode_metrics
+from ptztrack.geometry.ptz import project_people
 
 MIN_PEOPLE = 50
 
 
-def annotated_recall_trials(world, episode, occluded_above: float) -> tuple[np.ndarray, np.ndarray]:
-    """The annotated people fully in view at each step's pose: their heights (K,) px and whether a
-    detection of that step found them (K,)."""
+def annotated_recall_trials(world, episode, scenario, occluded_above: float) -> tuple[np.ndarray, np.ndarray]:
+    """The annotated people fully in view at each step's pose: their heights (K,) px, as the model
+    measures a track's (a person of the policies' height standing at the annotated ground point), and
+    whether a detection of that step found them (K,)."""
     heights, found = [], []
     for step, (pose, detections) in enumerate(zip(episode.poses, episode.detections, strict=True)):
         people = world.backend.people(step, pose)
@@ -36,7 +42,11 @@ def annotated_recall_trials(world, episode, occluded_above: float) -> tuple[np.n
             continue
         distance_px = np.linalg.norm(people.feet_px[visible, None] - detections.feet_px[None], axis=-1)
         near = distance_px <= MATCH_FRACTION_OF_HEIGHT * people.height_px[visible, None]
-        heights.append(people.height_px[visible])
+        ground_m = world.truth.positions_m[step, people.person_index[visible]]
+        modelled = project_people(
+            world.camera, pose, ground_m, scenario.control.person_height_m, scenario.people.width_m
+        )
+        heights.append(modelled.height_px)
         found.append(near.any(axis=1) if len(detections) else np.zeros(visible.sum(), dtype=bool))
     return np.concatenate(heights), np.concatenate(found)
 
@@ -50,7 +60,7 @@ def main() -> None:
     episode = run_episode(scenario, "smpl", 0, world)
     model = world.detector_model.as_dict()
     occluded_above = scenario.required_recording("the annotated recall").occluded_above
-    heights, found = annotated_recall_trials(world, episode, occluded_above)
+    heights, found = annotated_recall_trials(world, episode, scenario, occluded_above)
     which = np.digitize(heights, HEIGHT_BIN_EDGES_PX) - 1
     print(f"smpl b1, seed 0: MOTA {episode_metrics(episode)['mota']:.1%}, mean zoom {episode.poses[:, 2].mean():.2f}")
     curve = model["curve"]

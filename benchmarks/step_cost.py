@@ -117,8 +117,8 @@ def step_costs(scenario, reference: HogPeopleDetector, policy_name: str, steps: 
     The loop is run_loop's (a perfect camera, the commanded pose) with the backend's image split
     into reading and warping.
     """
-    scene_seed, _detector_seed, policy_seed, _landing_seed, _tracker_seed = episode_seeds(seed)
-    world = build_world(scenario, np.random.default_rng(scene_seed))
+    scene_seed, _detector_seed, policy_seed, _landing_seed, _tracker_seed, model_seed = episode_seeds(seed)
+    world = build_world(scenario, np.random.default_rng(scene_seed), model_seed=model_seed)
     backend, detector = world.backend, world.detector
     if not isinstance(detector, HogPeopleDetector) or detector.search is None:
         raise ValueError("the scenario must use the HOG detector with a ground search")

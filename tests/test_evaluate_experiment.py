@@ -140,7 +140,8 @@ def test_experiment_command_prints_the_table_and_writes_one_row_per_strategy(tmp
 
 
 def table(detector):
-    scenario = scenario_from_dict({"detector": {"kind": detector}})
+    # The paper's protocol: the policies know the simulated detector's curve.
+    scenario = scenario_from_dict({"detector": {"kind": detector, "model": "true"}})
     return {row["label"]: row for row in summarise(run_cells(synthetic_cells(scenario, 12), run_cell, "local"))}
 
 
