@@ -128,6 +128,7 @@ def integral_detection_weight(policy: InformationGainPolicy, poses, mean_m, posi
             )
             # the scale alone can overflow where the shifted Gaussian is far outside the rectangle
             alpha = np.where((alpha > 0) & (shifted > 0), alpha - np.exp(log_scale + np.log(shifted)), alpha)
+            alpha = recall.plateau * alpha
     return np.where(_in_front(H, mean_m), np.clip(alpha, 0.0, 1.0), 0.0)
 
 
