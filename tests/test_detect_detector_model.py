@@ -157,3 +157,21 @@ def test_the_prior_weighs_as_many_trials_per_bin_as_it_says():
     learned = model()
     assert np.all(learned.prior_trials == PRIOR_TRIALS_PER_BIN)
     assert len(learned.prior_trials) == len(HEIGHT_BIN_EDGES_PX) - 1
+
+
+def test_a_run_writes_what_it_learned_and_the_next_run_starts_from_it(tmp_path, capsys):
+    from ptztrack.cli import main
+
+    first = tmp_path / "first"
+    assert main(["run", "--frames", "15", "--quiet", "--out", str(first)]) == 0
+    learned = json.loads((first / "detector_model.json").read_text())
+    assert learned["learning"] is True
+    prior_trials = PRIOR_TRIALS_PER_BIN * (len(HEIGHT_BIN_EDGES_PX) - 1)
+    assert sum(learned["trials"]) > prior_trials + 5  # the run's own trials beside the prior's pseudo-trials
+    second = tmp_path / "second"
+    arguments = ["run", "--frames", "15", "--quiet", "--detector-model", str(first / "detector_model.json")]
+    assert main([*arguments, "--out", str(second)]) == 0
+    again = json.loads((second / "detector_model.json").read_text())
+    # The second run's counts start from the first's and only grow.
+    assert np.all(np.asarray(again["trials"]) >= np.asarray(learned["trials"]) - 1e-9)
+    assert again["views"] == learned["views"] + 15
