@@ -52,7 +52,7 @@ from ptztrack.geometry.occlusion import occluded_fraction
 from ptztrack.geometry.ptz import PTZCamera, look_at, person_in_view, project_people
 from ptztrack.types import TrackerEvidence
 
-# Bins 1.25x apart from 4 px to 256 px: a person is a few pixels to a whole view tall.
+# 19 bins 1.25x apart from 4 px to 278 px: a person is a few pixels to a whole view tall.
 HEIGHT_BIN_EDGES_PX = 4.0 * 1.25 ** np.arange(0, 20)
 # The prior's weight: as if the camera had seen two people of every size (a priori, before any run).
 PRIOR_TRIALS_PER_BIN = 2.0
