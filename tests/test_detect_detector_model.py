@@ -29,7 +29,7 @@ def evidence(pose, mean_m, detected, existence=None, hits=None, excess_px2=(), f
     return TrackerEvidence(
         pose=np.asarray(pose, dtype=float),
         mean_m=np.asarray(mean_m, dtype=float).reshape(n, 2),
-        position_cov_m2=np.broadcast_to(0.01 * np.eye(2), (n, 2, 2)),
+        position_sigma_m=np.full(n, 0.1),
         existence=np.ones(n) if existence is None else np.asarray(existence, dtype=float),
         hits=np.full(n, 5) if hits is None else np.asarray(hits),
         detected=np.asarray(detected, dtype=bool),

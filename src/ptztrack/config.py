@@ -321,7 +321,7 @@ class Tracker(_Strict):
     probability that a track's person exists (:mod:`ptztrack.track.tracker`); existence_update 'bayes'
     weighs each detection against the clutter (the learned rate where the detector model learns,
     else ``clutter_density_per_px2``) and reports tracks of existence ``existence_to_report`` or more;
-    'fixed' is the lifecycle before issue 28.
+    'fixed' sets it to ``existence_when_detected`` at every detection and reports every track.
     max_position_sigma_m : where people can leave the scene (a recording, or ``people.enter_leave``),
     a track this uncertain is deleted; where they never leave, uncertainty deletes nobody.
     report_position_sigma_m : a track more uncertain than this is kept but not reported.

@@ -47,7 +47,8 @@ class TrackerEvidence:
     """What one tracker step tells about its detector, without any annotation.
 
     pose : (3,) the pose the detections were mapped with.
-    mean_m : (n, 2) and position_cov_m2 : (n, 2, 2) the tracks' predicted ground positions before the update.
+    mean_m : (n, 2) the tracks' predicted ground positions before the update; position_sigma_m : (n,) their
+        standard deviations along the most uncertain direction (:attr:`Tracks.position_sigma_m`).
     existence : (n,) their existence probabilities before the update; hits : (n,) their detections so far.
     detected : (n,) bool, whether a detection was assigned to each.
     excess_px2 : (m,) for each detected track, ``|nu|^2 - tr(C P C^T)``: the squared innovation less the
@@ -58,7 +59,7 @@ class TrackerEvidence:
 
     pose: np.ndarray
     mean_m: np.ndarray
-    position_cov_m2: np.ndarray
+    position_sigma_m: np.ndarray
     existence: np.ndarray
     hits: np.ndarray
     detected: np.ndarray

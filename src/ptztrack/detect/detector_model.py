@@ -128,7 +128,6 @@ class OnlineDetectorModel:
         self._parameters, self._log_recall, self._log_miss = _curve_grid(self.prior, self.centres_px)
         self.curve = self.prior
         self._refit()
-        self.planning_curve = self.curve
         self._draw()
 
     # The RecallModel the policies and the tracker read.
@@ -160,15 +159,13 @@ class OnlineDetectorModel:
         self.excess_sum_px2 += float(np.sum(evidence.excess_px2))
         self.innovations += len(evidence.excess_px2)
         index, height_px, weight = self.trials_of(evidence)
-        if len(index) == 0:
-            self._draw()
-            return
-        which = np.digitize(height_px, HEIGHT_BIN_EDGES_PX) - 1
-        inside = (which >= 0) & (which < len(self.centres_px))
-        self.trials += np.bincount(which[inside], weight[inside], len(self.centres_px))
-        found = weight * evidence.detected[index]
-        self.successes += np.bincount(which[inside], found[inside], len(self.centres_px))
-        self._refit()
+        if len(index):
+            which = np.digitize(height_px, HEIGHT_BIN_EDGES_PX) - 1
+            inside = (which >= 0) & (which < len(self.centres_px))
+            self.trials += np.bincount(which[inside], weight[inside], len(self.centres_px))
+            found = weight * evidence.detected[index]
+            self.successes += np.bincount(which[inside], found[inside], len(self.centres_px))
+            self._refit()
         self._draw()
 
     def trials_of(self, evidence: TrackerEvidence) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -178,8 +175,7 @@ class OnlineDetectorModel:
         mean_m = np.asarray(evidence.mean_m, dtype=float)
         if len(mean_m) == 0:
             return none
-        sigma_m = np.sqrt(np.max(np.linalg.eigvalsh(evidence.position_cov_m2), axis=-1))
-        candidate = (evidence.hits >= ESTABLISHED_HITS) & (sigma_m <= TRIAL_POSITION_SIGMA_M)
+        candidate = (evidence.hits >= ESTABLISHED_HITS) & (evidence.position_sigma_m <= TRIAL_POSITION_SIGMA_M)
         if not candidate.any():
             return none
         people = project_people(self.camera, evidence.pose, mean_m, self.person_height_m, self.person_width_m)

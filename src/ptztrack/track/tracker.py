@@ -26,7 +26,7 @@ covariance ``S``, against false detections of density ``kappa`` per px^2,
 the ratio of the detection's likelihood as this person's to its likelihood as
 clutter; at most ``existence_when_detected`` (a detection never makes a track
 certain: a false positive can repeat). ``existence_update`` 'fixed' sets
-it to ``existence_when_detected`` instead (the lifecycle before issue 28).
+it to ``existence_when_detected`` instead and reports every track until it is deleted.
 Below ``existence_to_delete`` the track goes. A new track starts at
 ``existence_at_birth`` (one detection: a new person, a false positive or
 somebody already tracked). Every track is kept for the policy and for
@@ -392,7 +392,7 @@ def _after_update(
     else:
         existence[track_index] = existence_after_detection(
             tracks.existence[track_index],
-            np.broadcast_to(detectable, len(tracks))[track_index],
+            detectable[track_index],
             likelihood[track_index],
             parameters.clutter_density_per_px2,
             parameters.existence_when_detected,
@@ -449,7 +449,7 @@ def tracker_evidence(
     return TrackerEvidence(
         pose=np.asarray(pose, dtype=float),
         mean_m=tracks.mean[:, :2],
-        position_cov_m2=tracks.covariance[:, :2, :2],
+        position_sigma_m=tracks.position_sigma_m,
         existence=tracks.existence,
         hits=tracks.hits,
         detected=detected,
