@@ -31,6 +31,7 @@ def test_a_move_takes_as_long_as_its_slowest_axis():
     assert times.seconds([0, 0, 1], [30, 5, 1]) == pytest.approx(max(0.2 + 0.3, 0.3 + 0.1))
     assert times.seconds([0, 0, 1], [0, 0, 3]) == pytest.approx(1.1)
     assert times.seconds([1, 2, 3], [1, 2, 3]) == 0.0
+    np.testing.assert_allclose(times.seconds([0, 0, 1], [[30, 5, 1], [0, 0, 3], [0, 0, 1]]), [0.5, 1.1, 0.0])
 
 
 def test_credentials_come_from_the_url_then_the_file_then_the_environment():

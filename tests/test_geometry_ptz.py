@@ -18,6 +18,7 @@ from ptztrack.geometry.ptz import (
     look_at,
     pixels_to_ground,
     plane_homography,
+    pose_noise_px2,
     project_people,
     projection_matrix,
     rotation_homography,
@@ -553,3 +554,25 @@ def test_no_one_stands_beyond_the_horizon():
     pose = np.array([0.0, 10.0, 1.0])
     above_px = [[320.0, horizon_row_px(pose) - 5.0]]
     assert np.isnan(standing_height_px(CAMERA, pose, 1.75, above_px)).all()
+
+
+@given(st.floats(-60, 60), st.floats(5, 60), st.floats(1.0, 8.0))
+def test_pose_noise_is_the_image_shift_of_a_small_pose_error_at_the_centre_and_over_the_image(pan, tilt, zoom):
+    """A pan or tilt error of ``e`` moves the image centre by ``f cos(tilt) e`` or ``f e`` px, as
+    projecting the point seen there at the two poses shows; a zoom error ``e`` moves a point spread
+    evenly over the image by ``e / z`` of its offset from the centre, whose mean square is ``(w^2 or
+    h^2) / 12``."""
+    pose, error_deg = np.array([pan, tilt, zoom]), 1e-4
+    centre = CAMERA.principal_point_px
+    for axis in (0, 1):
+        seen_m = apply_homography(image_to_ground(CAMERA, pose), centre[None])[0]
+        assume(np.all(np.isfinite(seen_m)))
+        moved = pose.copy()
+        moved[axis] += error_deg
+        shift_px = np.linalg.norm(apply_homography(ground_to_image(CAMERA, moved), seen_m[None])[0] - centre)
+        sd = np.zeros(3)
+        sd[axis] = error_deg
+        np.testing.assert_allclose(np.sqrt(np.trace(pose_noise_px2(CAMERA, pose, sd))), shift_px, rtol=1e-3)
+    zoom_noise = pose_noise_px2(CAMERA, pose, [0.0, 0.0, 0.01 * zoom])
+    np.testing.assert_allclose(np.diag(zoom_noise), np.array([640.0, 480.0]) ** 2 * 1e-4 / 12)
+    assert zoom_noise[0, 1] == 0.0

@@ -1,3 +1,5 @@
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -81,6 +83,23 @@ def assert_tracks_follow_walkers(start, velocity, steps: int, config: TrackerPar
 
 def test_tracks_follow_walkers_and_keep_their_ids():
     assert_tracks_follow_walkers(np.array([[4.0, 4.0], [11.0, 10.0]]), np.array([[1.0, 0.5], [-0.8, -0.6]]), 30, CONFIG)
+
+
+def test_the_tracker_predicts_by_any_time_and_by_its_step_by_default():
+    """Two predictions of 0.1 s move a walker as one of 0.2 s (its own step), and its spread grows with
+    the time as the constant-velocity model's closed form says."""
+    tracks = start_tracks(feet_px([[5.0, 5.0]]), CAMERA, POSE, V, CONFIG.initial_speed_sigma_m_s, first_id=0)
+    tracks = replace(tracks, mean=np.array([[5.0, 5.0, 1.0, -0.5]]))
+    halves = EkfTracker(CAMERA, 0.2, ACCELERATION_SIGMA_M_S2, V, CONFIG, lambda *a: np.ones(len(a[0])), tracks)
+    whole = EkfTracker(CAMERA, 0.2, ACCELERATION_SIGMA_M_S2, V, CONFIG, lambda *a: np.ones(len(a[0])), tracks)
+    halves.predict(0.1)
+    halves.predict(0.1)
+    whole.predict()
+    np.testing.assert_allclose(halves.tracks.mean, whole.tracks.mean)
+    np.testing.assert_allclose(whole.tracks.mean, [[5.2, 4.9, 1.0, -0.5]])
+    F, U = constant_velocity_model(0.7, ACCELERATION_SIGMA_M_S2)
+    later = EkfTracker(CAMERA, 0.2, ACCELERATION_SIGMA_M_S2, V, CONFIG, lambda *a: np.ones(len(a[0])), tracks)
+    np.testing.assert_allclose(later.predict(0.7).covariance[0], F @ tracks.covariance[0] @ F.T + U)
 
 
 def test_hungarian_assignment_ignores_detection_order_and_gates_outliers():
@@ -219,14 +238,13 @@ def test_the_tracker_reports_only_tracks_sure_enough_to_exist():
     start = feet_px([[7.5, 6.0]])
     first = update_tracks(Tracks.empty(), start, CAMERA, POSE, V, params, np.zeros(0)).tracks
     assert first.existence[0] == pytest.approx(0.4)
-    tracker = EkfTracker(
-        CAMERA, *constant_velocity_model(0.2, ACCELERATION_SIGMA_M_S2), V, params, lambda *a: np.ones(len(a[0]))
-    )
+    tracker = EkfTracker(CAMERA, 0.2, ACCELERATION_SIGMA_M_S2, V, params, lambda *a: np.ones(len(a[0])))
     tracker.tracks = first
     assert len(tracker.reported()) == 0
     fixed = EkfTracker(
         CAMERA,
-        *constant_velocity_model(0.2, ACCELERATION_SIGMA_M_S2),
+        0.2,
+        ACCELERATION_SIGMA_M_S2,
         V,
         parameters(**fields, existence_update="fixed"),
         lambda *a: np.ones(len(a[0])),

@@ -56,16 +56,20 @@ class Detector(Protocol):
 class Tracker(Protocol):
     """Keeps beliefs about people on the ground plane, one step at a time."""
 
-    def predict(self) -> Tracks:
-        """Advance every track by one step; returns the predicted tracks, which the policy plans with."""
+    def predict(self, dt_s: float | None = None) -> Tracks:
+        """Advance every track by one step (``dt_s`` seconds; None: the tracker's own step); returns the
+        predicted tracks, which the policy plans with."""
         ...
 
     def wants_detections(self, step: int) -> bool:
         """Whether the detector should run at ``step`` (a tracker may measure on its own in between)."""
         ...
 
-    def update(self, detections: Detections | None, pose: np.ndarray, view: ImageSource) -> TrackUpdate:
-        """Update with the step's detections (None where it did not ask for any), taken at ``pose``."""
+    def update(
+        self, detections: Detections | None, pose: np.ndarray, view: ImageSource, pose_sd: np.ndarray | None = None
+    ) -> TrackUpdate:
+        """Update with the step's detections (None where it did not ask for any), taken at ``pose``, known
+        to within ``pose_sd`` (3,) standard deviations (None: exactly)."""
         ...
 
     def reported(self) -> Tracks:

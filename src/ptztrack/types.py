@@ -180,11 +180,13 @@ class DecisionContext:
 
     step : time step being decided (0-based).
     current_action : flat index of the grid action the camera was sent to last (the nearest one
-        when it was last sent to a pose off the grid).
+        when it was last sent to a pose off the grid; for a live camera, the nearest to where it is).
     reachable : flat indices of the actions the mechanics allow next.
     tracks : the tracks predicted to this step (``x-``, ``P-``), before observing.
     rng : the run's random generator; policies draw only from it.
-    current_pose : (3,) the pose the camera was last sent to (pan_deg, tilt_deg, zoom).
+    current_pose : (3,) the pose the camera was last sent to (pan_deg, tilt_deg, zoom); for a live
+        camera, where it is.
+    dt_s : the scenario's seconds since the last decision (None: one step).
     """
 
     step: int
@@ -193,3 +195,4 @@ class DecisionContext:
     tracks: Tracks
     rng: np.random.Generator
     current_pose: np.ndarray = field(default_factory=lambda: np.full(3, np.nan))
+    dt_s: float | None = None

@@ -21,7 +21,6 @@ from ptztrack.detect.hog import GroundSearch, HogPeopleDetector
 from ptztrack.detect.simulated import AnnotationDetector, RecallCurve, RecallDetector, RecallModel
 from ptztrack.loop import World
 from ptztrack.scene.pets import RecordedVideo
-from ptztrack.track.kalman import constant_velocity_model
 from ptztrack.track.templates import TemplateTracker
 from ptztrack.track.tracker import DetectionModel, EkfTracker, TrackerParameters, pixel_noise_covariance
 
@@ -179,13 +178,12 @@ def ekf_tracker(scenario: Scenario, world: World) -> EkfTracker | TemplateTracke
     """One EKF per person on the ground (``tracker.association``), measured by the detector or, with
     ``tracker.measurement_source`` 'spatiogram', by colour templates between detector steps."""
     config = scenario.tracker
-    F, U = constant_velocity_model(1.0 / scenario.frame_rate_hz, config.acceleration_sigma_m_s2)
     parameters, model = tracker_parameters(scenario), detection_model(scenario, world)
     learned = world.detector_model
     tracker = EkfTracker(
         world.camera,
-        F,
-        U,
+        1.0 / scenario.frame_rate_hz,
+        config.acceleration_sigma_m_s2,
         pixel_noise(scenario),
         parameters,
         model,

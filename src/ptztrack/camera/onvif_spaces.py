@@ -76,15 +76,12 @@ class MoveTimes:
     tilt: tuple[float, float]
     zoom: tuple[float, float]
 
-    def seconds(self, start, end) -> float:
-        """How long a move from pose ``start`` (3,) to ``end`` (3,) takes; 0 if nothing moves."""
+    def seconds(self, start, end):
+        """How long moves from pose ``start`` (3,) to poses ``end`` (..., 3) take: the slowest axis's
+        time, an axis that does not move taking none; shape (...)."""
         distance = np.abs(np.asarray(end, dtype=float) - np.asarray(start, dtype=float))
-        times = [
-            intercept + slope * d
-            for (intercept, slope), d in zip((self.pan, self.tilt, self.zoom), distance, strict=True)
-            if d > 0
-        ]
-        return max(times, default=0.0)
+        intercept, slope = np.array([self.pan, self.tilt, self.zoom], dtype=float).T
+        return np.max(np.where(distance > 0, intercept + slope * distance, 0.0), axis=-1)
 
 
 def _between(ends, normalised) -> np.ndarray:

@@ -61,14 +61,15 @@ class ExplorationMap:
     in_view : (L, C) whether that person stands fully in view.
     recall : the detector model, read at every decision (a learned model changes as the camera runs).
     occupancy : (C,) current beliefs ``p_c``.
-    arrival_probability : (C,) chance that a person arrives in a cell during one step.
+    arrival_rate_per_s : (C,) the rate at which people arrive in each cell; step_s : a step's seconds.
     """
 
     height_px: np.ndarray = field(repr=False)
     in_view: np.ndarray = field(repr=False)
     recall: RecallCurve
     occupancy: np.ndarray
-    arrival_probability: np.ndarray = field(repr=False)
+    arrival_rate_per_s: np.ndarray = field(repr=False)
+    step_s: float
 
     def detection_probability(self, actions) -> np.ndarray:
         """``q_c(a)`` (len(actions), C) for flat action indices ``actions`` (a scalar index: (C,))."""
@@ -78,9 +79,11 @@ class ExplorationMap:
         """``I_p(a)`` for the given flat action indices; (len(actions),)."""
         return self.detection_probability(actions) @ binary_entropy_nats(self.occupancy)
 
-    def advance(self, action: int) -> None:
-        """One step: people may arrive anywhere, then the camera looks with ``action``."""
-        self.occupancy = 1.0 - (1.0 - self.occupancy) * (1.0 - self.arrival_probability)
+    def advance(self, action: int, dt_s: float | None = None) -> None:
+        """One step of ``dt_s`` seconds (None: ``step_s``): people may arrive anywhere, each cell's with
+        probability ``1 - exp(-rate dt)``, then the camera looks with ``action``."""
+        arrival_probability = -np.expm1(-self.arrival_rate_per_s * (self.step_s if dt_s is None else dt_s))
+        self.occupancy = 1.0 - (1.0 - self.occupancy) * (1.0 - arrival_probability)
         q = self.detection_probability(action)
         self.occupancy = self.occupancy * (1.0 - q) / (1.0 - self.occupancy * q)
 
@@ -110,5 +113,6 @@ def exploration_map(
         in_view=person_in_view(camera, people),
         recall=recall,
         occupancy=np.full(len(centres), min(prior_untracked_people / cells, 0.5)),
-        arrival_probability=np.full(len(centres), -np.expm1(-arrival_rate_per_s * dt_s / cells)),
+        arrival_rate_per_s=np.full(len(centres), arrival_rate_per_s / cells),
+        step_s=dt_s,
     )

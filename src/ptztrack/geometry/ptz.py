@@ -50,6 +50,29 @@ class PTZCamera:
         return np.array([self.image_width_px / 2.0, self.image_height_px / 2.0])
 
 
+def pose_noise_px2(camera: PTZCamera, pose, pose_sd) -> np.ndarray:
+    """The pixel noise (2, 2) px^2 that an error of standard deviation ``pose_sd`` (3,) (deg, deg, zoom
+    factor) in the pose (3,) adds to a point of the image, the errors independent:
+
+        V_pose = diag((f cos(tilt) s_pan)^2 + (w s_zoom / z)^2 / 12,  (f s_tilt)^2 + (h s_zoom / z)^2 / 12),
+
+    with ``f`` the focal length (px) at zoom ``z`` and ``s_pan``, ``s_tilt`` in radians: a pan (about the
+    vertical, at ``cos(tilt)`` to the image plane) and a tilt move the image centre by that many px, and a
+    zoom scales the image about its centre, which moves a point spread evenly over a ``w`` x ``h`` image
+    by ``w / sqrt(12)`` (``h / sqrt(12)``) px per unit of relative zoom, root mean square."""
+    pan_sd, tilt_sd, zoom_sd = np.asarray(pose_sd, dtype=float)
+    _, tilt_deg, zoom = np.asarray(pose, dtype=float)
+    focal_px = zoom * camera.f_min_px
+    relative_zoom_sd = zoom_sd / zoom
+    return np.diag(
+        [
+            (focal_px * np.cos(np.deg2rad(tilt_deg)) * np.deg2rad(pan_sd)) ** 2
+            + (camera.image_width_px * relative_zoom_sd) ** 2 / 12,
+            (focal_px * np.deg2rad(tilt_sd)) ** 2 + (camera.image_height_px * relative_zoom_sd) ** 2 / 12,
+        ]
+    )
+
+
 def rotation_world_to_camera(pan_deg, tilt_deg) -> np.ndarray:
     """Rotation ``R`` with ``X_cam = R (X_world - C)``; shape ``(*P, 3, 3)``.
 

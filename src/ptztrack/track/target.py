@@ -44,6 +44,7 @@ from ptztrack.geometry.ptz import (
     apply_homography,
     homography_jacobian,
     plane_homography,
+    pose_noise_px2,
     rotation_homography,
     standing_height_px,
 )
@@ -175,7 +176,7 @@ class TargetTracker:
         (3,), the pose the camera was at before the first step.
     person_height_m : the height assumed for everybody (the track is under the person's middle).
     smoothing : the alpha-beta output filter's pole, in (0, 1) (0: no smoothing).
-    step_s : seconds per step.
+    step_s : seconds per step; dt_s : the time the last prediction stepped (``step_s`` unless it was given one).
     """
 
     camera: PTZCamera
@@ -188,9 +189,15 @@ class TargetTracker:
     pose: np.ndarray | None = None
     track: Tracks | None = None
     missed_steps: int = 0
+    dt_s: float = field(init=False)
 
-    def predict(self) -> Tracks:
-        """The track predicted to this step (one step of its velocity on), or the initial box's before the first."""
+    def __post_init__(self):
+        self.dt_s = self.step_s
+
+    def predict(self, dt_s: float | None = None) -> Tracks:
+        """The track predicted to this step (``dt_s``, by default ``step_s``, of its velocity on), or the
+        initial box's before the first; the next update's filter steps by the same time."""
+        self.dt_s = self.step_s if dt_s is None else dt_s
         if self.track is None:
             box = np.asarray(self.initial_box_px, dtype=float)
             centre = box[:2] + box[2:] / 2
@@ -198,12 +205,14 @@ class TargetTracker:
             position, covariance = self._ground(centre, spread_px2, self.initial_pose)
             return self._tracks(position, np.zeros(2), covariance, missed_steps=0, hits=0)
         mean = self.track.mean[0]
-        return replace(self.track, mean=np.r_[mean[:2] + self.step_s * mean[2:], mean[2:]][None])
+        return replace(self.track, mean=np.r_[mean[:2] + self.dt_s * mean[2:], mean[2:]][None])
 
     def wants_detections(self, step: int) -> bool:
         return False
 
-    def update(self, detections: Detections | None, pose, view: ImageSource) -> TrackUpdate:
+    def update(self, detections: Detections | None, pose, view: ImageSource, pose_sd=None) -> TrackUpdate:
+        """Step the target source on the view; pose_sd (3,) widens its box centre's noise by the pixel
+        noise of a pose known only so well (:func:`~ptztrack.geometry.ptz.pose_noise_px2`)."""
         image = view()
         if image is None:
             raise RuntimeError("the follow camera's tracker needs a camera backend that renders images")
@@ -218,7 +227,10 @@ class TargetTracker:
             estimate = self.source.step(image, rotation_homography(self.camera, self.pose, pose), standing)
         self.pose = pose
         box = np.asarray(estimate.box_px, dtype=float)
-        position, covariance = self._ground(box[:2] + box[2:] / 2, estimate.centre_covariance_px2, pose)
+        centre_covariance_px2 = estimate.centre_covariance_px2
+        if pose_sd is not None:
+            centre_covariance_px2 = centre_covariance_px2 + pose_noise_px2(self.camera, pose, pose_sd)
+        position, covariance = self._ground(box[:2] + box[2:] / 2, centre_covariance_px2, pose)
         self.track = self._filtered(position, covariance, estimate.lost)
         feet_px = np.array([[box[0] + box[2] / 2, box[1] + box[3]]])
         measured = Detections(feet_px, np.array([box[3]]), np.array([-1]))
@@ -246,10 +258,10 @@ class TargetTracker:
         mean = previous.mean[0]
         if lost:
             return self._tracks(mean[:2], np.zeros(2), previous.covariance[0, :2, :2], self.missed_steps, hits)
-        predicted = mean[:2] + self.step_s * mean[2:]
+        predicted = mean[:2] + self.dt_s * mean[2:]
         residual = position - predicted
         alpha, beta = 1 - self.smoothing**2, (1 - self.smoothing) ** 2
-        velocity = mean[2:] + beta / self.step_s * residual
+        velocity = mean[2:] + beta / self.dt_s * residual
         return self._tracks(predicted + alpha * residual, velocity, covariance, missed_steps=0, hits=hits + 1)
 
     def _tracks(self, position, velocity, covariance, missed_steps: int, hits: int) -> Tracks:

@@ -49,7 +49,13 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ptztrack.geometry.ptz import PTZCamera, apply_homography, head_from_feet_homology, inside_image
+from ptztrack.geometry.ptz import (
+    PTZCamera,
+    apply_homography,
+    head_from_feet_homology,
+    inside_image,
+    pose_noise_px2,
+)
 from ptztrack.roles import ImageSource
 from ptztrack.track import kalman
 from ptztrack.track.appearance import Spatiogram, search, spatiogram
@@ -209,25 +215,28 @@ class TemplateTracker:
     person_width_m: float
     templates: Templates = field(default_factory=dict)
 
-    def predict(self) -> Tracks:
-        return self.tracker.predict()
+    def predict(self, dt_s: float | None = None) -> Tracks:
+        return self.tracker.predict(dt_s)
 
     def wants_detections(self, step: int) -> bool:
         return step % self.detector_every_steps == 0
 
-    def update(self, detections: Detections | None, pose, view: ImageSource) -> TrackUpdate:
+    def update(self, detections: Detections | None, pose, view: ImageSource, pose_sd=None) -> TrackUpdate:
+        """The detector's update where it ran, else the templates'; pose_sd as :meth:`EkfTracker.update` takes it."""
         camera, height_m, width_m = self.tracker.camera, self.person_height_m, self.person_width_m
         image = view()
         if image is None:
             raise RuntimeError("template matching needs a camera backend that renders images")
         if detections is not None:
-            update = self.tracker.update(detections, pose, view)
+            update = self.tracker.update(detections, pose, view, pose_sd)
             feet_px = detections.feet_px[update.measurement_index]
             self.templates = refresh_templates(
                 self.templates, update.tracks.ids, image, camera, pose, update.track_ids, feet_px, height_m, width_m
             )
             return update
         tracks, V = self.tracker.tracks, self.tracker.V
+        if pose_sd is not None:
+            V = V + pose_noise_px2(camera, pose, pose_sd)
         found = template_measurements(image, camera, pose, tracks, self.templates, V, height_m, width_m)
         noise = template_noise_covariance(camera, pose, found.feet_px, height_m, V)
         max_sigma_m = self.tracker.parameters.max_position_sigma_m

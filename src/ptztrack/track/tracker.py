@@ -51,6 +51,7 @@ from ptztrack.geometry.ptz import (
     ground_to_image,
     image_to_ground,
     inside_image,
+    pose_noise_px2,
 )
 from ptztrack.roles import ImageSource
 from ptztrack.track import jpdaf, kalman
@@ -462,8 +463,9 @@ def tracker_evidence(
 class EkfTracker:
     """The ground-plane tracker as a role of the loop (:class:`ptztrack.roles.Tracker`).
 
-    camera : the camera model; F, U : the motion model (:func:`ptztrack.track.kalman.constant_velocity_model`);
-    V : (2, 2) px^2 the detections' noise; parameters : see :func:`update_tracks`;
+    camera : the camera model; step_s, acceleration_sigma_m_s2 : the motion model's step and its white
+    acceleration (:func:`ptztrack.track.kalman.constant_velocity_model`); V : (2, 2) px^2 the detections'
+    noise; parameters : see :func:`update_tracks`;
     detection_model : what the detector would find (see :data:`DetectionModel`);
     learner : given every step's :class:`~ptztrack.types.TrackerEvidence` (a detector model that
         learns from it, say; None: nobody).
@@ -472,8 +474,8 @@ class EkfTracker:
     """
 
     camera: PTZCamera
-    F: np.ndarray
-    U: np.ndarray
+    step_s: float
+    acceleration_sigma_m_s2: float
     V: np.ndarray
     parameters: TrackerParameters
     detection_model: DetectionModel
@@ -481,27 +483,33 @@ class EkfTracker:
     learner: Callable[[TrackerEvidence], None] | None = None
     clutter_per_view: Callable[[], float] | None = None
 
-    def predict(self) -> Tracks:
-        self.tracks = predict_tracks(self.tracks, self.F, self.U)
+    def predict(self, dt_s: float | None = None) -> Tracks:
+        F, U = kalman.constant_velocity_model(self.step_s if dt_s is None else dt_s, self.acceleration_sigma_m_s2)
+        self.tracks = predict_tracks(self.tracks, F, U)
         return self.tracks
 
     def wants_detections(self, step: int) -> bool:
         return True
 
-    def update(self, detections: Detections | None, pose, view: ImageSource) -> TrackUpdate:
+    def update(self, detections: Detections | None, pose, view: ImageSource, pose_sd=None) -> TrackUpdate:
+        """The step's update (:func:`update_tracks`). pose_sd : (3,) the standard deviations of ``pose``
+        (deg, deg, zoom factor) where it is known only so well (a camera caught moving); the pixel noise
+        they add (:func:`~ptztrack.geometry.ptz.pose_noise_px2`) widens ``V``, and is taken out of the
+        innovations the learner is given."""
         detections = Detections.empty() if detections is None else detections
         tracks, pose = self.tracks, np.asarray(pose, dtype=float)
+        pose_noise = np.zeros((2, 2)) if pose_sd is None else pose_noise_px2(self.camera, pose, pose_sd)
         detectable = self.detection_model(tracks.mean[:, :2], tracks.covariance[:, :2, :2], pose)
         parameters = self.parameters
         if self.clutter_per_view is not None:
             image_area_px2 = self.camera.image_width_px * self.camera.image_height_px
             parameters = replace(parameters, clutter_density_per_px2=self.clutter_per_view() / image_area_px2)
-        update = update_tracks(tracks, detections.feet_px, self.camera, pose, self.V, parameters, detectable)
+        V = self.V + pose_noise
+        update = update_tracks(tracks, detections.feet_px, self.camera, pose, V, parameters, detectable)
         self.tracks = update.tracks
         if self.learner is not None:
-            self.learner(
-                tracker_evidence(tracks, update, detections.feet_px, self.camera, pose, detectable, self.parameters)
-            )
+            evidence = tracker_evidence(tracks, update, detections.feet_px, self.camera, pose, detectable, parameters)
+            self.learner(replace(evidence, excess_px2=evidence.excess_px2 - np.trace(pose_noise)))
         return update
 
     def reported(self) -> Tracks:
