@@ -1,29 +1,40 @@
-"""The live loop's rates against the virtual ONVIF camera on 127.0.0.1, and its score beside the offline run.
+"""The live loop's pace against the virtual ONVIF camera on 127.0.0.1, its score beside the offline
+run of the same recording steps, and where the two differ.
 
 ``ptztrack live``'s loop (:func:`ptztrack.builders.live.run_live_episode`)
-drives the virtual camera of ``ptztrack serve-camera`` (PETS S2.L1, moving at
-90 deg/s and 3 zoom per second) over ONVIF, in this process, for ``--steps``
-steps of the PETS scenario at ``--time-scale`` of its 5 Hz, with ``--policy``
-and the HOG detector. It prints the steps per second, the decisions sent
-(a decision is not sent while the camera moves), the images captured, the
-time of a decision, of a capture (waiting for the camera to stand still,
-GetStatus and the snapshot: ``image_after_ms`` from the step's start), and the MOTA of the live run
-scored against the recording's truth beside the offline virtual-PTZ run of
-the same steps.
+drives the virtual camera of ``ptztrack serve-camera`` (PETS S2.L1 played at
+``--time-scale``, 25 fps over RTSP, moving at 90 deg/s and 3 zoom per
+second), served by a process of its own on this machine's cores, with ``--policy`` and
+the HOG detector, for ``--steps`` pictures. It prints the rates (decisions
+and pictures used per second, the age of the picture each decision was made
+on), the policy's time, and the MOTA of the live run scored against the
+recording's truth beside the offline virtual-PTZ run of the same recording
+steps. Each picture used is then found among the pictures the camera
+rendered (by its thumbnail), which gives what the live run paid: the
+stream's true delay, the pose error at capture (the pose the tracker used
+against the pose rendered, still and moving), the recording step it took
+the picture for against the one shown, and the detections per picture
+against the offline run's.
 
-    python benchmarks/live_loop.py [--steps 110] [--time-scale 0.25] [--policy smpl] [--json PATH]
+    python benchmarks/live_loop.py [--steps 150] [--time-scale 1] [--policy smpl] [--transport tcp] [--json PATH]
 """
 
 import argparse
+import multiprocessing
+import time
 from pathlib import Path
 
+import cv2
 import numpy as np
 
-from ptztrack.builders.episode import run_episode
+from ptztrack.builders.episode import episode_world, run_episode
 from ptztrack.builders.live import (
+    RecordingFeed,
     live_as_episode,
     offline_counterpart,
     run_live_episode,
+    shown_steps,
+    thumbnail,
     virtual_calibration,
     virtual_camera,
 )
@@ -32,40 +43,114 @@ from ptztrack.config import pets_scenario
 from ptztrack.evaluate.metrics import episode_metrics
 from ptztrack.files import write_json
 
+# A picture is matched among the renders of the second before its estimated capture time and after it.
+MATCH_WINDOW_S = (1.0, 0.5)
+# Thumbnails within this mean grey level of the best match are indistinguishable from it.
+SAME_GREY = 0.5
+
+
+def identify(live, log: np.ndarray, thumbnails: np.ndarray) -> np.ndarray:
+    """For each picture the live run used, the row of the camera's truth ``log`` (n, 5) it was rendered
+    as (``thumbnails`` (n, 48, 64) of the renders); -1 where renders that differ in pose or step are
+    indistinguishable from it."""
+    rows = np.full(len(live.capture_time_s), -1)
+    for index, (jpeg, time_s) in enumerate(zip(live.images, live.capture_time_s, strict=True)):
+        image = cv2.imdecode(np.frombuffer(jpeg, np.uint8), cv2.IMREAD_COLOR)
+        window = np.flatnonzero((log[:, 0] > time_s - MATCH_WINDOW_S[0]) & (log[:, 0] < time_s + MATCH_WINDOW_S[1]))
+        if image is None or not len(window):
+            continue
+        distance = np.mean(np.abs(thumbnails[window] - thumbnail(image)), axis=(1, 2))
+        alike = window[distance <= distance.min() + SAME_GREY]
+        if np.all(log[alike, 1:] == log[alike[0], 1:]):  # the same step at the same pose: any of them
+            rows[index] = alike[0]
+    return rows
+
+
+def serve(time_scale: float, ready, stop, results) -> None:
+    """The virtual camera in a process of its own (as a camera is a machine of its own): its ONVIF port
+    into ``ready``, then, once ``stop`` is set, its truth log and thumbnails into ``results``."""
+    scenario = pets_scenario("hog")
+    feed = RecordingFeed(episode_world(scenario, 0), 1.0 / scenario.frame_rate_hz, time_scale, thumbnails=[])
+    camera, _ = virtual_camera(scenario, time_scale, 0, "bench", "bench-pass", feed=feed)
+    with camera:
+        ready.put(camera.onvif_port)
+        stop.wait()
+    results.put((feed.rows(), np.asarray(feed.thumbnails)))
+
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--steps", type=int, default=110)
-    parser.add_argument("--time-scale", type=float, default=0.25)
+    parser.add_argument("--steps", type=int, default=150, help="pictures the live run uses")
+    parser.add_argument("--time-scale", type=float, default=1.0)
     parser.add_argument("--policy", default="smpl")
+    parser.add_argument("--transport", choices=("tcp", "udp"), default="tcp")
     parser.add_argument("--json", type=Path)
     args = parser.parse_args()
-    scenario = pets_scenario("hog", frames=args.steps)
-    camera, feed = virtual_camera(scenario, args.time_scale, 0, "bench", "bench-pass")
-    with camera:
-        address = CameraAddress("127.0.0.1", camera.onvif_port, "bench", "bench-pass")
+    scenario = pets_scenario("hog")
+    decisions: list[tuple[float, int]] = []
+
+    def observe(world, policy):
+        return lambda step, context, record: decisions.append((record["decision_s"], len(context.tracks)))
+
+    processes = multiprocessing.get_context("spawn")
+    ready, stop, results = processes.Queue(), processes.Event(), processes.Queue()
+    server = processes.Process(target=serve, args=(args.time_scale, ready, stop, results), daemon=True)
+    server.start()
+    try:
+        address = CameraAddress("127.0.0.1", ready.get(timeout=120), "bench", "bench-pass")
+        started = time.perf_counter()
         world, live = run_live_episode(
-            scenario, virtual_calibration(), address, args.policy, args.steps, args.time_scale, seed=0
-        )
-    live_metrics = episode_metrics(live_as_episode(world, live, feed.rows()))
-    offline = offline_counterpart(scenario, world, live, feed.rows())
-    offline_metrics = episode_metrics(run_episode(offline, args.policy, 0))
-    captured = np.isfinite(live.capture_time_s)
-    step_s = np.diff(live.step_time_s)
+            scenario, virtual_calibration(), address, args.policy, args.steps, args.time_scale, 0,
+            observe=observe, transport=args.transport, keep_images=True,
+        )  # fmt: skip
+        wall_s = time.perf_counter() - started
+    finally:
+        stop.set()
+    truth_log, thumbnails = results.get(timeout=60)
+    server.join()
+    live_metrics = episode_metrics(live_as_episode(world, live, truth_log))
+    offline = offline_counterpart(scenario, world, live, truth_log)
+    offline_episode = run_episode(offline, args.policy, 0)
+    offline_metrics = episode_metrics(offline_episode)
+
+    rendered = identify(live, truth_log, thumbnails)
+    found = rendered >= 0
+    true_pose = truth_log[rendered[found], 2:]
+    pose_error = np.abs(live.poses[found] - true_pose)
+    moving = np.any(live.pose_sd[found] > 0, axis=1)
+    arrival_s = live.capture_time_s[found] + virtual_calibration().image_delay_s
+    with_tracks = [seconds for seconds, tracks in decisions if tracks > 0]
+    rates = live.rates()
     row = {
         "policy": args.policy,
-        "steps": len(live.commanded),
         "time_scale": args.time_scale,
-        "first_video_frame": offline.required_recording("").frame_range[0],
-        "steps_per_s": float(1 / np.mean(step_s)),
-        "decisions_sent": int(live.sent.sum()),
-        "images": int(captured.sum()),
-        "decision_ms": float(1e3 * np.mean(live.decision_s)),
-        "image_after_ms": float(1e3 * np.nanmean(live.capture_time_s - live.step_time_s)),
-        "live_mota": live_metrics["mota"],
-        "offline_mota": offline_metrics["mota"],
-        "live_motp_m": live_metrics["motp_m"],
-        "offline_motp_m": offline_metrics["motp_m"],
+        "transport": args.transport,
+        "pictures_used": len(live.capture_time_s),
+        "recording_steps": offline.frames,
+        "wall_s": wall_s,
+        "decisions_per_s": rates["decisions_per_s"],
+        "frames_used_per_s": rates["frames_used_per_s"],
+        "frames_received_per_s": rates["frames_received_per_s"],
+        "frame_age_s_p95": rates["frame_age_s_p95"],
+        "first_decision_s": with_tracks[0] if with_tracks else float("nan"),
+        "median_decision_s": rates["median_decision_s"],
+        "mota_live": live_metrics["mota"],
+        "mota_offline": offline_metrics["mota"],
+        "motp_live_m": live_metrics["motp_m"],
+        "motp_offline_m": offline_metrics["motp_m"],
+        "pictures_identified": int(found.sum()),
+        "stream_delay_s_median": float(np.median(arrival_s - truth_log[rendered[found], 0])),
+        "pictures_moving": float(np.mean(moving)),
+        "pan_error_deg_still_p95": float(np.percentile(pose_error[~moving, 0], 95)) if (~moving).any() else 0.0,
+        "pan_error_deg_moving_p95": float(np.percentile(pose_error[moving, 0], 95)) if moving.any() else 0.0,
+        "zoom_error_moving_p95": float(np.percentile(pose_error[moving, 2], 95)) if moving.any() else 0.0,
+        "wrong_step": float(
+            np.mean(shown_steps(truth_log, live.capture_time_s[found]) != truth_log[rendered[found], 1])
+        ),
+        "detections_per_picture_live": float(np.mean([len(d) for d in live.detections])),
+        "detections_per_step_offline": float(np.mean([len(d) for d in offline_episode.detections])),
+        "zoom_live": float(np.mean(live.poses[:, 2])),
+        "zoom_offline": float(np.mean(offline_episode.poses[:, 2])),
     }
     width = max(map(len, row))
     for key, value in row.items():

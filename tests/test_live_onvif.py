@@ -22,7 +22,8 @@ from ptztrack.builders.live import (
     virtual_calibration,
     virtual_camera,
 )
-from ptztrack.camera.onvif_client import CameraAddress, CameraError, ONVIFClient, read_stream_frame
+from ptztrack.camera.onvif_client import CameraAddress, CameraError, ONVIFClient
+from ptztrack.camera.stream import open_rtsp
 from ptztrack.cli import main
 from ptztrack.config import load_camera_calibration, pets_scenario, write_camera_calibration
 from ptztrack.evaluate.metrics import episode_metrics
@@ -31,9 +32,9 @@ pytest.importorskip("ipycam", reason="the virtual ONVIF camera needs ipycam (pip
 pytestmark = pytest.mark.onvif
 
 USER, PASSWORD = "operator", "s3cret-pass"
-# The recording at a fifth of its speed: a step of 1 s holds a move (up to 0.33 s), the image delay (0.1 s)
-# and a HOG detection (0.35 s here; twice that on a loaded machine, where a quarter failed once in two runs).
-TIME_SCALE = 0.2
+# The recording at half its speed: the camera shares the test's process (and its interpreter lock) here,
+# where ptztrack live meets a camera of its own; at half speed a loaded machine keeps the pace too.
+TIME_SCALE = 0.5
 
 
 def _address(camera, password: str = PASSWORD) -> CameraAddress:
@@ -42,26 +43,24 @@ def _address(camera, password: str = PASSWORD) -> CameraAddress:
 
 @pytest.mark.slow
 def test_a_live_smpl_run_with_hog_scores_within_10_points_of_the_offline_run():
-    steps = 110
-    scenario = pets_scenario("hog", frames=steps)
+    """Every picture the detector can take is used; the score over the recording steps they showed is
+    near the offline run's over the same steps."""
+    scenario = pets_scenario("hog")
     camera, feed = virtual_camera(scenario, TIME_SCALE, 0, USER, PASSWORD)
     with camera:
-        world, live = run_live_episode(
-            scenario, virtual_calibration(), _address(camera), "smpl", steps, TIME_SCALE, seed=0
-        )
+        world, live = run_live_episode(scenario, virtual_calibration(), _address(camera), "smpl", 300, TIME_SCALE, 0)
     live_mota = episode_metrics(live_as_episode(world, live, feed.rows()))["mota"]
-    offline_mota = episode_metrics(run_episode(offline_counterpart(scenario, world, live, feed.rows()), "smpl", 0))[
-        "mota"
-    ]
-    assert len(live.commanded) == steps and np.isfinite(live.capture_time_s).sum() >= 100
+    offline = offline_counterpart(scenario, world, live, feed.rows())
+    offline_mota = episode_metrics(run_episode(offline, "smpl", 0))["mota"]
+    assert len(live.capture_time_s) == 300 and offline.frames >= 30
+    assert np.all(np.isfinite(live.poses)) and np.all(np.diff(live.capture_time_s) > 0)
     assert abs(live_mota - offline_mota) <= 0.10, (live_mota, offline_mota)
 
 
 def test_the_run_goes_on_through_a_camera_that_goes_away_and_comes_back():
-    """The camera stops after 2 s and a new one comes up on its port 4 s later (three steps), the recording
-    going on:
-    the steps in between capture nothing, the tracker keeps its tracks on predictions, and the run
-    captures again once the camera is back."""
+    """The camera stops after 3 s and a new one comes up on its port 4 s later, the recording going on:
+    no picture is used in between, the tracker keeps its tracks on predictions, and the run goes on
+    with the new camera's pictures, the tracks under the same ids."""
     scenario = pets_scenario("hog")
     camera, feed = virtual_camera(scenario, TIME_SCALE, 0, USER, PASSWORD)
     camera.start()
@@ -70,28 +69,26 @@ def test_the_run_goes_on_through_a_camera_that_goes_away_and_comes_back():
 
     def run():
         result["run"] = run_live_episode(
-            scenario, virtual_calibration(), address, "fix", 16, TIME_SCALE, seed=0, timeout_s=1.0
+            scenario, virtual_calibration(), address, "fix", 150, TIME_SCALE, seed=0, timeout_s=1.0
         )
 
     runner = threading.Thread(target=run)
     runner.start()
-    time.sleep(2.0)
+    time.sleep(3.0)
     camera.stop()
     time.sleep(4.0)
     restarted, _ = virtual_camera(scenario, TIME_SCALE, address.port, USER, PASSWORD, feed)
     with restarted:
-        runner.join(timeout=60)
+        runner.join(timeout=90)
     assert not runner.is_alive()
     _, live = result["run"]
-    captured = np.isfinite(live.capture_time_s)
-    gap = np.flatnonzero(~captured[2:]) + 2
-    assert len(gap) >= 2, "no steps without the camera"
-    assert captured[gap[-1] + 1 :].any(), "never captured again"
+    gaps = np.flatnonzero(np.diff(live.capture_time_s) > 3.0)
+    assert len(gaps) == 1, "no time without the camera"
+    before, after = live.tracks[gaps[0]], live.tracks[gaps[0] + 1 :]
+    assert len(after) > 10, "no pictures after the camera came back"
     # Tracks too uncertain are not reported while the camera is away; the tracker keeps them, and
     # reports them again under the same ids once it sees their people.
-    before = set(live.tracks[gap[0] - 1].ids)
-    after = set().union(*(set(tracks.ids) for tracks in live.tracks[gap[-1] + 1 :]))
-    assert before and before & after, "tracks lost while the camera was away"
+    assert set(before.ids) & set().union(*(set(tracks.ids) for tracks in after)), "tracks lost while away"
 
 
 def test_a_refused_connection_exits_2_with_one_line(capsys):
@@ -207,7 +204,11 @@ def test_the_client_moves_reads_limits_keeps_presets_and_reads_the_rtsp_stream()
             np.testing.assert_allclose(spaces.pose(client.status().position), [30.0, 10.0, 2.0], atol=1e-6)
             if camera.rtsp_port is None:
                 pytest.skip("ffmpeg is not on the PATH: the virtual camera has no RTSP stream")
-            assert read_stream_frame(client.stream_uri()).shape == (120, 160, 3)
+            capture = open_rtsp(client.stream_uri())
+            try:
+                assert capture.read()[1].shape == (120, 160, 3)
+            finally:
+                capture.release()
         finally:
             client.close()
 

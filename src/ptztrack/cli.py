@@ -42,6 +42,7 @@ from ptztrack.builders.live import (
     TRUTH_LOG_HEADER,
     camera_spaces,
     live_as_episode,
+    live_pictures,
     run_live_episode,
     virtual_calibration,
     virtual_camera,
@@ -267,30 +268,30 @@ def live_command(args: argparse.Namespace) -> int:
     scenario = build_scenario(args.scenario, args.detector, detector_model=args.detector_model)
     calibration = virtual_calibration() if args.calibration == "virtual" else load_camera_calibration(args.calibration)
     address = camera_address(args.camera, _credentials(args))
+    truth_log = None if args.truth is None else read_truth_log(args.truth)
     steps = args.steps or scenario.frames
-    print(f"live: {args.policy} on {address}, up to {steps} steps at {scenario.frame_rate_hz * args.time_scale:g} Hz")
+    print(f"live: {args.policy} on {address}, up to {steps} pictures, RTSP over {args.transport}")
     label = f"live {args.policy}"
     with Watch(args.view, args.out is not None, lambda w, p: ViewState(w, p, steps, label, truth=False)) as watch:
         world, live = run_live_episode(
             scenario, calibration, address, args.policy, steps, args.time_scale, args.seed, args.timeout_s,
-            watch.observe,
+            watch.observe, args.transport, keep_images=args.out is not None,
         )  # fmt: skip
-    truth_log = None if args.truth is None else read_truth_log(args.truth)
     episode = live_as_episode(world, live, truth_log)
-    captured = np.isfinite(live.capture_time_s)
-    elapsed_s = live.step_time_s[-1] - live.step_time_s[0] if len(live.step_time_s) > 1 else 0.0
+    rates = live.rates()
     print(
-        f"{len(live.commanded)} steps ({len(live.commanded) / max(elapsed_s, 1e-9):.2f} per second), "
-        f"{int(live.sent.sum())} decisions sent, {int(captured.sum())} images, "
-        f"decision {1e3 * np.mean(live.decision_s) if len(live.decision_s) else 0:.1f} ms"
+        f"{len(live.capture_time_s)} pictures used ({rates['frames_used_per_s']:.2f} per second) of "
+        f"{live.frames_received} received, {int(np.isfinite(live.decided_s).sum())} decisions "
+        f"({rates['decisions_per_s']:.2f} per second, median {1e3 * rates['median_decision_s']:.1f} ms, "
+        f"95 % on a picture at most {rates['frame_age_s_p95']:.2f} s old), {int(live.sent.sum())} new targets sent"
     )
     metrics = episode_metrics(episode)
     if truth_log is not None:
         print(format_metrics(metrics))
     if args.out is not None:
-        title = f"live {args.policy}, {scenario.detector.kind} detector: {len(live.commanded)} steps"
+        title = f"live {args.policy}, {scenario.detector.kind} detector: {len(live.capture_time_s)} pictures"
         with run_folder(args.out, args.overwrite) as folder:
-            write_outputs(folder, episode, metrics, title, None)
+            write_outputs(folder, episode, metrics, title, live_pictures(live))
             watch.write(folder)
         print(f"wrote {', '.join(RUN_FOLDER_FILES)} into {args.out}")
     return 0
@@ -851,8 +852,13 @@ def _add_camera_commands(commands, policies: list[str]) -> None:
         "default), a-priori (the prior curve, kept), true (a simulation's own curve) or an earlier run's "
         "detector_model.json as the prior",
     )
-    live.add_argument("--steps", type=_positive_int, help="at most this many steps (default: the scenario's frames)")
-    live.add_argument("--time-scale", type=_positive_float, default=1.0, help="steps at the scenario's rate times this")
+    live.add_argument(
+        "--steps", type=_positive_int, help="use at most this many pictures (default: the scenario's frames)"
+    )
+    live.add_argument(
+        "--time-scale", type=_positive_float, default=1.0, help="the scenario's seconds per second (serve-camera's)"
+    )
+    live.add_argument("--transport", choices=("tcp", "udp"), default="tcp", help="RTSP's transport (default tcp)")
     live.add_argument("--timeout-s", type=_positive_float, default=5.0, help="the longest wait for any camera call")
     live.add_argument(
         "--truth", type=Path, help="score against a virtual camera's truth log (serve-camera --truth-log)"

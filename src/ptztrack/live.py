@@ -1,17 +1,32 @@
-"""The closed loop against a live camera, in real time: capture, detect, track and decide at the camera's pace.
+"""The closed loop against a live camera, pipelined so that no stage waits for another.
 
-:func:`run_live` is :func:`ptztrack.loop.run_loop` for a camera that is
-really out there. The loop's steps keep the scenario's rate (``period_s``
-apart, on the wall clock); each step the policy decides, and the decision
-is sent only if the camera is not still moving from the last one; the
-camera's image and its pose at capture (its own GetStatus, read just before
-the image is taken while the camera stands still) go to the detector and
-the tracker. While the camera moves, or cannot be reached, the tracker runs
-on its predictions alone. The camera (:class:`LiveCamera`) reconnects by
-itself; Ctrl-C (or ``stop``) ends the run after the step in progress and
-returns what was recorded, so that its outputs are written whole.
+:func:`run_live` drives a camera that moves in its own time
+(:class:`LiveCamera`, :class:`ptztrack.camera.live_camera.LiveONVIFCamera`)
+with four stages in their own threads:
+
+* the camera's pictures, decoded without pause, only the newest kept, each
+  with its capture time (:mod:`ptztrack.camera.stream`);
+* its pose, sampled by GetStatus and looked up at any moment with its
+  uncertainty (:mod:`ptztrack.camera.pose_timeline`), and its commands,
+  sent at once whether it still moves or not;
+* the detector, on the newest picture not yet seen, at the pose of its
+  capture time;
+* the tracker and the policy (the calling thread): every detected picture
+  updates the tracker, predicted to its capture time (the scenario's time:
+  wall time times ``time_scale``) with the pose's uncertainty in the
+  measurement noise; once no newer picture waits, the policy decides on the
+  tracks as the newest picture left them, and the camera is sent there.
+
+So every picture the detector can take is used, moving or not, and a
+decision follows each picture the tracker takes. Before the first picture
+the stages are run once on copies (:func:`warm_up`), so that compiling and
+caching are done and the first decision is as fast as the others. Ctrl-C
+(or ``steps`` pictures used) ends the run with what was recorded.
 """
 
+import copy
+import queue
+import threading
 import time
 from dataclasses import dataclass
 from functools import partial
@@ -19,62 +34,121 @@ from typing import Protocol
 
 import numpy as np
 
-from ptztrack.camera.live_camera import Capture
+from ptztrack.camera.pose_timeline import PoseTimeline
+from ptztrack.camera.stream import LatestFrame
 from ptztrack.loop import StepObserver, World, command, episode_seeds
 from ptztrack.roles import Policy, Tracker
-from ptztrack.types import DecisionContext, Detections, PeopleInView, Tracks
+from ptztrack.types import DecisionContext, Detections, PeopleInView
+
+# How long the detector waits for a pose sample after a picture's capture time before it looks the pose
+# up anyway (the camera's move-time model then carries it past the last sample).
+POSE_WAIT_S = 0.1
+IDLE_WAIT_S = 0.5
 
 
 class LiveCamera(Protocol):
-    """A camera that moves in its own time (:class:`ptztrack.camera.live_camera.ReconnectingCamera`)."""
+    """A camera that moves in its own time (:class:`ptztrack.camera.live_camera.LiveONVIFCamera`)."""
+
+    timeline: PoseTimeline
+
+    @property
+    def frames(self) -> "FrameSource": ...
 
     def send(self, pose: np.ndarray) -> bool:
-        """Send the camera to ``pose`` unless it is still moving; whether the command went out."""
+        """Have the camera go to ``pose`` without waiting; whether it is a new target."""
         ...
 
-    def capture(self, until_s: float) -> Capture | None:
-        """The image and its pose once the camera stands still, waiting for it until ``until_s`` (on
-        ``time.monotonic``'s clock); None if it still moves then, or cannot be reached."""
-        ...
+
+class FrameSource(Protocol):
+    latest: LatestFrame
 
 
 @dataclass(frozen=True)
 class LiveEpisode:
-    """What a live run recorded, per step (T steps).
+    """What a live run recorded, one row per picture used (T pictures).
 
-    commanded : (T, 3) the decided poses; sent : (T,) whether each went out to the camera;
-    poses : (T, 3) the captured poses, NaN where nothing was captured; capture_time_s : (T,) epoch
-    seconds of the captures (NaN likewise); step_time_s : (T,) epoch seconds of the steps' starts;
-    decision_s : (T,) the policy's time; tracks : per step, the tracks reported; detections : per
-    step, the detections the tracker was updated with.
+    capture_time_s : (T,) epoch seconds each picture was taken; poses : (T, 3) the pose at that time
+    and pose_sd : (T, 3) its standard deviation (NaN where the camera's pose was unknown);
+    decided_s : (T,) epoch seconds of the decision that followed the picture, NaN where a newer picture
+    was already waiting and none was made; decision_s : (T,) the policy's time (NaN likewise);
+    commanded : (T, 3) the pose the camera was sent to last, after the picture; sent : (T,) whether a new
+    target went out then; tracks, detections : per picture, the tracks reported after its update and the
+    detections it was updated with; images : per picture, its JPEG (empty unless kept).
+    frames_received : pictures that came from the camera; started_s, ended_s : the run's epoch seconds.
     """
 
+    capture_time_s: np.ndarray
+    poses: np.ndarray
+    pose_sd: np.ndarray
+    decided_s: np.ndarray
+    decision_s: np.ndarray
     commanded: np.ndarray
     sent: np.ndarray
-    poses: np.ndarray
-    capture_time_s: np.ndarray
-    step_time_s: np.ndarray
-    decision_s: np.ndarray
-    tracks: list[Tracks]
-    detections: list[Detections]
+    tracks: list
+    detections: list
+    images: list
+    frames_received: int
+    started_s: float
+    ended_s: float
 
     @property
     def seen_time_s(self) -> np.ndarray:
-        """(T,) epoch seconds of what each step saw: its capture, or its start where nothing was captured."""
-        return np.where(np.isfinite(self.capture_time_s), self.capture_time_s, self.step_time_s)
+        """(T,) epoch seconds of what each row saw: its picture's capture time."""
+        return self.capture_time_s
+
+    def rates(self) -> dict[str, float]:
+        """Pictures used and decisions per second over the run (intervals over the time they span),
+        and each decision's age: seconds from its picture's capture to the decision."""
+        decided = np.isfinite(self.decided_s)
+        age_s = (self.decided_s - self.capture_time_s)[decided]
+        return {
+            "frames_used_per_s": _rate(self.capture_time_s),
+            "decisions_per_s": _rate(self.decided_s[decided]),
+            "frames_received_per_s": self.frames_received / max(self.ended_s - self.started_s, 1e-9),
+            "frame_age_s_p95": float(np.percentile(age_s, 95)) if len(age_s) else float("nan"),
+            "median_decision_s": float(np.median(self.decision_s[decided])) if decided.any() else float("nan"),
+        }
+
+
+def _rate(times_s) -> float:
+    """Events per second: the intervals between the first and the last of ``times_s``, over their span."""
+    if len(times_s) < 2:
+        return float("nan")
+    return (len(times_s) - 1) / max(float(times_s[-1] - times_s[0]), 1e-9)
 
 
 class _CapturedView:
-    """The captured image as a camera backend for the detector: a real camera knows no people."""
+    """A picture as a camera backend for the detector: a real camera knows no people."""
 
-    def __init__(self, capture: Capture):
-        self._capture = capture
+    def __init__(self, image: np.ndarray):
+        self._image = image
 
     def image(self, step: int, pose) -> np.ndarray:
-        return self._capture.image
+        return self._image
 
     def people(self, step: int, pose) -> PeopleInView | None:
         return None
+
+
+def warm_up(world: World, policy: Policy, tracker: Tracker, steps: int = 3) -> None:
+    """Run the detector, the tracker and the policy on copies for ``steps`` steps, as :func:`run_live`
+    runs them (from the start pose, one person standing low in the view, then a second beside: Numba
+    compiles again for arrays of one row, which NumPy takes for contiguous), so that whatever compiles
+    or caches on first use is done."""
+    pose = world.grid.poses[world.start_action]
+    blank = np.zeros((world.camera.image_height_px, world.camera.image_width_px, 3), np.uint8)
+    world.detector.detect(_CapturedView(blank), 0, pose, np.random.default_rng(0))
+    tracker, policy = copy.deepcopy(tracker), copy.deepcopy(policy)
+    feet_px = np.array([[0.35, 0.8], [0.65, 0.8]]) * [world.camera.image_width_px, world.camera.image_height_px]
+    grid, rng = world.grid, np.random.default_rng(0)
+    for step in range(steps):
+        seen = Detections(feet_px[: 1 + min(step, 1)], np.full(1 + min(step, 1), 100.0), np.full(1 + min(step, 1), -1))
+        tracker.predict(None if step == 0 else 0.1)
+        update = tracker.update(seen, pose, partial(_CapturedView(blank).image, step, pose), np.full(3, 0.1))
+        tracker.reported()
+        policy.choose(
+            DecisionContext(step, world.start_action, grid.reachable(world.start_action), update.tracks, rng, pose)
+        )
 
 
 def run_live(
@@ -83,72 +157,147 @@ def run_live(
     tracker: Tracker,
     camera: LiveCamera,
     steps: int,
-    period_s: float,
+    time_scale: float,
     seed: int,
-    clock=time.monotonic,
-    sleep=time.sleep,
     observer: StepObserver | None = None,
+    keep_images: bool = False,
 ) -> LiveEpisode:
-    """At most ``steps`` steps, ``period_s`` apart; Ctrl-C ends the run early with what was recorded.
+    """Use at most ``steps`` pictures; Ctrl-C ends the run early with what was recorded.
 
-    observer : called after every step as :func:`ptztrack.loop.run_loop` calls it, with the step's
-    LiveEpisode fields, its ``actions`` (flat index, -1 off the grid) and the captured ``image``
-    (None where nothing was captured).
+    time_scale : scenario seconds per wall-clock second (a virtual camera's recording plays that fast).
+    observer : called after every decision as :func:`ptztrack.loop.run_loop` calls it, with the row's
+    fields, its ``actions`` (flat index, -1 off the grid), ``poses`` and the picture as ``image``.
+    keep_images : keep each picture used, as JPEG, in the episode (for its video).
     """
     _, detector_seed, policy_seed, _, _, _ = episode_seeds(seed)
-    frame_seeds = detector_seed.spawn(steps)
     policy_rng = np.random.default_rng(policy_seed)
     grid = world.grid
     nearest, commanded = world.start_action, grid.poses[world.start_action]
     camera.send(commanded)
-    record: dict[str, list] = {name: [] for name in LiveEpisode.__dataclass_fields__}
-    started = clock()
+    detected: queue.Queue = queue.Queue(maxsize=1)  # the detector is at most one picture ahead
+    stopping = threading.Event()
+    detector = threading.Thread(
+        target=_detect_pictures,
+        args=(world, camera, detector_seed, detected, stopping),
+        name="live-detector",
+        daemon=True,
+    )
+    rows: list[dict] = []
+    started_s = time.time()
+    detector.start()
+    last_time_s: float | None = None
+    last_decided_s: float | None = None
     try:
-        for step in range(steps):
-            sleep(max(0.0, started + step * period_s - clock()))
-            step_time_s = time.time()
-            predicted = tracker.predict()
-            context = DecisionContext(step, nearest, grid.reachable(nearest), predicted, policy_rng, commanded)
-            deciding = time.perf_counter()
-            choice = policy.choose(context)
-            decision_s = time.perf_counter() - deciding
-            action, commanded = command(grid, choice)
-            nearest = action if action >= 0 else grid.nearest(commanded)
-            sent = camera.send(commanded)
-            # Half the step for the camera to land, half for the detector.
-            capture = camera.capture(started + (step + 0.5) * period_s)
-            measured, pose = None, np.full(3, np.nan)
-            if capture is not None:  # else the tracker has its prediction alone: nothing was seen, nor missed
-                view = _CapturedView(capture)
-                rng = np.random.default_rng(frame_seeds[step])
-                detections, pose = world.detector.detect(view, step, capture.pose, rng), capture.pose
-                update = tracker.update(detections, capture.pose, partial(view.image, step, capture.pose))
-                measured = update.measurements if update.measurements is not None else detections
-            step_record = {
-                "commanded": commanded,
-                "sent": sent,
-                "poses": pose,
-                "capture_time_s": np.nan if capture is None else capture.time_s,
-                "step_time_s": step_time_s,
-                "decision_s": decision_s,
+        while len(rows) < steps:
+            try:
+                item = detected.get(timeout=IDLE_WAIT_S)
+            except queue.Empty:
+                continue
+            if isinstance(item, BaseException):
+                raise item
+            frame, at, detections = item
+            dt_s = None if last_time_s is None else max(frame.time_s - last_time_s, 0.0) * time_scale
+            last_time_s = frame.time_s
+            tracker.predict(dt_s)
+            view = _CapturedView(frame.image)
+            update = tracker.update(detections, at.pose, partial(view.image, len(rows), at.pose), at.sd)
+            measured = update.measurements if update.measurements is not None else detections
+            row = {
+                "capture_time_s": frame.time_s,
+                "poses": at.pose,
+                "pose_sd": at.sd,
+                "decided_s": np.nan,
+                "decision_s": np.nan,
+                "sent": False,
                 "tracks": tracker.reported(),
-                "detections": Detections.empty() if measured is None else measured,
+                "detections": measured,
+                "images": _jpeg(frame.image) if keep_images else b"",
             }
-            for name, value in step_record.items():
-                record[name].append(value)
-            if observer is not None:
-                image = None if capture is None else capture.image
-                observed_s = clock()
-                observer(step, context, {**step_record, "actions": action, "image": image})
-                waited_s = clock() - observed_s
-                if waited_s > period_s:  # a paused view: the steps after it keep their pace, not catch up
-                    started += waited_s
+            action = nearest
+            if detected.empty() and (
+                last_decided_s is None
+                or (time.time() - last_decided_s) * time_scale >= float(__import__("os").environ.get("PACE", "0"))
+            ):  # decide on the newest picture only
+                decided_s = time.time()
+                now = camera.timeline.at(decided_s)
+                here = commanded if now is None else now.pose
+                nearest = grid.nearest(here)
+                if camera.timeline.moving():  # no new target while the camera moves
+                    nearest = grid.nearest(commanded)
+                    reachable = np.array([nearest])
+                else:
+                    reachable = grid.reachable(nearest)
+                since_s = None if last_decided_s is None else (decided_s - last_decided_s) * time_scale
+                last_decided_s = decided_s
+                context = DecisionContext(len(rows), nearest, reachable, update.tracks, policy_rng, here, since_s)
+                deciding = time.perf_counter()
+                choice = policy.choose(context)
+                row["decision_s"] = time.perf_counter() - deciding
+                action, commanded = command(grid, choice)
+                row["sent"] = camera.send(commanded)
+                row["decided_s"] = time.time()
+            row["commanded"] = commanded
+            if observer is not None and np.isfinite(row["decided_s"]):
+                observer(len(rows), context, {**row, "actions": action, "image": frame.image})
+            rows.append(row)
     except KeyboardInterrupt:
-        pass  # the steps recorded whole so far are the run
-    done = min(len(values) for values in record.values())
-    lists = ("tracks", "detections")
+        pass  # the rows recorded whole so far are the run
+    finally:
+        stopping.set()
+        detector.join()
+    return _episode(rows, camera.frames.latest.received, started_s, time.time())
+
+
+def _detect_pictures(world: World, camera: LiveCamera, seeds, detected: queue.Queue, stopping) -> None:
+    """The detector's stage: each newest picture not yet seen, at the pose of its capture, into ``detected``
+    as (frame, pose, detections); an exception goes there too, for the tracker's stage to raise."""
+    try:
+        number = 0
+        while not stopping.is_set():
+            frame = camera.frames.latest.newer(number, IDLE_WAIT_S)
+            if frame is None:
+                continue
+            number = frame.number
+            camera.timeline.wait_past(frame.time_s, POSE_WAIT_S)
+            at = camera.timeline.at(frame.time_s)
+            if at is None:  # no pose known yet: a picture nobody can place
+                continue
+            rng = np.random.default_rng(seeds.spawn(1)[0])
+            detections = world.detector.detect(_CapturedView(frame.image), number, at.pose, rng)
+            while not stopping.is_set():
+                try:
+                    detected.put((frame, at, detections), timeout=IDLE_WAIT_S)
+                    break
+                except queue.Full:
+                    continue
+    except BaseException as error:  # noqa: BLE001 - handed to the tracker's stage, which raises it
+        detected.put(error)
+
+
+def _jpeg(image: np.ndarray) -> bytes:
+    import cv2
+
+    ok, encoded = cv2.imencode(".jpg", image, [cv2.IMWRITE_JPEG_QUALITY, 85])
+    return encoded.tobytes() if ok else b""
+
+
+def _episode(rows: list[dict], received: int, started_s: float, ended_s: float) -> LiveEpisode:
+    def column(name: str, width: int = 0) -> np.ndarray:
+        values = np.array([row[name] for row in rows], dtype=float)
+        return values.reshape(-1, width) if width else values
+
     return LiveEpisode(
-        **{name: np.asarray(values[:done]) for name, values in record.items() if name not in lists},
-        tracks=record["tracks"][:done],
-        detections=record["detections"][:done],
+        capture_time_s=column("capture_time_s"),
+        poses=column("poses", 3),
+        pose_sd=column("pose_sd", 3),
+        decided_s=column("decided_s"),
+        decision_s=column("decision_s"),
+        commanded=column("commanded", 3),
+        sent=np.array([row["sent"] for row in rows], dtype=bool),
+        tracks=[row["tracks"] for row in rows],
+        detections=[row["detections"] for row in rows],
+        images=[row["images"] for row in rows],
+        frames_received=received,
+        started_s=started_s,
+        ended_s=ended_s,
     )

@@ -15,16 +15,20 @@ from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING
 
+import cv2
 import numpy as np
 
 from ptztrack.builders.episode import episode_world, make_policy, make_tracker
 from ptztrack.builders.world import detector_model
-from ptztrack.camera.live_camera import ReconnectingCamera
+from ptztrack.camera.live_camera import LiveONVIFCamera
 from ptztrack.camera.onvif_client import CameraAddress, CameraError, ONVIFClient
-from ptztrack.camera.onvif_spaces import AxisSpeeds, CameraSpaces
+from ptztrack.camera.onvif_spaces import AxisSpeeds, CameraSpaces, MoveTimes
+from ptztrack.camera.pose_timeline import PoseTimeline
 from ptztrack.camera.recorded import RecordedPTZ
 from ptztrack.config import VIRTUAL_CAMERA_CALIBRATION, CameraCalibrationFile, Scenario
-from ptztrack.live import LiveEpisode, run_live
+from ptztrack.control.information_policy import InformationGainPolicy
+from ptztrack.evaluate.video import RenderView
+from ptztrack.live import LiveEpisode, run_live, warm_up
 from ptztrack.loop import Episode, StepObserver, World, episode_seeds
 from ptztrack.roles import Policy
 from ptztrack.types import GroundTruth
@@ -43,13 +47,16 @@ def camera_spaces(calibration: CameraCalibrationFile) -> CameraSpaces:
 class RecordingFeed:
     """The pictures of the virtual ONVIF camera: ``world``'s view of its recording at a pose, the
     recording's step advancing with the time since the first picture (``step_s`` apart, divided by
-    ``time_scale``), held at the last step; a camera restarted with the same feed goes on with the
-    recording. ``log`` holds (epoch s, step, pan, tilt, zoom) per picture."""
+    ``time_scale``), from its start again after its last step; a camera restarted with the same feed
+    goes on with the recording. ``log`` holds (epoch s, step, pan, tilt, zoom) per picture, and
+    ``thumbnails``, where it is a list, each picture's :func:`thumbnail` (to tell afterwards which picture
+    a client received)."""
 
     world: World
     step_s: float
     time_scale: float = 1.0
     log: list[tuple[float, int, float, float, float]] = field(default_factory=list)
+    thumbnails: list[np.ndarray] | None = None
     _lock: threading.Lock = field(default_factory=threading.Lock, repr=False)
     _started_s: float | None = field(default=None, repr=False)
 
@@ -58,18 +65,36 @@ class RecordingFeed:
         now_s = time.time()
         self._started_s = now_s if self._started_s is None else self._started_s
         steps = self.world.truth.positions_m.shape[0]
-        step = min(int((now_s - self._started_s) * self.time_scale / self.step_s), steps - 1)
+        step = int((now_s - self._started_s) * self.time_scale / self.step_s) % steps
         image = self.world.backend.image(step, np.asarray(pose, dtype=float))
         if image is None:
             raise RuntimeError("the virtual ONVIF camera needs a recording with a video")
+        small = None if self.thumbnails is None else thumbnail(image)
         with self._lock:
             self.log.append((now_s, step, *(float(value) for value in pose)))
+            if small is not None and self.thumbnails is not None:
+                self.thumbnails.append(small)
         return image
+
+    @property
+    def duration_s(self) -> float:
+        """Wall-clock seconds the recording takes to play once."""
+        return self.world.truth.positions_m.shape[0] * self.step_s / self.time_scale
 
     def rows(self, start: int = 0) -> np.ndarray:
         """The log from row ``start`` on, (n, 5): epoch s, step, pan_deg, tilt_deg, zoom."""
         with self._lock:
             return np.asarray(self.log[start:], dtype=float).reshape(-1, 5)
+
+
+THUMBNAIL_SIZE_PX = (64, 48)
+
+
+def thumbnail(image: np.ndarray) -> np.ndarray:
+    """A picture (h, w, 3) uint8 BGR as a (48, 64) float32 grey thumbnail, area-averaged: what survives a
+    stream's compression of it."""
+    grey = cv2.cvtColor(image, cv2.COLOR_BGR2GRAY)
+    return cv2.resize(grey, THUMBNAIL_SIZE_PX, interpolation=cv2.INTER_AREA).astype(np.float32)
 
 
 TRUTH_LOG_HEADER = "time_s,step,pan_deg,tilt_deg,zoom"
@@ -84,19 +109,20 @@ def shown_steps(truth_log, times_s) -> np.ndarray:
 
 
 def live_as_episode(world: World, live: LiveEpisode, truth_log=None) -> Episode:
-    """A live run as an :class:`Episode`: with a virtual camera's ``truth_log`` (n, 5), step t is scored
-    against the truth of the recording step its image showed (where nothing was captured, the step shown
-    when it began); without, against nobody (a real camera's run: no truth). Poses not captured are
-    the commanded ones, and counted as not known."""
+    """A live run as an :class:`Episode`, one step per picture used: with a virtual camera's
+    ``truth_log`` (n, 5), each step is scored against the truth of the recording step shown at its
+    picture's capture time; without, against nobody (a real camera's run: no truth). Where the pose was
+    not known, the commanded one stands in, counted as not known."""
     truth = world.truth
+    steps = len(live.capture_time_s)
     if truth_log is None:
-        positions_m = np.full((len(live.commanded), 0, 2), np.nan)
+        positions_m = np.full((steps, 0, 2), np.nan)
         truth = GroundTruth(positions_m, np.zeros(0), np.zeros(0), truth.frame_rate_hz)
-        shown = np.arange(len(live.commanded))
+        shown = np.arange(steps)
     else:
-        shown = np.clip(shown_steps(truth_log, live.seen_time_s), 0, truth.positions_m.shape[0] - 1)
-    captured = np.all(np.isfinite(live.poses), axis=1)
-    poses = np.where(captured[:, None], live.poses, live.commanded)
+        shown = np.clip(shown_steps(truth_log, live.capture_time_s), 0, truth.positions_m.shape[0] - 1)
+    known = np.all(np.isfinite(live.poses), axis=1)
+    poses = np.where(known[:, None], live.poses, live.commanded)
     return Episode(
         GroundTruth(truth.positions_m[shown], truth.heights_m, truth.widths_m, truth.frame_rate_hz),
         world.camera,
@@ -105,22 +131,53 @@ def live_as_episode(world: World, live: LiveEpisode, truth_log=None) -> Episode:
         commanded=live.commanded.reshape(-1, 3),
         poses=poses.reshape(-1, 3),
         tracker_poses=poses.reshape(-1, 3),
-        pose_known=captured,
-        decision_s=live.decision_s,
+        pose_known=known,
+        decision_s=np.nan_to_num(live.decision_s),
         tracks=live.tracks,
         detections=live.detections,
     )
 
 
+def live_pictures(live: LiveEpisode) -> RenderView:
+    """``render_view`` for a live run's video (:mod:`ptztrack.evaluate.video`): the picture each step
+    used, as the run kept it (``keep_images``)."""
+
+    def render(step: int, pose) -> np.ndarray:
+        image = cv2.imdecode(np.frombuffer(live.images[step], np.uint8), cv2.IMREAD_COLOR)
+        if image is None:
+            raise ValueError(f"the live run kept no picture for step {step}: run it with keep_images")
+        return image
+
+    return render
+
+
 # The virtual camera's mechanics, a priori: an IP PTZ dome's preset moves (Axis and Sony domes turn at
-# 100-450 deg/s; 90 deg/s is a slow one) and a zoom through 1x-4x in a second.
+# 100-450 deg/s; 90 deg/s is a slow one) and a zoom through 1x-4x in a second; its stream at PAL's 25 fps.
 VIRTUAL_SPEEDS = AxisSpeeds(pan_deg_s=90.0, tilt_deg_s=90.0, zoom_per_s=3.0)
-VIRTUAL_FRAME_RATE_HZ = 10.0
+VIRTUAL_FRAME_RATE_HZ = 25.0
+# A stream holds a picture back by about one frame interval (the encoder's and the decoder's pipelines).
+VIRTUAL_IMAGE_DELAY_S = 1.0 / VIRTUAL_FRAME_RATE_HZ
 
 
 def virtual_calibration() -> CameraCalibrationFile:
-    """The calibration of ``ptztrack serve-camera``'s camera (``--calibration virtual``)."""
-    return CameraCalibrationFile.model_validate(VIRTUAL_CAMERA_CALIBRATION)
+    """The calibration of ``ptztrack serve-camera``'s camera (``--calibration virtual``): its spaces, its
+    moves' times from its speeds, and its stream's delay."""
+    speeds = VIRTUAL_SPEEDS
+    move_times = {
+        "pan": (0.0, 1 / speeds.pan_deg_s),
+        "tilt": (0.0, 1 / speeds.tilt_deg_s),
+        "zoom": (0.0, 1 / speeds.zoom_per_s),
+    }
+    return CameraCalibrationFile.model_validate(
+        {**VIRTUAL_CAMERA_CALIBRATION, "move_times": move_times, "image_delay_s": VIRTUAL_IMAGE_DELAY_S}
+    )
+
+
+def pose_timeline(calibration: CameraCalibrationFile) -> PoseTimeline:
+    """The timeline of a camera's poses with the speeds of its calibrated move times (none where a slope
+    is not measured)."""
+    slopes = np.array([calibration.move_times.pan[1], calibration.move_times.tilt[1], calibration.move_times.zoom[1]])
+    return PoseTimeline(1.0 / slopes if np.all(slopes > 0) else None)
 
 
 def virtual_camera(
@@ -151,7 +208,7 @@ def virtual_camera(
         port=port,
         username=username,
         password=password,
-        # A picture every 0.1 s at least (a camera's stream at 10 fps), and twice per step of the recording.
+        # A camera's stream rate, and at least twice per step of the recording.
         frame_rate_hz=max(VIRTUAL_FRAME_RATE_HZ, 2.0 * scenario.frame_rate_hz * time_scale),
     )
     return camera, feed
@@ -179,14 +236,23 @@ def run_live_episode(
     seed: int,
     timeout_s: float = 5.0,
     observe: Callable[[World, Policy], StepObserver | None] | None = None,
+    transport: str = "tcp",
+    keep_images: bool = False,
 ) -> tuple[World, LiveEpisode]:
-    """Connect to the camera at ``address`` and run ``policy`` for ``steps`` steps at the scenario's rate
-    times ``time_scale``; the camera is released at the end (Ctrl-C included).
+    """Connect to the camera at ``address`` (a :class:`CameraError` if it cannot be used) and run
+    ``policy`` on ``steps`` of its pictures, the recording's time passing ``time_scale`` times as fast
+    as the wall clock's; the camera is released at the end (Ctrl-C included).
 
     observe : ``observe(world, policy)`` gives the run's step observer (a live view, say).
+    transport : the RTSP stream over 'tcp' or 'udp'; keep_images : keep the pictures used (for a video).
     """
     world = live_world(scenario, calibration, seed)
     live_policy = make_policy(policy, scenario, world)
+    if isinstance(live_policy, InformationGainPolicy):
+        move_times = MoveTimes(calibration.move_times.pan, calibration.move_times.tilt, calibration.move_times.zoom)
+        live_policy.move_seconds, live_policy.step_s = move_times.seconds, 1.0 / scenario.frame_rate_hz
+    tracker = make_tracker(None, scenario, world)
+    warm_up(world, live_policy, tracker)
 
     def connect() -> ONVIFClient:
         client = ONVIFClient(address, timeout_s)
@@ -197,30 +263,29 @@ def run_live_episode(
             raise
         return client
 
-    camera = ReconnectingCamera(connect, camera_spaces(calibration), calibration.image_delay_s)
+    camera = LiveONVIFCamera(
+        connect, camera_spaces(calibration), pose_timeline(calibration), calibration.image_delay_s, transport
+    )
     try:
-        live = run_live(
-            world,
-            live_policy,
-            make_tracker(None, scenario, world),
-            camera,
-            steps,
-            1.0 / (scenario.frame_rate_hz * time_scale),
-            seed,
-            observer=None if observe is None else observe(world, live_policy),
-        )
+        camera.start()
+        observer = None if observe is None else observe(world, live_policy)
+        live = run_live(world, live_policy, tracker, camera, steps, time_scale, seed, observer, keep_images)
     finally:
         camera.close()
     return world, live
 
 
 def offline_counterpart(scenario: Scenario, world: World, live: LiveEpisode, truth_log) -> Scenario:
-    """``scenario`` narrowed to the recording's frames a live run against the virtual camera saw (from
-    the first step its images showed, as many steps as it ran): the offline run to compare it with."""
+    """``scenario`` narrowed to the recording's steps a live run against the virtual camera saw, from the
+    first its pictures showed to the last (within one play of the recording): the offline run to compare
+    it with."""
     recording = scenario.required_recording("the offline counterpart of a live run")
     backend = world.backend
     assert isinstance(backend, RecordedPTZ)
-    first = int(backend.scene.video_frame[max(int(shown_steps(truth_log, live.seen_time_s)[0]), 0)])
-    frame_range = (first, first + len(live.commanded) * recording.frame_step)
+    shown = np.maximum(shown_steps(truth_log, live.seen_time_s), 0)
+    first_step, last_step = int(shown[0]), int(shown.max())
+    first = int(backend.scene.video_frame[first_step])
+    steps = last_step - first_step + 1
+    frame_range = (first, first + steps * recording.frame_step)
     narrowed = recording.model_copy(update={"frame_range": frame_range})
-    return scenario.model_copy(update={"recording": narrowed, "frames": len(live.commanded)})
+    return scenario.model_copy(update={"recording": narrowed, "frames": steps})

@@ -232,23 +232,6 @@ class ONVIFClient:
             raise CameraError(f"{self.address}: {_reason(error)}") from None
 
 
-def read_stream_frame(uri: str, timeout_s: float = 10.0) -> np.ndarray:
-    """One frame (h, w, 3) uint8 BGR of an RTSP stream through OpenCV's ffmpeg, over TCP, within
-    ``timeout_s`` to open and to read; a :class:`CameraError` naming the stream (not its credentials)."""
-    # OpenCV's ffmpeg reads its options from the environment: RTP over TCP, one connection, no UDP ports.
-    os.environ.setdefault("OPENCV_FFMPEG_CAPTURE_OPTIONS", "rtsp_transport;tcp")
-    milliseconds = int(1000 * timeout_s)
-    options = [cv2.CAP_PROP_OPEN_TIMEOUT_MSEC, milliseconds, cv2.CAP_PROP_READ_TIMEOUT_MSEC, milliseconds]
-    capture = cv2.VideoCapture(uri, cv2.CAP_FFMPEG, options)
-    try:
-        ok, frame = capture.read()
-    finally:
-        capture.release()
-    if not ok:
-        raise CameraError(f"{urlsplit(uri).hostname}:{urlsplit(uri).port}: no frame from the RTSP stream")
-    return frame
-
-
 def _reason(error: Exception) -> str:
     """What went wrong, in a few words, never with the request (which may carry credentials)."""
     from zeep.exceptions import Fault

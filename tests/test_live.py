@@ -1,0 +1,130 @@
+"""The pipelined live loop on a camera of this process: pictures taken as they come, each tracked at
+the time it was taken, decisions on the newest, no new target while the camera moves, and the rates
+it reports."""
+
+import threading
+import time
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from ptztrack.builders.episode import episode_world, make_policy, make_tracker
+from ptztrack.camera.pose_timeline import PoseTimeline
+from ptztrack.camera.stream import LatestFrame
+from ptztrack.config import scenario_from_dict
+from ptztrack.live import run_live, warm_up
+from ptztrack.types import Detections
+
+PICTURE_S = 0.02
+
+
+class PictureCamera:
+    """A camera whose pictures come every PICTURE_S from a thread, standing at ``pose`` (or moving
+    there, ``moving``); its targets are kept in ``sent``."""
+
+    def __init__(self, world, moving: bool = False):
+        self.frames, self.timeline, self.sent = self, PoseTimeline(None), []
+        self.latest = LatestFrame()
+        self.pose = world.grid.poses[world.start_action]
+        self.moving, self.image = moving, np.zeros((world.camera.image_height_px, world.camera.image_width_px, 3))
+        self._stopping = threading.Event()
+        self._thread = threading.Thread(target=self._run, daemon=True)
+
+    def send(self, pose) -> bool:
+        if self.sent and np.array_equal(pose, self.sent[-1]):
+            return False
+        self.sent.append(np.asarray(pose))
+        return True
+
+    def _run(self) -> None:
+        while not self._stopping.wait(PICTURE_S):
+            now = time.time()
+            self.timeline.sample(now, self.pose, self.moving)
+            self.latest.put(self.image, now - 0.005)
+
+    def __enter__(self):
+        self._thread.start()
+        return self
+
+    def __exit__(self, *exc_info):
+        self._stopping.set()
+        self._thread.join()
+
+
+class Nobody:
+    """A detector that finds nobody, at once."""
+
+    def detect(self, camera, step, pose, rng, believed_pose=None) -> Detections:
+        return Detections.empty()
+
+
+class TimedTracker:
+    """The scenario's tracker, keeping the time each prediction stepped."""
+
+    def __init__(self, tracker):
+        self.tracker, self.dt_s = tracker, []
+
+    def predict(self, dt_s=None):
+        self.dt_s.append(dt_s)
+        return self.tracker.predict(dt_s)
+
+    def update(self, *arguments, **keywords):
+        return self.tracker.update(*arguments, **keywords)
+
+    def reported(self):
+        return self.tracker.reported()
+
+
+@pytest.fixture(scope="module")
+def world():
+    scenario = scenario_from_dict({"frames": 5})
+    built = episode_world(scenario, 0)
+    return scenario, replace(built, detector=Nobody())
+
+
+def test_each_picture_is_tracked_at_its_time_and_a_pause_skips_to_the_newest_picture(world):
+    """The tracker steps by the time between the pictures' captures times ``time_scale``; a decision's
+    observer that blocks (a paused view) leaves the pictures of its pause unused but the one the detector
+    had taken, not queued."""
+    scenario, built = world
+    tracker = TimedTracker(make_tracker(None, scenario, built))
+    paused = []
+
+    def observer(step, context, record):
+        if step == 3:
+            time.sleep(0.5)
+            paused.append(time.time())
+
+    with PictureCamera(built) as camera:
+        live = run_live(built, make_policy("fix", scenario, built), tracker, camera, 12, 0.5, 0, observer)
+    assert len(live.capture_time_s) == 12 and tracker.dt_s[0] is None
+    np.testing.assert_allclose(tracker.dt_s[1:], 0.5 * np.diff(live.capture_time_s))
+    # Four before it, and two of its first moments: the one the tracker had queued, the one the detector held.
+    assert np.sum(live.capture_time_s < paused[0] - 0.1) <= 6, "pictures of the pause were used"
+    rates = live.rates()
+    assert rates["frames_used_per_s"] == pytest.approx(11 / (live.capture_time_s[-1] - live.capture_time_s[0]))
+    assert np.all(live.decided_s[np.isfinite(live.decided_s)] >= live.capture_time_s[np.isfinite(live.decided_s)])
+
+
+def test_no_new_target_goes_out_while_the_camera_moves(world):
+    """A camera that never stops moving keeps the target it was first sent: the policy is given that
+    one action only."""
+    scenario, built = world
+    policy = make_policy("random", scenario, built)
+    seen = []
+
+    def observer(step, context, record):
+        seen.append(context.reachable)
+
+    with PictureCamera(built, moving=True) as camera:
+        live = run_live(built, policy, make_tracker(None, scenario, built), camera, 6, 1.0, 0, observer)
+    assert all(len(reachable) == 1 and reachable[0] == built.start_action for reachable in seen)
+    assert not live.sent.any() and len(camera.sent) == 1
+
+
+def test_warming_up_leaves_the_policy_and_the_tracker_as_they_were(world):
+    scenario, built = world
+    policy, tracker = make_policy("smpl", scenario, built), make_tracker(None, scenario, built)
+    warm_up(built, policy, tracker)
+    assert len(tracker.tracks) == 0 and policy.last_terms is None
