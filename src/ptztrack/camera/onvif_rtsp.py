@@ -84,6 +84,13 @@ class RTSPServer(NativeRTSPServer):
         session.interleaved, session.interleaved_channel, session.interleaved_channel_rtcp = True, _RTP, _RTCP
         session.state, session.stream_name = RTSPState.READY, stream_name
         server_ports = "-".join(str(udp.getsockname()[1]) for udp in peer.sockets)
+        log.debug(
+            "RTSP session %s: RTP over UDP from %s:%s to ports %d-%d",
+            session_id,
+            HOST,
+            server_ports,
+            *peer.client_ports,
+        )
         session.transport = f"RTP/AVP;unicast;client_port={ports[1]}-{ports[2]};server_port={server_ports}"
         return (
             f"RTSP/1.0 200 OK\r\nCSeq: {cseq}\r\nSession: {session_id};timeout={SESSION_TIMEOUT_S:g}\r\n"
@@ -135,8 +142,8 @@ class RTSPServer(NativeRTSPServer):
                 return  # the session was closed under us
             try:
                 sender.sendto(data, (HOST, port))
-            except OSError as error:  # the client's port is closed (ICMP unreachable): it went away
-                log.debug("RTSP session %s: UDP client port %d went away: %s", session.session_id, port, error)
+            except OSError as error:  # the session was closed under us
+                log.debug("RTSP session %s: UDP forwarding to port %d stopped: %s", session.session_id, port, error)
                 return
 
     def _close_session(self, session) -> None:

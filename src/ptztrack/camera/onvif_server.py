@@ -19,8 +19,9 @@ server; its ``IPCamera`` and its SOAP service are not used. Its defects, and wha
   so nothing is discovered.
 * HTTP binds every interface (camera.py:131-133), RTSP 0.0.0.0 (rtsp.py:94, camera.py:211): both bind
   127.0.0.1 here.
-* Its SOAP answers fail the ONVIF schemas (GetProfiles' encoder has no Multicast or SessionTimeout,
-  GetCapabilities' System lacks required elements), its envelope declares s, tds, tt and trt only
+* Its SOAP answers fail the ONVIF schemas (GetProfiles' encoder configuration lacks the required
+  Multicast, GetVideoEncoderConfiguration's elements are out of order, GetCapabilities' System lacks
+  required elements), its envelope declares s, tds, tt and trt only
   while the PTZ templates use ``ptz:`` (static/soap/envelope.xml), GetStatus leaves its MoveStatus and
   UtcTime placeholders unfilled (onvif.py:428-429), operations are routed by substring of the
   SOAPAction or body (onvif.py:176-178, http.py:173-191: GetConfigurationOptions is answered as
@@ -33,14 +34,14 @@ server; its ``IPCamera`` and its SOAP service are not used. Its defects, and wha
   (ptz.py:469-489): the PTZ service is this package's, in the model's units, presets in memory.
 * ``IPCameraHTTPHandler.camera`` is a class attribute (camera.py:130): each camera gets its own handler
   class, which also shuts the web UI and REST API (they write ./camera_config.json and take uploads,
-  http.py:98-148); its HTTP authentication is Basic only (http.py:34-68): Digest is added.
+  http.py:98-148); its HTTP authentication is Basic only (http.py:34-70): Digest is added.
 * A client that goes away mid-answer leaves socketserver's traceback on stderr (the snapshot's
   http.py:396 and the SOAP answer's writes are unguarded): the server logs one debug line instead.
 * RTSP over UDP binds ('', 0) (rtsp.py:740) and has ffmpeg send from 0.0.0.0 straight to the client
-  (rtsp.py:1095): UDP sessions are relayed like TCP-interleaved ones, through sockets on 127.0.0.1.
+  (rtsp.py:1081): UDP sessions are relayed like TCP-interleaved ones, through sockets on 127.0.0.1.
 * ffmpeg's progress lines go to a pipe read only once it exits (rtsp.py:923-928): at ~200 bytes/s the
   pipe fills in minutes and the encoder stalls; ffmpeg is run with ``-nostats -loglevel error``.
-* An RTSP connection silent for 30 s ends its session (rtsp.py:283, 412-417) though SETUP gives a
+* An RTSP connection silent for 30 s ends its session (rtsp.py:283, 400-403) though SETUP gives a
   60 s session timeout: the connection waits 65 s.
 * Closing a session sends SIGTERM to an ffmpeg blocked on its still open input, gives up after 1 s and
   kills it without reaping it (rtsp.py:1197-1208): a zombie. The session's encoder thread, which
