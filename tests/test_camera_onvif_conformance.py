@@ -243,14 +243,17 @@ def test_every_operation_answers_schema_valid_xml_and_faults_are_soap_1_2_with_t
             status, answer = soap(cam.onvif_port, body)
             assert (status, answer.tag) == (200, f"{{{NAMESPACES[prefix]}}}{name}Response"), (name, status)
             assert schema.validate(answer), (name, str(schema.error_log))
+        # (request, its header (None: a valid token), HTTP status, code, subcodes, what the reason names)
         refusals = [
             (
-                "<tptz:GetStatus><tptz:ProfileToken>nope</tptz:ProfileToken></tptz:GetStatus>",
+                f"<tptz:GetStatus>{PROFILE.format('tptz').replace('Profile_Main', 'nope')}</tptz:GetStatus>",
                 None,
                 400,
                 "Sender",
                 ["InvalidArgVal", "NoProfile"],
+                "ProfileToken 'nope'",
             ),
+            ("<tptz:GetStatus/>", None, 400, "Sender", ["InvalidArgVal", "NoProfile"], "ProfileToken is missing"),
             (
                 f'<tptz:AbsoluteMove>{PROFILE.format("tptz")}<tptz:Position><tt:PanTilt x="1.5" y="0"/></tptz:Position>'
                 "</tptz:AbsoluteMove>",
@@ -258,6 +261,7 @@ def test_every_operation_answers_schema_valid_xml_and_faults_are_soap_1_2_with_t
                 400,
                 "Sender",
                 ["InvalidArgVal", "InvalidPosition"],
+                "Position 1.5",
             ),
             (
                 f'<tptz:RelativeMove>{PROFILE.format("tptz")}<tptz:Translation><tt:PanTilt x="0" y="0" space="urn:x"/>'
@@ -266,6 +270,15 @@ def test_every_operation_answers_schema_valid_xml_and_faults_are_soap_1_2_with_t
                 400,
                 "Sender",
                 ["InvalidArgVal", "SpaceNotSupported"],
+                "Translation.PanTilt space 'urn:x'",
+            ),
+            (
+                f"<tptz:RelativeMove>{PROFILE.format('tptz')}</tptz:RelativeMove>",
+                None,
+                400,
+                "Sender",
+                ["InvalidArgs"],
+                "Translation is missing",
             ),
             (
                 "<tds:GetCapabilities><tds:Category>Events</tds:Category></tds:GetCapabilities>",
@@ -273,15 +286,17 @@ def test_every_operation_answers_schema_valid_xml_and_faults_are_soap_1_2_with_t
                 500,
                 "Receiver",
                 ["ActionNotSupported", "NoSuchService"],
+                "Category ['Events']",
             ),
-            ("<tds:SystemReboot/>", None, 500, "Receiver", ["ActionNotSupported"]),
-            ("<trt:GetProfiles/>", "", 400, "Sender", ["NotAuthorized"]),
-            ("<trt:GetProfiles/>", security_header(password="wrong"), 400, "Sender", ["NotAuthorized"]),
+            ("<tds:SystemReboot/>", None, 500, "Receiver", ["ActionNotSupported"], "SystemReboot"),
+            ("<trt:GetProfiles/>", "", 400, "Sender", ["NotAuthorized"], "UsernameToken"),
+            ("<trt:GetProfiles/>", security_header(password="wrong"), 400, "Sender", ["NotAuthorized"], "digest"),
         ]
-        for body, header, status, code, subcodes in refusals:
+        for body, header, status, code, subcodes, named in refusals:
             answered, fault = soap(cam.onvif_port, body, header)
             assert answered == status, (body, answered)
             assert_soap_1_2_fault(fault, code, subcodes)
+            assert named in fault.findtext(f".//{{{SOAP}}}Text"), (named, fault.findtext(f".//{{{SOAP}}}Text"))
         status, root = post(cam.onvif_port, b"<s:Envelope xmlns:s='" + SOAP.encode() + b"'><s:Body><oops")
         assert status == 400
         assert_soap_1_2_fault(root.find(f"{{{SOAP}}}Body")[0], "Sender", ["WellFormed"])

@@ -45,6 +45,8 @@ _DIGESTS: dict[str, Callable[[bytes], str]] = {
 # An auth-param of an Authorization header: name=token or name="quoted string" (RFC 9110 11.2).
 _PARAM = re.compile(r'\s*([!#$%&\'*+.^_`|~0-9A-Za-z-]+)\s*=\s*("(?:[^"\\]|\\.)*"|[^\s,]*)\s*(?:,|$)')
 _DISCONNECTS = (BrokenPipeError, ConnectionResetError, ConnectionAbortedError)
+# The largest SOAP request read: ONVIF requests are a few kilobytes.
+_MAX_REQUEST_BYTES = 1 << 20
 
 
 class Verdict(Enum):
@@ -187,6 +189,9 @@ class _Handler(IPCameraHTTPHandler):
             length = int(self.headers.get("Content-Length", ""))
         except ValueError:
             self.send_error(411, "a SOAP request needs a Content-Length")
+            return
+        if not 0 <= length <= _MAX_REQUEST_BYTES:
+            self.send_error(413, f"Content-Length {length} is not in [0, {_MAX_REQUEST_BYTES}]")
             return
         status, answer = self.camera.soap.answer(self.rfile.read(length))
         self.send_response(status)

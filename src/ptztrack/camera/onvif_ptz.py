@@ -167,10 +167,15 @@ class PTZService:
     def _profile(self, operation: Element) -> None:
         require_token(operation, "ProfileToken", PROFILE, "NoProfile")
 
-    def _vector(self, operation: Element, element: str, pan_tilt_spaces: Sequence[str], zoom_space: str) -> _Vector:
+    def _vector(
+        self, operation: Element, element: str, pan_tilt_spaces: Sequence[str], zoom_space: str, required: bool = True
+    ) -> _Vector:
         """((x, y, space) of the PanTilt, x of the Zoom) of ``element`` (None where absent); a PanTilt is in
-        one of ``pan_tilt_spaces`` (the first if it names none), a Zoom in ``zoom_space``."""
+        one of ``pan_tilt_spaces`` (the first if it names none), a Zoom in ``zoom_space``; ``element`` is
+        refused if ``required`` and absent."""
         vector = operation.find(f"{{{TPTZ}}}{element}")
+        if vector is None and required:
+            raise Fault("Sender", ["ter:InvalidArgs"], f"{element} is missing")
         parts = [None if vector is None else vector.find(f"{{{TT}}}{part}") for part in ("PanTilt", "Zoom")]
         pan_tilt, zoom = parts
         for part, name, spaces in ((pan_tilt, "PanTilt", pan_tilt_spaces), (zoom, "Zoom", [zoom_space])):
@@ -183,7 +188,7 @@ class PTZService:
 
     def _speed(self, operation: Element) -> list[float]:
         """The Speed's fractions (3,) of full speed, each in (0, 1], 1 where not given."""
-        pan_tilt, zoom = self._vector(operation, "Speed", [PAN_TILT_SPEED], ZOOM_SPEED)
+        pan_tilt, zoom = self._vector(operation, "Speed", [PAN_TILT_SPEED], ZOOM_SPEED, required=False)
         speed = [*(pan_tilt[:2] if pan_tilt else (1.0, 1.0)), 1.0 if zoom is None else zoom]
         if not all(0.0 < fraction <= 1.0 for fraction in speed):
             raise invalid("InvalidSpeed", f"Speed {speed} is not in (0, 1]")

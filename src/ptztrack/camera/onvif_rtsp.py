@@ -56,7 +56,7 @@ class RTSPServer(NativeRTSPServer):
         # The first transport the client lists is the one it prefers.
         transport = headers.get("Transport", "").split(",")[0]
         profile = transport.split(";")[0].strip().upper()
-        if profile in ("RTP/AVP/TCP", "RTP/AVP/TCP/UNICAST") or "interleaved" in transport:
+        if profile == "RTP/AVP/TCP" or "interleaved" in transport:
             return super()._handle_setup(uri, stream_name, headers, cseq, client_socket, client_address, session_id)
         ports = re.search(r"client_port=(\d+)-(\d+)", transport)
         if profile not in ("RTP/AVP", "RTP/AVP/UDP") or "multicast" in transport or ports is None:

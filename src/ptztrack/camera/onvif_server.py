@@ -21,14 +21,14 @@ server; its ``IPCamera`` and its SOAP service are not used. Its defects, and wha
   127.0.0.1 here.
 * Its SOAP answers fail the ONVIF schemas (GetProfiles' encoder configuration lacks the required
   Multicast, GetVideoEncoderConfiguration's elements are out of order, GetCapabilities' System lacks
-  required elements), its envelope declares s, tds, tt and trt only
-  while the PTZ templates use ``ptz:`` (static/soap/envelope.xml), GetStatus leaves its MoveStatus and
-  UtcTime placeholders unfilled (onvif.py:428-429), operations are routed by substring of the
-  SOAPAction or body (onvif.py:176-178, http.py:173-191: GetConfigurationOptions is answered as
-  GetConfigurations), faults go out with HTTP 200 and refused tokens with 401 (http.py:161-197), and
-  its WS-Security check finds the token's fields by regular expression anywhere in the body and lets
-  a nonce be replayed (onvif.py:31-112): the SOAP service, its answers and the UsernameToken check
-  are this package's, routed by the qualified name of the Body's child.
+  required elements); its envelope declares s, tds, tt and trt only while the PTZ templates use
+  ``ptz:`` (static/soap/envelope.xml); GetStatus leaves its MoveStatus and UtcTime placeholders
+  unfilled (onvif.py:428-429); operations are routed by substring of the SOAPAction or body
+  (onvif.py:176-178, http.py:173-191: GetConfigurationOptions is answered as GetConfigurations);
+  faults go out with HTTP 200 and refused tokens with 401 (http.py:161-197); its WS-Security check
+  finds the token's fields by regular expression anywhere in the body and lets a nonce be replayed
+  (onvif.py:31-112): the SOAP service, its answers and the UsernameToken check are this package's,
+  routed by the qualified name of the Body's child.
 * Moves are instant and out-of-range positions clipped without a fault (ptz.py:361-380);
   ContinuousMove's Timeout is ignored (onvif.py:432-440); presets go to ./ptz_presets.json
   (ptz.py:469-489): the PTZ service is this package's, in the model's units, presets in memory.
