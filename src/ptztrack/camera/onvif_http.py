@@ -3,7 +3,7 @@
 SOAP requests authenticate inside the envelope (WS-Security, :mod:`ptztrack.camera.onvif_soap`) and
 are answered with the status of SOAP 1.2's HTTP binding. The snapshot and the MJPEG stream take HTTP
 Basic (RFC 7617) or Digest (RFC 7616) authentication. Unauthenticated, they answer 401 with three
-challenges, strongest first (RFC 7616 3.7, ONVIF Core 5.12.3): Digest SHA-256, Digest MD5, Basic.
+challenges, strongest first (RFC 7616 3.7): Digest SHA-256, Digest MD5, Basic.
 Digest with qop=auth:
 
     HA1 = H(username ":" realm ":" password),   HA2 = H(method ":" request-target),

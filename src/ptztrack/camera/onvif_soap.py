@@ -3,7 +3,7 @@
 A request is a SOAP 1.2 envelope whose Body holds one operation, routed by its qualified name. A
 fault is SOAP 1.2's (Part 1, 5.4: Code with Value env:Sender or env:Receiver and ONVIF's ``ter:``
 subcodes, Reason with an ``xml:lang`` Text) and goes out with the HTTP status of SOAP 1.2's HTTP
-binding (Part 2, 7.5.1.2): 400 for env:Sender, 500 for any other code.
+binding (Part 2, 7): 400 for env:Sender, 500 for any other code.
 
 WS-Security UsernameToken (OASIS Username Token Profile 1.0, which ONVIF Core requires):
 
@@ -12,8 +12,8 @@ WS-Security UsernameToken (OASIS Username Token Profile 1.0, which ONVIF Core re
 with ``nonce`` the Base64-decoded Nonce and Created its text, UTF-8. A token is accepted when the
 user name and digest match, Created lies within ``window_s`` of the camera's clock either way, and
 its nonce has not been accepted before while that nonce's Created was within the window (a replay).
-A refused token is ONVIF Core's env:Sender ter:NotAuthorized with HTTP 400 (5.9.2: a device that
-authenticates by UsernameToken only).
+A refused token is ONVIF Core's env:Sender ter:NotAuthorized with HTTP 400 (section "Authentication
+over HTTP and HTTPS": a device that authenticates SOAP by UsernameToken only).
 """
 
 import base64
