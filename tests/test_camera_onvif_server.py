@@ -4,9 +4,11 @@ and a stop that leaves nothing behind."""
 
 import asyncio
 import base64
+import contextlib
 import http.client
 import logging
 import os
+import re
 import socket
 import threading
 import time
@@ -83,7 +85,7 @@ async def nothing(client, token: str) -> None:
 
 @pytest.fixture
 def rtsp_reader(monkeypatch):
-    """An RTSP reader over TCP (the camera refuses UDP) that gives up after 8 s."""
+    """An RTSP reader over TCP that gives up after 8 s."""
     monkeypatch.setenv("OPENCV_FFMPEG_CAPTURE_OPTIONS", "rtsp_transport;tcp")
 
     def reader(uri: str) -> cv2.VideoCapture:
@@ -123,40 +125,41 @@ def ffmpeg_children() -> list[psutil.Process]:
 
 
 def test_every_socket_is_on_127_0_0_1_and_nothing_multicasts(rtsp_reader):
-    """While an ONVIF client, an MJPEG viewer and an RTSP reader are connected, every new socket of this
-    process and of its children (ffmpeg) is bound to 127.0.0.1 and talks to 127.0.0.1, none is UDP 3702
-    (WS-Discovery), and no multicast group is joined; an RTSP SETUP over UDP is refused (461)."""
+    """While an ONVIF client, an MJPEG viewer, an RTSP reader (TCP) and an RTSP session over UDP are
+    open, every new socket of this process and of its children (ffmpeg) is bound to 127.0.0.1 and talks
+    to 127.0.0.1, the UDP session's server ports among them, none is UDP 3702 (WS-Discovery), and no
+    multicast group is joined."""
     igmp = Path("/proc/net/igmp").exists()
     groups_before = multicast_groups() if igmp else set()
     before = sockets()
-    with camera() as cam:
+    with camera() as cam, contextlib.ExitStack() as open_until_listed:
         call(cam.onvif_port, nothing)
         viewer = http.client.HTTPConnection(HOST, cam.onvif_port, timeout=5)
+        open_until_listed.callback(viewer.close)
         credentials = base64.b64encode(f"{USER}:{PASSWORD}".encode()).decode()
         viewer.request("GET", "/stream.mjpeg", headers={"Authorization": f"Basic {credentials}"})
         mjpeg = viewer.getresponse()
         assert mjpeg.status == 200 and b"--frame" in mjpeg.read1(4096)
-        capture = None
+        server_ports: set[int] = set()
         if cam.rtsp_port is not None:
-            with socket.create_connection((HOST, cam.rtsp_port), timeout=5) as rtsp:
-                rtsp.sendall(
-                    f"SETUP rtsp://{HOST}:{cam.rtsp_port}/video_main/trackID=0 RTSP/1.0\r\nCSeq: 1\r\n"
-                    "Transport: RTP/AVP;unicast;client_port=50000-50001\r\n\r\n".encode()
-                )
-                assert rtsp.recv(4096).startswith(b"RTSP/1.0 461")
+            rtsp = open_until_listed.enter_context(socket.create_connection((HOST, cam.rtsp_port), timeout=5))
+            rtsp.sendall(
+                f"SETUP rtsp://{HOST}:{cam.rtsp_port}/video_main/trackID=0 RTSP/1.0\r\nCSeq: 1\r\n"
+                "Transport: RTP/AVP;unicast;client_port=50000-50001\r\n\r\n".encode()
+            )
+            answer = rtsp.recv(4096).decode()
+            assert answer.startswith("RTSP/1.0 200"), answer
+            server_ports = {int(port) for port in re.search(r"server_port=(\d+)-(\d+)", answer).groups()}
             capture = rtsp_reader(call(cam.onvif_port, stream_uri))
+            open_until_listed.callback(capture.release)
             assert capture.read()[0]
-        try:
-            opened = sockets() - before
-            groups_during = multicast_groups() if igmp else set()
-        finally:
-            viewer.close()
-            if capture is not None:
-                capture.release()
+        opened = sockets() - before
+        groups_during = multicast_groups() if igmp else set()
     listening = {(kind, local.port) for _, _, kind, local, _, status in opened if status == psutil.CONN_LISTEN}
     assert ("tcp", cam.onvif_port) in listening
     if cam.rtsp_port is not None:
         assert ("tcp", cam.rtsp_port) in listening
+        assert server_ports <= {local.port for _, _, kind, local, _, _ in opened if kind == "udp"}
         assert any(name.startswith("ffmpeg") for _, name, *_ in opened), "no ffmpeg encoder socket was seen"
     for pid, name, kind, local, remote, _ in opened:
         assert local.ip == HOST and local.port != 3702, (pid, name, kind, local)
