@@ -49,5 +49,9 @@ def test_a_bad_camera_url_is_one_line_without_the_password():
     with pytest.raises(CameraError, match="expected onvif://") as error:
         camera_address("rtsp://admin:secret@camera.local/stream")
     assert "secret" not in str(error.value)
-    with pytest.raises(CameraError, match="port"):
-        camera_address("onvif://camera.local:99999")
+    for url in ("http://admin:secret@camera.local", "https://camera.local:443"):  # a web address is not ONVIF's
+        with pytest.raises(CameraError, match="expected onvif://"):
+            camera_address(url)
+    for port in ("99999", "0", "x"):
+        with pytest.raises(CameraError, match="the port is not a number from 1 to 65535"):
+            camera_address(f"onvif://camera.local:{port}")

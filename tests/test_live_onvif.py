@@ -2,6 +2,7 @@
 network brings (a camera that goes and comes back, a refused connection, a wrong password, a camera
 that stops answering)."""
 
+import http.server
 import signal
 import socket
 import subprocess
@@ -99,6 +100,24 @@ def test_a_refused_connection_exits_2_with_one_line(capsys):
     error = capsys.readouterr().err.strip().splitlines()
     assert status == 2 and len(error) == 1 and "connection refused" in error[0]
     assert PASSWORD not in error[0]
+
+
+def test_a_web_server_that_is_not_a_camera_exits_2_with_one_line_saying_so(capsys):
+    class NotACamera(http.server.BaseHTTPRequestHandler):
+        def do_POST(self) -> None:
+            self.send_response(404)
+            self.end_headers()
+
+        def log_message(self, *arguments) -> None:
+            pass
+
+    with http.server.ThreadingHTTPServer(("127.0.0.1", 0), NotACamera) as server:
+        threading.Thread(target=server.serve_forever, daemon=True).start()
+        url = f"onvif://127.0.0.1:{server.server_address[1]}"
+        status = main(["live", "--camera", url, "--calibration", "virtual", "--steps", "3"])
+        server.shutdown()
+    error = capsys.readouterr().err.strip().splitlines()
+    assert status == 2 and len(error) == 1 and "not an ONVIF camera" in error[0]
 
 
 def test_a_wrong_password_exits_2_with_one_line_that_does_not_show_it(capsys):

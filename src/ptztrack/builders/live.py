@@ -210,6 +210,7 @@ def virtual_camera(
         password=password,
         # A camera's stream rate, and at least twice per step of the recording.
         frame_rate_hz=max(VIRTUAL_FRAME_RATE_HZ, 2.0 * scenario.frame_rate_hz * time_scale),
+        f_min_px=world.camera.f_min_px,
     )
     return camera, feed
 

@@ -50,17 +50,19 @@ class CameraAddress:
 
 
 def camera_address(url: str, credentials: dict | None = None, environ=os.environ) -> CameraAddress:
-    """The address in ``url`` (``onvif://[user[:password]@]host[:port]``, ``http://`` alike; the port
+    """The address in ``url`` (``onvif://[user[:password]@]host[:port]``, or ``host[:port]``; the port
     defaults to 80), the user name and password taken from the URL, else from ``credentials`` (a
     mapping with ``username`` and ``password``, read from a file), else from the environment
     variables ``PTZTRACK_CAMERA_USER`` and ``PTZTRACK_CAMERA_PASSWORD``."""
     parts = urlsplit(url if "://" in url else f"onvif://{url}")
-    if parts.scheme not in ("onvif", "http") or not parts.hostname:
+    if parts.scheme != "onvif" or not parts.hostname:
         raise CameraError(f"--camera {_without_password(url)}: expected onvif://[user[:password]@]host[:port]")
     try:
-        port = parts.port or DEFAULT_ONVIF_PORT
+        port = DEFAULT_ONVIF_PORT if parts.port is None else parts.port
     except ValueError:
-        raise CameraError(f"--camera {_without_password(url)}: the port is not a number from 0 to 65535") from None
+        port = 0
+    if not 1 <= port <= 65535:
+        raise CameraError(f"--camera {_without_password(url)}: the port is not a number from 1 to 65535")
     credentials = credentials or {}
     username = unquote(parts.username or "") or credentials.get("username") or environ.get(USER_VARIABLE, "")
     password = unquote(parts.password or "") or credentials.get("password") or environ.get(PASSWORD_VARIABLE, "")
@@ -234,8 +236,15 @@ class ONVIFClient:
 
 def _reason(error: Exception) -> str:
     """What went wrong, in a few words, never with the request (which may carry credentials)."""
-    from zeep.exceptions import Fault
+    from zeep.exceptions import Fault, TransportError, XMLSyntaxError
 
+    # zeep makes a fault without a code of an answer that is not a SOAP fault (an HTTP error page).
+    if isinstance(error, XMLSyntaxError | TransportError) or isinstance(error, Fault) and error.code is None:
+        status = getattr(error, "status_code", None)
+        if status in (401, 403):
+            return f"the camera refused the user name or password (HTTP {status})"
+        answer = f"HTTP {status}" if status else "an answer that is not SOAP"
+        return f"not an ONVIF camera ({answer} where ONVIF's device service should answer)"
     if isinstance(error, Fault):
         message = str(error.message or "")
         if "authori" in message.lower() or "auth" in message.lower():
