@@ -16,7 +16,7 @@ against the pose rendered, still and moving), the recording step it took
 the picture for against the one shown, and the detections per picture
 against the offline run's.
 
-    python benchmarks/live_loop.py [--steps 150] [--time-scale 1] [--policy smpl] [--transport tcp] [--json PATH]
+    python benchmarks/live_loop.py [--steps 700] [--time-scale 1] [--policy smpl] [--transport tcp] [--json PATH]
 """
 
 import argparse
@@ -49,11 +49,12 @@ MATCH_WINDOW_S = (1.0, 0.5)
 SAME_GREY = 0.5
 
 
-def identify(live, log: np.ndarray, thumbnails: np.ndarray) -> np.ndarray:
+def identify(live, log: np.ndarray, thumbnails: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """For each picture the live run used, the row of the camera's truth ``log`` (n, 5) it was rendered
-    as (``thumbnails`` (n, 48, 64) of the renders); -1 where renders that differ in pose or step are
-    indistinguishable from it."""
-    rows = np.full(len(live.capture_time_s), -1)
+    as (``thumbnails`` (n, 48, 64) of the renders), -1 where renders that differ in pose or step are
+    indistinguishable from it; and whether that render is the only one like it (its time is then known:
+    a camera standing still renders the same picture until the recording steps on)."""
+    rows, only = np.full(len(live.capture_time_s), -1), np.zeros(len(live.capture_time_s), bool)
     for index, (jpeg, time_s) in enumerate(zip(live.images, live.capture_time_s, strict=True)):
         image = cv2.imdecode(np.frombuffer(jpeg, np.uint8), cv2.IMREAD_COLOR)
         window = np.flatnonzero((log[:, 0] > time_s - MATCH_WINDOW_S[0]) & (log[:, 0] < time_s + MATCH_WINDOW_S[1]))
@@ -62,8 +63,8 @@ def identify(live, log: np.ndarray, thumbnails: np.ndarray) -> np.ndarray:
         distance = np.mean(np.abs(thumbnails[window] - thumbnail(image)), axis=(1, 2))
         alike = window[distance <= distance.min() + SAME_GREY]
         if np.all(log[alike, 1:] == log[alike[0], 1:]):  # the same step at the same pose: any of them
-            rows[index] = alike[0]
-    return rows
+            rows[index], only[index] = alike[0], len(alike) == 1
+    return rows, only
 
 
 def serve(time_scale: float, ready, stop, results) -> None:
@@ -80,7 +81,7 @@ def serve(time_scale: float, ready, stop, results) -> None:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--steps", type=int, default=150, help="pictures the live run uses")
+    parser.add_argument("--steps", type=int, default=700, help="pictures the live run uses")
     parser.add_argument("--time-scale", type=float, default=1.0)
     parser.add_argument("--policy", default="smpl")
     parser.add_argument("--transport", choices=("tcp", "udp"), default="tcp")
@@ -113,12 +114,20 @@ def main() -> None:
     offline_episode = run_episode(offline, args.policy, 0)
     offline_metrics = episode_metrics(offline_episode)
 
-    rendered = identify(live, truth_log, thumbnails)
+    rendered, timed = identify(live, truth_log, thumbnails)
     found = rendered >= 0
     true_pose = truth_log[rendered[found], 2:]
     pose_error = np.abs(live.poses[found] - true_pose)
     moving = np.any(live.pose_sd[found] > 0, axis=1)
-    arrival_s = live.capture_time_s[found] + virtual_calibration().image_delay_s
+    arrival_s = live.capture_time_s + virtual_calibration().image_delay_s
+    decided = np.isfinite(live.decided_s)
+    stages_s = {
+        "stream (true delay)": float(np.median(arrival_s[timed] - truth_log[rendered[timed], 0])),
+        "waiting for the detector": float(np.median((live.picked_s - arrival_s)[decided])),
+        "pose sample and detection": float(np.median((live.detected_s - live.picked_s)[decided])),
+        "waiting for the tracker, tracking": float(np.median((live.tracked_s - live.detected_s)[decided])),
+        "decision and command": float(np.median((live.decided_s - live.tracked_s)[decided])),
+    }
     with_tracks = [seconds for seconds, tracks in decisions if tracks > 0]
     rates = live.rates()
     row = {
@@ -139,7 +148,8 @@ def main() -> None:
         "motp_live_m": live_metrics["motp_m"],
         "motp_offline_m": offline_metrics["motp_m"],
         "pictures_identified": int(found.sum()),
-        "stream_delay_s_median": float(np.median(arrival_s - truth_log[rendered[found], 0])),
+        "pictures_timed": int(timed.sum()),
+        "stream_delay_s_median": stages_s["stream (true delay)"],
         "pictures_moving": float(np.mean(moving)),
         "pan_error_deg_still_p95": float(np.percentile(pose_error[~moving, 0], 95)) if (~moving).any() else 0.0,
         "pan_error_deg_moving_p95": float(np.percentile(pose_error[moving, 0], 95)) if moving.any() else 0.0,
@@ -155,8 +165,11 @@ def main() -> None:
     width = max(map(len, row))
     for key, value in row.items():
         print(f"{key:>{width}}  {value:.4g}" if isinstance(value, float) else f"{key:>{width}}  {value}")
+    print("\nwhere a decision's picture ages (medians over the decisions), ms:")
+    for stage, seconds in stages_s.items():
+        print(f"  {stage:<36} {1e3 * seconds:7.1f}")
     if args.json is not None:
-        write_json(args.json, row)
+        write_json(args.json, {**row, "stages_s": stages_s})
 
 
 if __name__ == "__main__":

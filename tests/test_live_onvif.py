@@ -3,6 +3,8 @@ network brings (a camera that goes and comes back, a refused connection, a wrong
 that stops answering)."""
 
 import http.server
+import os
+import re
 import signal
 import socket
 import subprocess
@@ -25,7 +27,7 @@ from ptztrack.builders.live import (
 )
 from ptztrack.camera.onvif_client import CameraAddress, CameraError, ONVIFClient
 from ptztrack.camera.stream import open_rtsp
-from ptztrack.cli import main
+from ptztrack.cli import main, read_truth_log
 from ptztrack.config import load_camera_calibration, pets_scenario, write_camera_calibration
 from ptztrack.evaluate.metrics import episode_metrics
 
@@ -43,19 +45,30 @@ def _address(camera, password: str = PASSWORD) -> CameraAddress:
 
 
 @pytest.mark.slow
-def test_a_live_smpl_run_with_hog_scores_within_10_points_of_the_offline_run():
-    """Every picture the detector can take is used; the score over the recording steps they showed is
-    near the offline run's over the same steps."""
-    scenario = pets_scenario("hog")
-    camera, feed = virtual_camera(scenario, TIME_SCALE, 0, USER, PASSWORD)
-    with camera:
-        world, live = run_live_episode(scenario, virtual_calibration(), _address(camera), "smpl", 300, TIME_SCALE, 0)
-    live_mota = episode_metrics(live_as_episode(world, live, feed.rows()))["mota"]
-    offline = offline_counterpart(scenario, world, live, feed.rows())
+def test_a_live_smpl_run_with_hog_at_the_recordings_pace_scores_near_the_offline_run(tmp_path):
+    """`ptztrack serve-camera` in a process of its own, as a camera is a machine of its own, the recording
+    at its own pace: the live run keeps it (a decision at least every step) and scores within 15 points
+    of the offline run of the recording steps its pictures showed."""
+    log = tmp_path / "truth.csv"
+    command = [sys.executable, "-m", "ptztrack.cli", "serve-camera", "--port", "0", "--truth-log", str(log)]
+    command += ["--user", USER]
+    environment = {**os.environ, "PTZTRACK_CAMERA_PASSWORD": PASSWORD}
+    server = subprocess.Popen(command, stdout=subprocess.PIPE, text=True, env=environment)
+    try:
+        port = int(re.search(r"onvif://127\.0\.0\.1:(\d+)", server.stdout.readline()).group(1))
+        scenario = pets_scenario("hog")
+        address = CameraAddress("127.0.0.1", port, USER, PASSWORD)
+        world, live = run_live_episode(scenario, virtual_calibration(), address, "smpl", 300, 1.0, 0)
+    finally:
+        server.send_signal(signal.SIGINT)
+        server.communicate(timeout=30)
+    truth_log = read_truth_log(log)
+    live_mota = episode_metrics(live_as_episode(world, live, truth_log))["mota"]
+    offline = offline_counterpart(scenario, world, live, truth_log)
     offline_mota = episode_metrics(run_episode(offline, "smpl", 0))["mota"]
-    assert len(live.capture_time_s) == 300 and offline.frames >= 30
-    assert np.all(np.isfinite(live.poses)) and np.all(np.diff(live.capture_time_s) > 0)
-    assert abs(live_mota - offline_mota) <= 0.10, (live_mota, offline_mota)
+    assert len(live.capture_time_s) == 300 and np.all(np.isfinite(live.poses))
+    assert live.rates()["decisions_per_s"] >= scenario.frame_rate_hz
+    assert abs(live_mota - offline_mota) <= 0.15, (live_mota, offline_mota)
 
 
 def test_the_run_goes_on_through_a_camera_that_goes_away_and_comes_back():

@@ -350,6 +350,7 @@ def serve_camera_command(args: argparse.Namespace) -> int:
         print(f"virtual ONVIF camera: onvif://127.0.0.1:{camera.onvif_port} (calibration: virtual)", flush=True)
         if camera.rtsp_port is not None:
             print(f"RTSP: rtsp://127.0.0.1:{camera.rtsp_port}/", flush=True)
+        print(f"the recording plays in a loop, {feed.duration_s:.0f} s a play at this time scale", flush=True)
         if log_file is not None:
             log_file.write(TRUTH_LOG_HEADER + "\n")
         while True:

@@ -8,17 +8,20 @@ with four stages in their own threads:
   with its capture time (:mod:`ptztrack.camera.stream`);
 * its pose, sampled by GetStatus and looked up at any moment with its
   uncertainty (:mod:`ptztrack.camera.pose_timeline`), and its commands,
-  sent at once whether it still moves or not;
+  sent as soon as they are made;
 * the detector, on the newest picture not yet seen, at the pose of its
-  capture time;
+  capture time, busy at most half the time (it waits as long as its last
+  detection took before it takes the next picture);
 * the tracker and the policy (the calling thread): every detected picture
   updates the tracker, predicted to its capture time (the scenario's time:
   wall time times ``time_scale``) with the pose's uncertainty in the
   measurement noise; once no newer picture waits, the policy decides on the
   tracks as the newest picture left them, and the camera is sent there.
+  While the camera still moves to its last target it is given that target
+  only (the paper's camera is sent no new decision while it moves).
 
-So every picture the detector can take is used, moving or not, and a
-decision follows each picture the tracker takes. Before the first picture
+So the pictures the detector takes are used, moving or not, and a decision
+follows each picture the tracker takes. Before the first picture
 the stages are run once on copies (:func:`warm_up`), so that compiling and
 caching are done and the first decision is as fast as the others. Ctrl-C
 (or ``steps`` pictures used) ends the run with what was recorded.
@@ -44,6 +47,9 @@ from ptztrack.types import DecisionContext, Detections, PeopleInView
 # up anyway (the camera's move-time model then carries it past the last sample).
 POSE_WAIT_S = 0.1
 IDLE_WAIT_S = 0.5
+# The detector takes the next picture no sooner than this many times its last detection's time after it took
+# the last one.
+DETECTOR_DUTY_INVERSE = 2.0
 
 
 class LiveCamera(Protocol):
@@ -67,8 +73,9 @@ class FrameSource(Protocol):
 class LiveEpisode:
     """What a live run recorded, one row per picture used (T pictures).
 
-    capture_time_s : (T,) epoch seconds each picture was taken; poses : (T, 3) the pose at that time
-    and pose_sd : (T, 3) its standard deviation (NaN where the camera's pose was unknown);
+    capture_time_s : (T,) epoch seconds each picture was taken; picked_s, detected_s, tracked_s : (T,) epoch
+    seconds the detector took it, its detections were ready, and the tracker was done with it; poses :
+    (T, 3) the pose at its capture and pose_sd : (T, 3) its standard deviation;
     decided_s : (T,) epoch seconds of the decision that followed the picture, NaN where a newer picture
     was already waiting and none was made; decision_s : (T,) the policy's time (NaN likewise);
     commanded : (T, 3) the pose the camera was sent to last, after the picture; sent : (T,) whether a new
@@ -78,6 +85,9 @@ class LiveEpisode:
     """
 
     capture_time_s: np.ndarray
+    picked_s: np.ndarray
+    detected_s: np.ndarray
+    tracked_s: np.ndarray
     poses: np.ndarray
     pose_sd: np.ndarray
     decided_s: np.ndarray
@@ -195,7 +205,7 @@ def run_live(
                 continue
             if isinstance(item, BaseException):
                 raise item
-            frame, at, detections = item
+            frame, at, detections, picked_s, detected_s = item
             dt_s = None if last_time_s is None else max(frame.time_s - last_time_s, 0.0) * time_scale
             last_time_s = frame.time_s
             tracker.predict(dt_s)
@@ -204,6 +214,9 @@ def run_live(
             measured = update.measurements if update.measurements is not None else detections
             row = {
                 "capture_time_s": frame.time_s,
+                "picked_s": picked_s,
+                "detected_s": detected_s,
+                "tracked_s": time.time(),
                 "poses": at.pose,
                 "pose_sd": at.sd,
                 "decided_s": np.nan,
@@ -214,10 +227,7 @@ def run_live(
                 "images": _jpeg(frame.image) if keep_images else b"",
             }
             action = nearest
-            if detected.empty() and (
-                last_decided_s is None
-                or (time.time() - last_decided_s) * time_scale >= float(__import__("os").environ.get("PACE", "0"))
-            ):  # decide on the newest picture only
+            if detected.empty():  # decide on the newest picture only
                 decided_s = time.time()
                 now = camera.timeline.at(decided_s)
                 here = commanded if now is None else now.pose
@@ -250,26 +260,30 @@ def run_live(
 
 def _detect_pictures(world: World, camera: LiveCamera, seeds, detected: queue.Queue, stopping) -> None:
     """The detector's stage: each newest picture not yet seen, at the pose of its capture, into ``detected``
-    as (frame, pose, detections); an exception goes there too, for the tracker's stage to raise."""
+    as (frame, pose, detections, when it was picked, when detected); an exception goes there too, for the
+    tracker's stage to raise."""
     try:
         number = 0
         while not stopping.is_set():
             frame = camera.frames.latest.newer(number, IDLE_WAIT_S)
             if frame is None:
                 continue
-            number = frame.number
+            number, picked_s = frame.number, time.time()
             camera.timeline.wait_past(frame.time_s, POSE_WAIT_S)
             at = camera.timeline.at(frame.time_s)
             if at is None:  # no pose known yet: a picture nobody can place
                 continue
             rng = np.random.default_rng(seeds.spawn(1)[0])
             detections = world.detector.detect(_CapturedView(frame.image), number, at.pose, rng)
+            detected_s = time.time()
             while not stopping.is_set():
                 try:
-                    detected.put((frame, at, detections), timeout=IDLE_WAIT_S)
+                    detected.put((frame, at, detections, picked_s, detected_s), timeout=IDLE_WAIT_S)
                     break
                 except queue.Full:
                     continue
+            # Busy at most half the time: the other half of its core is the stream's decoder's and the tracker's.
+            stopping.wait(max(0.0, picked_s + DETECTOR_DUTY_INVERSE * (detected_s - picked_s) - time.time()))
     except BaseException as error:  # noqa: BLE001 - handed to the tracker's stage, which raises it
         detected.put(error)
 
@@ -288,6 +302,9 @@ def _episode(rows: list[dict], received: int, started_s: float, ended_s: float) 
 
     return LiveEpisode(
         capture_time_s=column("capture_time_s"),
+        picked_s=column("picked_s"),
+        detected_s=column("detected_s"),
+        tracked_s=column("tracked_s"),
         poses=column("poses", 3),
         pose_sd=column("pose_sd", 3),
         decided_s=column("decided_s"),
