@@ -30,15 +30,18 @@ import numpy as np
 from ptztrack.builders.episode import episode_world, run_episode
 from ptztrack.builders.live import (
     RecordingFeed,
+    camera_spaces,
     live_as_episode,
     offline_counterpart,
     run_live_episode,
     shown_steps,
-    thumbnail,
     virtual_calibration,
     virtual_camera,
 )
-from ptztrack.camera.onvif_client import CameraAddress
+from ptztrack.camera.move_timing import measure_image_delay
+from ptztrack.camera.onvif_client import CameraAddress, ONVIFClient
+from ptztrack.camera.onvif_spaces import MoveTimes
+from ptztrack.camera.stream import FrameStream, rtsp_pictures, thumbnail
 from ptztrack.config import pets_scenario
 from ptztrack.evaluate.metrics import episode_metrics
 from ptztrack.files import write_json
@@ -79,6 +82,22 @@ def serve(time_scale: float, ready, stop, results) -> None:
     results.put((feed.rows(), np.asarray(feed.thumbnails)))
 
 
+def calibrated(address: CameraAddress):
+    """The virtual calibration with the stream's delay as ``camera calibrate`` measures it on the camera."""
+    calibration = virtual_calibration()
+    client = ONVIFClient(address)
+    client.connect()
+    stream = FrameStream(rtsp_pictures(client.stream_uri()), delay_s=0.0)
+    stream.start()
+    try:
+        move_times = MoveTimes(calibration.move_times.pan, calibration.move_times.tilt, calibration.move_times.zoom)
+        delay_s, _ = measure_image_delay(client, camera_spaces(calibration), move_times, stream.latest)
+    finally:
+        stream.stop()
+        client.close()
+    return calibration.model_copy(update={"image_delay_s": delay_s})
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--steps", type=int, default=700, help="pictures the live run uses")
@@ -99,9 +118,10 @@ def main() -> None:
     server.start()
     try:
         address = CameraAddress("127.0.0.1", ready.get(timeout=120), "bench", "bench-pass")
+        calibration = calibrated(address)
         started = time.perf_counter()
         world, live = run_live_episode(
-            scenario, virtual_calibration(), address, args.policy, args.steps, args.time_scale, 0,
+            scenario, calibration, address, args.policy, args.steps, args.time_scale, 0,
             observe=observe, transport=args.transport, keep_images=True,
         )  # fmt: skip
         wall_s = time.perf_counter() - started
@@ -119,7 +139,7 @@ def main() -> None:
     true_pose = truth_log[rendered[found], 2:]
     pose_error = np.abs(live.poses[found] - true_pose)
     moving = np.any(live.pose_sd[found] > 0, axis=1)
-    arrival_s = live.capture_time_s + virtual_calibration().image_delay_s
+    arrival_s = live.capture_time_s + calibration.image_delay_s
     decided = np.isfinite(live.decided_s)
     stages_s = {
         "stream (true delay)": float(np.median(arrival_s[timed] - truth_log[rendered[timed], 0])),
@@ -134,6 +154,7 @@ def main() -> None:
         "policy": args.policy,
         "time_scale": args.time_scale,
         "transport": args.transport,
+        "image_delay_s_calibrated": calibration.image_delay_s,
         "pictures_used": len(live.capture_time_s),
         "recording_steps": offline.frames,
         "wall_s": wall_s,

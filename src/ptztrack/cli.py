@@ -50,8 +50,9 @@ from ptztrack.builders.live import (
 from ptztrack.builders.occupancy import ROOM_FRAMES, dataset_runs, room_runs
 from ptztrack.builders.pets import PROTOCOLS, protocol_folds
 from ptztrack.builders.registration import reference_index
-from ptztrack.camera.move_timing import measure_move_times
+from ptztrack.camera.move_timing import measure_image_delay, measure_move_times, timed_move
 from ptztrack.camera.onvif_client import PASSWORD_VARIABLE, ONVIFClient, camera_address
+from ptztrack.camera.stream import FrameStream, rtsp_pictures
 from ptztrack.config import (
     LiveView,
     MoveTimesSection,
@@ -314,21 +315,33 @@ def read_truth_log(path: Path) -> np.ndarray:
 def calibrate_camera_command(args: argparse.Namespace) -> int:
     calibration = load_camera_calibration(args.calibration)
     client = ONVIFClient(camera_address(args.camera, _credentials(args)), args.timeout_s)
+    stream = None
     try:
         client.connect()
-        move_times, samples = measure_move_times(client, camera_spaces(calibration))
+        spaces = camera_spaces(calibration)
+        home = client.status().position  # where the camera was put to look: its stream's delay is timed there
+        uri = client.stream_uri()
+        stream = FrameStream(rtsp_pictures(uri), delay_s=0.0)
+        stream.start()  # opening a stream takes seconds: it opens while the moves are timed
+        move_times, samples = measure_move_times(client, spaces)
+        timed_move(client, home)
+        for axis, (distances, seconds) in samples.items():
+            intercept, slope = getattr(move_times, axis)
+            unit = "zoom" if axis == "zoom" else "deg"
+            print(
+                f"{axis}: {intercept:.3f} s + {slope:.4f} s/{unit} "
+                f"({len(seconds)} moves of {distances.max():.3g} {unit} at most)"
+            )
+        image_delay_s, delays = measure_image_delay(client, spaces, move_times, stream.latest)
+        print(f"image delay: {image_delay_s:.3f} s (median of {len(delays)} pans, {np.ptp(delays):.3f} s apart)")
     finally:
+        if stream is not None:
+            stream.stop()
         client.close()
-    for axis, (distances, seconds) in samples.items():
-        intercept, slope = getattr(move_times, axis)
-        unit = "zoom" if axis == "zoom" else "deg"
-        print(
-            f"{axis}: {intercept:.3f} s + {slope:.4f} s/{unit} "
-            f"({len(seconds)} moves of {distances.max():.3g} {unit} at most)"
-        )
     section = MoveTimesSection(pan=move_times.pan, tilt=move_times.tilt, zoom=move_times.zoom)
-    write_camera_calibration(args.calibration, calibration.model_copy(update={"move_times": section}))
-    print(f"wrote move_times into {args.calibration}")
+    update = {"move_times": section, "image_delay_s": round(image_delay_s, 4)}
+    write_camera_calibration(args.calibration, calibration.model_copy(update=update))
+    print(f"wrote move_times and image_delay_s into {args.calibration}")
     return 0
 
 

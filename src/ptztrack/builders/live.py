@@ -25,6 +25,7 @@ from ptztrack.camera.onvif_client import CameraAddress, CameraError, ONVIFClient
 from ptztrack.camera.onvif_spaces import AxisSpeeds, CameraSpaces, MoveTimes
 from ptztrack.camera.pose_timeline import PoseTimeline
 from ptztrack.camera.recorded import RecordedPTZ
+from ptztrack.camera.stream import thumbnail
 from ptztrack.config import VIRTUAL_CAMERA_CALIBRATION, CameraCalibrationFile, Scenario
 from ptztrack.control.information_policy import InformationGainPolicy
 from ptztrack.evaluate.video import RenderView
@@ -85,16 +86,6 @@ class RecordingFeed:
         """The log from row ``start`` on, (n, 5): epoch s, step, pan_deg, tilt_deg, zoom."""
         with self._lock:
             return np.asarray(self.log[start:], dtype=float).reshape(-1, 5)
-
-
-THUMBNAIL_SIZE_PX = (64, 48)
-
-
-def thumbnail(image: np.ndarray) -> np.ndarray:
-    """A picture (h, w, 3) uint8 BGR as a (48, 64) float32 grey thumbnail, area-averaged: what survives a
-    stream's compression of it."""
-    grey = cv2.cvtColor(image, cv2.COLOR_BGR2GRAY)
-    return cv2.resize(grey, THUMBNAIL_SIZE_PX, interpolation=cv2.INTER_AREA).astype(np.float32)
 
 
 TRUTH_LOG_HEADER = "time_s,step,pan_deg,tilt_deg,zoom"

@@ -26,7 +26,7 @@ import numpy as np
 from ptztrack.camera.onvif_client import CameraError, ONVIFClient
 from ptztrack.camera.onvif_spaces import CameraSpaces
 from ptztrack.camera.pose_timeline import PoseTimeline
-from ptztrack.camera.stream import FrameStream, open_rtsp
+from ptztrack.camera.stream import FrameStream, rtsp_pictures
 
 log = logging.getLogger("ptztrack.live")
 
@@ -124,16 +124,10 @@ class LiveONVIFCamera:
         if client is None:
             raise ConnectionError("the camera is away")
         try:
-            capture = open_rtsp(client.stream_uri(), self.transport)
+            return rtsp_pictures(client.stream_uri(), self.transport)()
         except (CameraError, ConnectionError) as error:
             log.debug("no RTSP stream (%s): snapshots instead", error)
             return self._snapshot, lambda: None
-
-        def read() -> np.ndarray | None:
-            ok, image = capture.read()
-            return image if ok else None
-
-        return read, capture.release
 
     def _snapshot(self) -> np.ndarray | None:
         """The connected camera's snapshot, at most every SNAPSHOT_INTERVAL_S; None once it is away."""

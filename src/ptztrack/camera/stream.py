@@ -31,6 +31,16 @@ _FFMPEG_OPTIONS = "OPENCV_FFMPEG_CAPTURE_OPTIONS"
 _OPEN_LOCK = threading.Lock()
 
 
+THUMBNAIL_SIZE_PX = (64, 48)
+
+
+def thumbnail(image: np.ndarray) -> np.ndarray:
+    """A picture (h, w, 3) uint8 BGR as a (48, 64) float32 grey thumbnail, area-averaged: what survives a
+    stream's compression of it."""
+    grey = cv2.cvtColor(image, cv2.COLOR_BGR2GRAY)
+    return cv2.resize(grey, THUMBNAIL_SIZE_PX, interpolation=cv2.INTER_AREA).astype(np.float32)
+
+
 @dataclass(frozen=True)
 class Frame:
     """One picture: image (h, w, 3) uint8 BGR, its capture time (epoch s), and its number (1 for the
@@ -139,3 +149,18 @@ class FrameStream:
             finally:
                 close()
             self._stopping.wait(self._retry_s)
+
+
+def rtsp_pictures(uri: str, transport: str = "tcp"):
+    """An ``open_source`` for :class:`FrameStream`: the RTSP stream at ``uri`` (``read`` None once it ends)."""
+
+    def open_source():
+        capture = open_rtsp(uri, transport)
+
+        def read() -> np.ndarray | None:
+            ok, image = capture.read()
+            return image if ok else None
+
+        return read, capture.release
+
+    return open_source
