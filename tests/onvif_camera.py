@@ -41,11 +41,12 @@ def camera(**options) -> VirtualONVIFCamera:
     return VirtualONVIFCamera(render, SPACES, FAST, START_POSE, (WIDTH_PX, HEIGHT_PX), **options)
 
 
-def call(port: int, operation):
-    """``await operation(client, profile_token)`` with onvif-zeep-async connected to the camera, closed after."""
+def call(port: int, operation, password: str = PASSWORD):
+    """``await operation(client, profile_token)`` with onvif-zeep-async connected to the camera as USER with
+    ``password``, closed after."""
 
     async def run():
-        client = onvif.ONVIFCamera(HOST, port, USER, PASSWORD, WSDL, no_cache=True)
+        client = onvif.ONVIFCamera(HOST, port, USER, password, WSDL, no_cache=True)
         try:
             await client.update_xaddrs()
             media = await client.create_media_service()

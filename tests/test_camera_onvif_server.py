@@ -7,7 +7,6 @@ import base64
 import contextlib
 import http.client
 import logging
-import os
 import re
 import socket
 import threading
@@ -26,18 +25,16 @@ onvif = pytest.importorskip("onvif", reason="the ONVIF client is onvif-zeep-asyn
 
 import zeep.exceptions  # noqa: E402  (onvif-zeep-async's SOAP library)
 
+from onvif_camera import HOST, PASSWORD, USER, call  # noqa: E402
 from ptztrack.camera.onvif_server import VirtualONVIFCamera  # noqa: E402
 from ptztrack.camera.onvif_spaces import AxisSpeeds, CameraSpaces  # noqa: E402
 
 pytestmark = pytest.mark.onvif
 
-HOST = "127.0.0.1"
-USER, PASSWORD = "operator", "s3cret-pass"
 SPACES = CameraSpaces(pan_deg=(-170.0, 170.0), tilt_deg=(-10.0, 80.0), zoom_curve=((0.0, 1.0), (1.0, 8.0)))
 SPEEDS = AxisSpeeds(pan_deg_s=17.0, tilt_deg_s=17.0, zoom_per_s=2.0)
 START_POSE = (0.0, 20.0, 1.0)
 WIDTH_PX, HEIGHT_PX = 320, 240
-WSDL = os.path.join(os.path.dirname(onvif.__file__), "wsdl")
 ONVIF_ERRORS = "http://www.onvif.org/ver10/error"
 RTSP_SKIP = "ffmpeg is not on the PATH: the camera has no RTSP stream"
 
@@ -56,21 +53,6 @@ def camera(speeds: AxisSpeeds = SPEEDS, **options) -> VirtualONVIFCamera:
     return VirtualONVIFCamera(
         render, SPACES, speeds, START_POSE, (WIDTH_PX, HEIGHT_PX), username=USER, password=PASSWORD, **options
     )
-
-
-def call(port: int, operation, password: str = PASSWORD):
-    """``await operation(client, profile_token)`` with an ONVIF client connected to the camera, closed after."""
-
-    async def run():
-        client = onvif.ONVIFCamera(HOST, port, USER, password, WSDL, no_cache=True)
-        try:
-            await client.update_xaddrs()
-            media = await client.create_media_service()
-            return await operation(client, (await media.GetProfiles())[0].token)
-        finally:
-            await client.close()
-
-    return asyncio.run(run())
 
 
 async def stream_uri(client, token: str) -> str:

@@ -35,6 +35,7 @@ from dataclasses import dataclass
 from functools import partial
 from typing import Protocol
 
+import cv2
 import numpy as np
 
 from ptztrack.camera.pose_timeline import PoseTimeline
@@ -100,11 +101,6 @@ class LiveEpisode:
     frames_received: int
     started_s: float
     ended_s: float
-
-    @property
-    def seen_time_s(self) -> np.ndarray:
-        """(T,) epoch seconds of what each row saw: its picture's capture time."""
-        return self.capture_time_s
 
     def rates(self) -> dict[str, float]:
         """Pictures used and decisions per second over the run (intervals over the time they span),
@@ -289,8 +285,6 @@ def _detect_pictures(world: World, camera: LiveCamera, seeds, detected: queue.Qu
 
 
 def _jpeg(image: np.ndarray) -> bytes:
-    import cv2
-
     ok, encoded = cv2.imencode(".jpg", image, [cv2.IMWRITE_JPEG_QUALITY, 85])
     return encoded.tobytes() if ok else b""
 

@@ -274,7 +274,7 @@ def offline_counterpart(scenario: Scenario, world: World, live: LiveEpisode, tru
     recording = scenario.required_recording("the offline counterpart of a live run")
     backend = world.backend
     assert isinstance(backend, RecordedPTZ)
-    shown = np.maximum(shown_steps(truth_log, live.seen_time_s), 0)
+    shown = np.maximum(shown_steps(truth_log, live.capture_time_s), 0)
     first_step, last_step = int(shown[0]), int(shown.max())
     first = int(backend.scene.video_frame[first_step])
     steps = last_step - first_step + 1
