@@ -26,6 +26,9 @@ from urllib.parse import quote, unquote, urlsplit
 import cv2
 import numpy as np
 
+# Connecting also parses the ONVIF WSDLs (0.7 s of CPU on an idle core, several seconds on a loaded
+# one), which is not the camera's answer time that ``timeout_s`` bounds.
+CONNECT_TIMEOUT_S = 15.0
 PASSWORD_VARIABLE = "PTZTRACK_CAMERA_PASSWORD"
 USER_VARIABLE = "PTZTRACK_CAMERA_USER"
 DEFAULT_ONVIF_PORT = 80
@@ -86,11 +89,13 @@ class CameraStatus:
 
 
 class ONVIFClient:
-    """One ONVIF PTZ camera: its first media profile's PTZ and snapshot, each call within ``timeout_s``."""
+    """One ONVIF PTZ camera: its first media profile's PTZ and snapshot, each call within ``timeout_s``,
+    the connection within ``connect_timeout_s``."""
 
-    def __init__(self, address: CameraAddress, timeout_s: float = 5.0):
+    def __init__(self, address: CameraAddress, timeout_s: float = 5.0, connect_timeout_s: float = CONNECT_TIMEOUT_S):
         self.address = address
         self.timeout_s = timeout_s
+        self.connect_timeout_s = connect_timeout_s
         self._loop = asyncio.new_event_loop()
         self._thread = threading.Thread(target=self._loop.run_forever, name="onvif-client", daemon=True)
         self._thread.start()
@@ -101,7 +106,7 @@ class ONVIFClient:
 
     def connect(self) -> None:
         """Connect, read the services and the first profile; a :class:`CameraError` if the camera cannot be used."""
-        self._call(self._connect())
+        self._call(self._connect(), self.connect_timeout_s)
 
     def status(self) -> CameraStatus:
         status = self._call(self._ptz.GetStatus({"ProfileToken": self._profile}))
@@ -221,13 +226,14 @@ class ONVIFClient:
             raise CameraError(f"{address}: the camera has no media profile")
         self._camera, self._profile = camera, profiles[0].token
 
-    def _call(self, coroutine: Coroutine) -> Any:
-        future = asyncio.run_coroutine_threadsafe(asyncio.wait_for(coroutine, self.timeout_s), self._loop)
+    def _call(self, coroutine: Coroutine, timeout_s: float | None = None) -> Any:
+        timeout_s = self.timeout_s if timeout_s is None else timeout_s
+        future = asyncio.run_coroutine_threadsafe(asyncio.wait_for(coroutine, timeout_s), self._loop)
         try:
-            return future.result(self.timeout_s + 1.0)
+            return future.result(timeout_s + 1.0)
         except TimeoutError:
             future.cancel()
-            raise CameraError(f"{self.address}: no answer within {self.timeout_s:g} s") from None
+            raise CameraError(f"{self.address}: no answer within {timeout_s:g} s") from None
         except CameraError:
             raise
         except Exception as error:
