@@ -1,4 +1,4 @@
-"""The follow controller (seed 003, section III-D): keep one person at a chosen image point and size.
+"""The follow controller (Nair et al., IROS 2008, section III-D): keep one person at a chosen image point and size.
 
 The robot cameraman keeps "the error vector as small as possible while, at
 the same time, avoiding jittering and abrupt accelerations": the image error

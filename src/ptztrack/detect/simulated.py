@@ -7,8 +7,8 @@ hidden by the boxes of people nearer the camera (nearer: closer to the
 optical centre, which decides who hides whom along a ray, however the camera
 is turned):
 
-* ideal: ``recall(r) = 1``. The issue asks that an occluded person not be
-  detected; we read "occluded" through the paper's own linear model
+* ideal: ``recall(r) = 1``, and an occluded person is not detected; we
+  read "occluded" through the paper's own linear model
   ``p(d=1 | c) = 1 - c`` (section 4.2), so a fully visible person is always
   detected and a fully hidden one never;
 * realistic: ``recall(r) = 1 - exp(-Kd (r - r0))`` for ``r >= r0``, else 0

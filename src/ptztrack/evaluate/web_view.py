@@ -33,7 +33,7 @@ from starlette.websockets import WebSocket, WebSocketDisconnect
 HOST = "127.0.0.1"  # never another interface: the view shows a camera's pictures
 MAX_STATES_PER_S = 30.0  # faster than a page redraws is wasted work
 # The share of a fast run's CPU time for taking, building and sending states; the run loses about twice
-# that (the threads' switching, the caches), some 3 % in benchmarks/view_overhead.py.
+# that (the threads' switching, the caches), as benchmarks/view_overhead.py measures.
 VIEW_SHARE = 0.02
 FINAL_SEND_TIMEOUT_S = 5.0  # how long the end of a run waits for the open pages to get the final state
 COMMANDS = ("pause", "step", "resume")

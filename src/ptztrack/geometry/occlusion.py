@@ -76,10 +76,8 @@ def occluded_fraction(box_px, depth_m, valid) -> np.ndarray:
     valid : (..., N) bool, people that exist and are in front of the camera.
     Returns (..., N) in [0, 1], 0 for a person not valid. The union over the
     k boxes that overlap a person's is measured exactly by cutting it along
-    their edges into at most (2k - 1)^2 cells. Cutting every box along the
-    edges of all N boxes at once, as whole arrays, cost O(N^4) per frame in
-    time and memory: 96 % of an 'smpl' decision at 20 tracks, and 4 N^5 bytes
-    for the simulated detector's N views of N people.
+    their edges into at most (2k - 1)^2 cells, not along the edges of all N
+    boxes, which would cost O(N^4) per frame in time and memory.
     """
     box_px = np.asarray(box_px, dtype=float)
     left, depth_m, valid = np.broadcast_arrays(

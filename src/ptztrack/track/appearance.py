@@ -1,6 +1,6 @@
 """Colour spatiograms and template search: a track's feet without a detector.
 
-The PTZ tracking paper (seed 002, section 5) measures a target by "scale
+The scale-invariant PTZ tracking paper (Lisanti, Del Bimbo and Pernici, section 5) measures a target by "scale
 invariant template matching inside [the] target search region", with colour
 spatiograms as templates because they "retain information about the geometry
 of object feature spatial distributions". Scale invariance comes from the

@@ -1,4 +1,4 @@
-"""The robot-cameraman paper's target model (seed 003, section III-B and III-C3): multi-patch colour histograms.
+"""The robot-cameraman paper's target model (Nair et al. 2008, sections III-B, III-C3): multi-patch colour histograms.
 
 A target is a box with rectangular patches inside it (the paper's head, torso
 and legs; by default the torso and the legs are each split into a left and a

@@ -29,7 +29,7 @@ from ptztrack.track import kalman
 # 1/2, i.e. beta_k0 < 1/2. Since sum_k beta_ki <= 1 for every measurement,
 # a lone measurement keeps at most one track alive, as the Hungarian assignment
 # does, while it still updates every track whose gate it is in: two tracks
-# on one person (JPDA's coalescence) no longer both live on it, the less
+# on one person (JPDA's coalescence) do not both live on it, the less
 # likely one runs out of missed steps. Two people crossing, both detected,
 # give each track 2/3.
 MIN_DETECTION_PROBABILITY = 0.5

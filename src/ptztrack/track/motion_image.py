@@ -1,4 +1,4 @@
-"""A motion history image for a camera that turns and zooms (seed 003, section III-C1 and III-C4).
+"""A motion history image for a camera that turns and zooms (Nair et al., IROS 2008, sections III-C1 and III-C4).
 
 The robot-cameraman paper's tracking camera stood still and differenced
 consecutive frames into a motion history image (Bobick and Davis): a pixel

@@ -1,4 +1,4 @@
-"""The robot-cameraman paper's particle filter (seed 003, section III-C): one person in the image.
+"""The robot-cameraman paper's particle filter (Nair et al., IROS 2008, section III-C): one person in the image.
 
 State: ``(x, y, h)`` in the image, the centre of the person's box and its
 height in pixels, as in the paper. We keep the image state rather than a
@@ -65,7 +65,7 @@ recovery), plus the random walk; ``velocity_gain`` 0 is the paper's walk.
 
 Height prior (not in the paper). Where the view is calibrated, a box's height is weighed against
 the height of a person standing on its bottom centre: a log-normal prior, ``ln(h / h_standing)``
-with spread ``height_log_sigma``. Background-weighted histograms no longer count the background a
+with spread ``height_log_sigma``. Background-weighted histograms do not count the background a
 box takes in, so without it nothing stops a box from growing; the paper's prior on h is none.
 
 Likelihoods: colour from the patches' hue-saturation histograms, motion

@@ -131,8 +131,8 @@ class OpenCVSource:
     It sees every view as it comes: OpenCV's trackers cannot be told that the camera moved, except by
     starting them again, which the one-pass protocol forbids. While it reports failure the box is its
     last good one. The box centre's uncertainty is ``spread`` of the box height per axis (a tracker
-    gives none of its own). CSRT gives the same boxes on the same frames every time; MIL does not
-    (measured: up to 38 px apart over 29 frames, also after ``cv2.setRNGSeed`` and on one thread).
+    gives none of its own). CSRT gives the same boxes on the same frames every time; MIL does not,
+    even after ``cv2.setRNGSeed`` and on one thread.
     """
 
     create: Callable[[], cv2.Tracker]

@@ -1,4 +1,4 @@
-"""Spatiogram template matching as a measurement source (seed 002, section 5).
+"""Spatiogram template matching as a measurement source (Lisanti, Del Bimbo and Pernici, section 5).
 
 Each track keeps a colour spatiogram of its person (:mod:`ptztrack.track.appearance`),
 taken from the box of a detection. At a step, each track predicted in the
@@ -7,41 +7,8 @@ person must have there (from the head/feet homology of the pose), and a good
 enough match gives a feet pixel for that track: the paper's "scale invariant
 template matching inside [the] target search region".
 
-Thresholds, measured on PETS 2009 S2.L1 View_001 (every 8th frame of 0-312,
-templates at the annotated feet, boxes 1.75 m x 0.5 m from the homology,
-searched 2, 4 and 6 frames later; virtual 160 x 120 and 320 x 240 views at
-zoom 1-3, people 16-98 px tall):
-
-* The homology with 1.75 m gives the annotated box heights to a median
-  ratio of 1.01 (10-90 %: 0.95-1.06).
-* The best box within half a body height of the person 2 frames later
-  scores 0.59 at the 10th percentile in the smallest view (160 x 120, zoom
-  1, people 16 px tall) and 0.77-0.85 in the others; 6 frames later,
-  0.57-0.82. The best box near empty ground scores 0.29-0.44 at the median
-  and 0.49-0.58 at the 90th percentile. ``MIN_SIMILARITY`` 0.6 keeps 89 %
-  of the true matches in the smallest view and 99-100 % in the others, and
-  1-3 % of the searches over empty ground. Similarity does not tell people
-  apart (34-80 % of searches centred on somebody else reach 0.6): keeping
-  the search inside the track's own uncertainty does.
-* The found feet lie 3-6.5 % of the person's height from the annotated ones
-  at the median (1 px for 16 px people, 3.4 px for 98 px people) and
-  6.5-13.5 % at the 90th percentile: noisier than the ideal detector.
-* Boxes as wide as the annotated ones (0.36 of the height, 0.63 m) place the
-  feet a little better (90th percentile 11 % of the height in the smallest
-  view) but score empty ground higher (90th percentile 0.54-0.62), so
-  0.5 m separates the person from the background better.
-* Wider searches rarely jump to somebody else: with radii of a quarter, a
-  half, one and one and a half body heights around the true feet, 0, 1.9,
-  2.5 and 3.2 % of the matches land more than a quarter height away.
-* In closed-loop PETS runs (ideal detector, 'fix' and 'intg' policies) the
-  3-sigma radius of the innovation covariance of tracks in view has median
-  3-9 px and 90th percentile 6-20 px; tracks found again after the camera
-  looked away reach 100 px and more. ``MAX_RADIUS_PX`` 20 keeps the searches
-  of tracked people whole and bounds the cost (about 80 ms for a 100 px tall
-  person), leaving lost tracks to the detector. ``MIN_RADIUS_PX`` 3 is the
-  90th percentile of the localisation error of the smallest people
-  (2.2-3.0 px): an overconfident track still lets its template settle where
-  it fits.
+The thresholds (``MIN_SIMILARITY``, ``MIN_RADIUS_PX``, ``MAX_RADIUS_PX``) were measured on PETS 2009
+S2.L1 View_001 (the measurements are in the documentation's registration page, "Template thresholds").
 """
 
 from dataclasses import dataclass, field
@@ -66,11 +33,9 @@ MIN_SIMILARITY = 0.6
 MIN_RADIUS_PX = 3.0
 MAX_RADIUS_PX = 20.0
 # The noise the tracker assumes for template-found feet, 1 sigma per axis, as a fraction of the
-# person's height. One frame's error is 3-6.5 % of the height at the median (above), but the errors
-# of consecutive frames are not independent: a template that settles a little off its person stays
-# off. Trusting each match at 5 % made the PETS tracks (160 x 120 views, detector every 5th step)
-# so confident that the next detection fell outside their gates and started a second track: MOTA
-# fix -2 %, 'smpl' -76 %. At 10 % it was 31 % and 28 %, at 20 % 45 % and 50 %.
+# person's height: several times one frame's error, because the errors of consecutive frames are not
+# independent (a template that settles a little off its person stays off), and a track trusting each
+# match alone grows so confident that the next detection falls outside its gate.
 NOISE_HEIGHT_FRACTION = 0.2
 SEARCH_SIGMAS = 3.0  # the search region is the 3-sigma extent of the innovation covariance
 
