@@ -37,7 +37,7 @@ from ptztrack.geometry.ptz import rotation_homography, standing_height_px  # noq
 from ptztrack.track.target import box_corners_carried  # noqa: E402
 
 # The paper's head, torso and legs ([left, top, width, height] of the box), with the lambdas set for three
-# patches (lambda_colour K / 20, lambda_loss K / 3; see the README).
+# patches (lambda_colour K / 20, lambda_loss K / 3; see the docs, the follow camera).
 PAPER_PATCHES = {
     "patches": ((0.3, 0.0, 0.4, 0.15), (0.15, 0.15, 0.7, 0.35), (0.2, 0.5, 0.6, 0.5)),
     "lambda_colour": 3 / 20,

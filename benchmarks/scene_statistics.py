@@ -7,7 +7,7 @@ height (the paper: 278.3 of 350, 79.5 %, at 49.1 px), and where the others
 went: out of view (head or feet outside the image) or hidden by nearer
 people (the ideal detector misses a person hidden by a fraction c with
 probability c). These describe the scene, not a policy; the default
-mounting and crowd were chosen with them (see the README).
+mounting and crowd were chosen with them (see the docs, the information-gain PTZ camera).
 
     python benchmarks/scene_statistics.py [--sequences 12] [--scenario FILE.yaml] [--json PATH]
 """

@@ -185,7 +185,7 @@ def virtual_camera(
         from ptztrack.camera.onvif_server import VirtualONVIFCamera
     except ImportError:
         raise RuntimeError(
-            "the virtual ONVIF camera needs ipycam: pip install --no-deps ipycam==1.3.0 (README, Real cameras)"
+            "the virtual ONVIF camera needs ipycam: pip install --no-deps ipycam==1.3.0 (docs: Real cameras)"
         ) from None
     if feed is None:
         feed = RecordingFeed(episode_world(scenario, 0), 1.0 / scenario.frame_rate_hz, time_scale)

@@ -80,7 +80,7 @@ class Observation:
 
 @dataclass(frozen=True)
 class TrackletTrackerConfig:
-    """The tracker's parameters (all fixed a priori; the README lists their sources).
+    """The tracker's parameters (all fixed a priori; the face-capture page of the docs lists their sources).
 
     zoom_steps : how long a face capture keeps the camera zoomed in; the capture comes at its last step.
     join_horizon_s : how far ahead a predicted meeting counts as Join(v).
