@@ -186,9 +186,6 @@ class Control(_Strict):
 _VideoFrame = Annotated[int, Field(ge=0), at_most(10_000_000, "video frames: 4 days at 30 Hz")]
 
 
-_Polygon = Annotated[tuple[tuple[_Coordinate, _Coordinate], ...], at_most_items(1000, "corners of a polygon")]
-
-
 class Recording(_Strict):
     """A calibrated recording with ground truth, seen through a virtual PTZ camera (paper section 5.2).
 
