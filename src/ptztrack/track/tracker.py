@@ -3,8 +3,8 @@
 Observations are feet pixels taken at a known pose; the observation function
 is the ground-to-image homography of that pose, linearised at the predicted
 state (the paper's section 3.1). Detections are associated with tracks by
-the Hungarian assignment (default) or by the Cheap JPDAF of
-:mod:`ptztrack.track.jpdaf` (``TrackerParameters.association``).
+the Hungarian assignment (default; :mod:`ptztrack.track.association`) or by
+the Cheap JPDAF of :mod:`ptztrack.track.jpdaf` (``TrackerParameters.association``).
 
 Track lifecycle. A PTZ camera looks at a few people at a time; a person it
 does not look at is still there, only more uncertain, and the information
@@ -41,7 +41,6 @@ from dataclasses import dataclass, field, replace
 from typing import Literal
 
 import numpy as np
-from scipy.optimize import linear_sum_assignment
 from scipy.stats import chi2
 
 from ptztrack.geometry.ptz import (
@@ -55,6 +54,7 @@ from ptztrack.geometry.ptz import (
 )
 from ptztrack.roles import ImageSource
 from ptztrack.track import jpdaf, kalman
+from ptztrack.track.association import assign_gated, associate, gated_innovations
 from ptztrack.types import Detections, TrackerEvidence, Tracks, TrackUpdate
 
 # Feet are found on a pixel grid: the tracker trusts them to half a pixel at
@@ -122,46 +122,6 @@ def predicted_feet_px(camera: PTZCamera, pose, mean) -> tuple[np.ndarray, np.nda
     H = ground_to_image(camera, pose)
     in_front = (mean[:, :2] @ H[2, :2] + H[2, 2]) > 0
     return apply_homography(H, mean[:, :2]), in_front
-
-
-def gated_innovations(predicted_px, in_front, S, feet_px, gate_probability: float):
-    """Innovations of every track w.r.t. every detection, and the chi-square gate.
-
-    predicted_px : (n, 2) and in_front : (n,) from :func:`predicted_feet_px`;
-    S : (n, 2, 2) innovation covariances; feet_px : (K, 2) detections.
-    Returns the innovations (n, K, 2) ``feet - predicted``, their squared
-    Mahalanobis distances (n, K), and which pairs are allowed (n, K): those
-    within the chi-square quantile ``gate_probability`` (2 degrees of
-    freedom) of tracks in front of the camera.
-    """
-    residual = feet_px[None, :, :] - predicted_px[:, None, :]
-    distance2 = np.einsum("tdi,tij,tdj->td", residual, np.linalg.inv(S), residual)
-    allowed = in_front[:, None] & (distance2 <= chi2.ppf(gate_probability, df=2))
-    return residual, distance2, allowed
-
-
-def associate(predicted_px, in_front, S, feet_px, gate_probability: float) -> tuple[np.ndarray, np.ndarray]:
-    """Hungarian assignment of detections to predicted tracks on the Mahalanobis distance.
-
-    predicted_px : (n, 2) and in_front : (n,) from :func:`predicted_feet_px`;
-    S : (n, 2, 2) innovation covariances; feet_px : (K, 2) detections.
-    Pairs whose squared Mahalanobis distance exceeds the chi-square quantile
-    ``gate_probability`` (2 degrees of freedom) are not allowed, nor are
-    tracks behind the camera. Returns matched (track_index, detection_index) arrays.
-    """
-    if len(predicted_px) == 0 or len(feet_px) == 0:
-        return np.zeros(0, dtype=int), np.zeros(0, dtype=int)
-    _, distance2, allowed = gated_innovations(predicted_px, in_front, S, feet_px, gate_probability)
-    return assign_gated(distance2, allowed, gate_probability)
-
-
-def assign_gated(distance2, allowed, gate_probability: float) -> tuple[np.ndarray, np.ndarray]:
-    """The Hungarian assignment on squared Mahalanobis distances (n, K) among the ``allowed`` (n, K)
-    pairs; returns matched (track_index, measurement_index) arrays."""
-    cost = np.where(allowed, distance2, chi2.ppf(gate_probability, df=2) * 1e3)
-    rows, cols = linear_sum_assignment(cost)
-    keep = allowed[rows, cols]
-    return rows[keep], cols[keep]
 
 
 def ground_points(feet_px, camera: PTZCamera, pose) -> tuple[np.ndarray, np.ndarray]:

@@ -1,0 +1,144 @@
+"""The scenario's camera sections: the PTZ camera, how a real one departs from its model (pose
+error, live views), which pose the tracker maps detections with, and the action grid."""
+
+from typing import Annotated, Literal
+
+import numpy as np
+from pydantic import Field, model_validator
+
+from ptztrack.config.fields import (
+    Degrees,
+    NonNegativeFloat,
+    Options,
+    Pixels,
+    PositiveFloat,
+    _Coordinate,
+    _registered,
+    _Strict,
+    _Zoom,
+    at_most,
+    at_most_items,
+)
+
+
+class PoseError(_Strict):
+    """How far a real PTZ camera lands from the pose it was sent to (backlash, zoom curves).
+
+    Each time the command changes, the camera lands at the commanded pan and tilt plus
+    ``pan_tilt_bias_deg`` plus independent Gaussian errors of ``pan_tilt_sigma_deg``, and at the
+    commanded zoom times ``zoom_bias`` times (1 + a Gaussian error of ``zoom_sigma``); it stays there
+    while the command does not change. The defaults are a perfect camera.
+    """
+
+    pan_tilt_sigma_deg: Annotated[NonNegativeFloat, at_most(90, "degrees")] = 0.0
+    pan_tilt_bias_deg: tuple[Degrees, Degrees] = (0.0, 0.0)
+    zoom_sigma: Annotated[float, Field(ge=0, lt=0.5)] = 0.0
+    zoom_bias: Annotated[PositiveFloat, at_most(10, "a factor on the zoom")] = 1.0
+
+
+_Gain = Annotated[PositiveFloat, at_most(100, "a factor on the contrast")]
+
+
+class LiveView(_Strict):
+    """How a real PTZ camera's views depart from the pinhole model (:mod:`ptztrack.camera.live_view`);
+    the defaults are the realistic model of the registration experiment.
+
+    Each view is rolled by up to ``roll_max_deg`` (uniform), its principal point is off the centre
+    by up to ``principal_offset_max_px`` (uniform over the disc; pixels of the registered image,
+    ``pose_feedback.image_size_px``, scaled for other sizes), its lens distorts radially by k1
+    (normalised coordinates) from ``k1_wide`` at zoom 1 linearly to ``k1_tele`` at ``tele_zoom``,
+    its contrast is multiplied by a ``gain`` in [low, high] and its brightness moved by up to
+    ``brightness_max`` grey levels (uniform), and it is JPEG-compressed at ``jpeg_quality``. A
+    view's values are fixed by ``seed`` (the camera unit) and its pose.
+    """
+
+    roll_max_deg: Annotated[NonNegativeFloat, at_most(45, "degrees: a mount rolled further is not level")] = 2.0
+    principal_offset_max_px: Annotated[NonNegativeFloat, at_most(1000, "pixels")] = 10.0
+    # The PETS camera's own lens over the field of our zoom-1 view (its calibration's k1).
+    k1_wide: Annotated[float, Field(gt=-1, lt=1)] = -0.15
+    k1_tele: Annotated[float, Field(gt=-1, lt=1)] = 0.0
+    tele_zoom: Annotated[float, Field(gt=1), at_most(100, "a PTZ camera's optical zoom")] = 4.0
+    gain: tuple[_Gain, _Gain] = (0.7, 1.3)
+    brightness_max: Annotated[NonNegativeFloat, at_most(255, "grey levels")] = 20.0
+    jpeg_quality: int = Field(75, ge=1, le=100)
+    seed: int = Field(0, ge=0, lt=2**63)
+
+    @model_validator(mode="after")
+    def _gain_ordered(self):
+        if self.gain[1] < self.gain[0]:
+            raise ValueError(f"gain must be [low, high] with low <= high (got {list(self.gain)})")
+        return self
+
+
+class Camera(_Strict):
+    """The PTZ camera. backend : a registered camera backend; by default 'simulated' for the
+    synthetic scene and 'virtual' (the virtual PTZ camera) for a recording. live_view : how a
+    recording's views depart from the pinhole model (None: exact pinhole views); the detector, the
+    templates and registration all see the same views."""
+
+    position_m: tuple[_Coordinate, _Coordinate, Annotated[PositiveFloat, at_most(10_000, "metres")]] = (7.5, -6.0, 2.5)
+    image_size_px: tuple[Pixels, Pixels] = (640, 480)
+    f_min_px: Annotated[PositiveFloat, at_most(1e6, "pixels")] = 325.0
+    pose_error: PoseError = PoseError()
+    live_view: LiveView | None = None
+    backend: Annotated[str | None, _registered("cameras")] = None
+    options: Options = Field(default_factory=dict)
+
+
+_REFERENCE_TIME = "time: every reference view is rendered and its SIFT features indexed"
+
+
+class PoseFeedback(_Strict):
+    """Which pose the tracker maps detections with (the scale-invariant tracking paper, section 3).
+
+    source : 'commanded' (what the camera was sent to), 'oracle' (where it really looks; for
+    experiments) or 'registered' (found from its image by SIFT registration against reference views,
+    :mod:`ptztrack.camera.pose_feedback`; needs a recording with a video). A view that cannot be
+    registered falls back to the commanded pose.
+    image_size_px : the resolution of the image registered (the detector may see a smaller one).
+    reference_zooms, reference_pan_steps, reference_tilt_steps : the reference views, a grid over the
+    action grid's pan and tilt range at each zoom; reference_pose_sigma_deg and
+    reference_zoom_spread : how roughly their poses are known before bundle adjustment.
+    index : a file caching the reference index: read when it exists, written when it does not.
+    """
+
+    source: Literal["commanded", "oracle", "registered"] = "commanded"
+    image_size_px: tuple[Pixels, Pixels] = (640, 480)
+    reference_zooms: Annotated[tuple[_Zoom, ...], at_most_items(20, _REFERENCE_TIME)] = (1.0, 2.0, 3.2)
+    reference_pan_steps: Annotated[int, Field(ge=1), at_most(50, _REFERENCE_TIME)] = 5
+    reference_tilt_steps: Annotated[int, Field(ge=1), at_most(50, _REFERENCE_TIME)] = 3
+    reference_pose_sigma_deg: Annotated[NonNegativeFloat, at_most(90, "degrees")] = 0.5
+    reference_zoom_spread: Annotated[float, Field(ge=0, lt=0.5)] = 0.03
+    index: str | None = None
+
+
+class AxisRange(_Strict):
+    start: Degrees
+    stop: Degrees
+    count: Annotated[int, Field(ge=1), at_most(1000, "time: the policies score every action")]
+
+    def values(self) -> np.ndarray:
+        return np.linspace(self.start, self.stop, self.count)
+
+
+_GridSteps = Annotated[int, Field(ge=0), at_most(1000, "steps of the action grid")]
+
+
+class Actions(_Strict):
+    pan_deg: AxisRange = AxisRange(start=-45.0, stop=45.0, count=7)
+    tilt_deg: AxisRange = AxisRange(start=0.0, stop=24.0, count=10)
+    zoom: Annotated[tuple[_Zoom, ...], at_most_items(100, "time: the policies score every action")] = (
+        1.0,
+        2.0,
+        3.0,
+        4.0,
+    )
+    max_steps: tuple[_GridSteps, _GridSteps, _GridSteps] = (2, 2, 1)
+
+    @model_validator(mode="after")
+    def _zoom_increasing(self):
+        if len(self.zoom) == 0 or np.any(np.diff(self.zoom) <= 0):
+            raise ValueError(f"zoom must be a non-empty increasing list (got {list(self.zoom)})")
+        if not -90 < self.tilt_deg.start <= self.tilt_deg.stop < 90:
+            raise ValueError("tilt_deg must run upwards within (-90, 90)")
+        return self

@@ -1,0 +1,92 @@
+"""A real (or virtual) ONVIF PTZ camera's calibration file (README, "Real cameras"): its model, read and
+written."""
+
+from pathlib import Path
+from typing import Annotated
+
+import numpy as np
+import pydantic
+import yaml
+from pydantic import Field, model_validator
+
+from ptztrack.config.fields import (
+    Degrees,
+    NonNegativeFloat,
+    PositiveFloat,
+    _Coordinate,
+    _Strict,
+    _Zoom,
+    at_most,
+    at_most_items,
+)
+from ptztrack.config.reading import ScenarioError, _first_error_line, read_yaml
+from ptztrack.files import write_atomically
+
+_MoveTime = tuple[
+    Annotated[NonNegativeFloat, at_most(60, "seconds")], Annotated[NonNegativeFloat, at_most(60, "seconds per unit")]
+]
+
+
+class MoveTimesSection(_Strict):
+    """``intercept_s + slope x distance`` per axis (Frigate's model), as [intercept_s, slope]: pan and tilt
+    per degree, zoom per unit of zoom factor; ``ptztrack camera calibrate`` measures them."""
+
+    pan: _MoveTime = (0.0, 0.0)
+    tilt: _MoveTime = (0.0, 0.0)
+    zoom: _MoveTime = (0.0, 0.0)
+
+
+class CameraCalibrationFile(_Strict):
+    """How a camera's normalised ONVIF spaces map to the camera model, and how long its moves take.
+
+    pan_deg, tilt_deg : the degrees at normalised -1 and +1; zoom_curve : [[normalised, zoom factor], ...]
+    both increasing, from the widest view (zoom factor 1); position_m : the optical centre (x, y, z) on the
+    ground plane's axes, metres, and f_min_px : the focal length at zoom 1 (null: the scenario's camera);
+    move_times : see :class:`MoveTimesSection`; image_delay_s : how long after the camera stands still
+    its images show where it stands (a frame interval and the stream's latency; 0.1 s: a 10 fps stream).
+    """
+
+    pan_deg: tuple[Degrees, Degrees]
+    tilt_deg: tuple[Degrees, Degrees]
+    zoom_curve: Annotated[
+        list[tuple[Annotated[float, Field(ge=0, le=1)], _Zoom]], Field(min_length=2), at_most_items(1000, "a table")
+    ]
+    position_m: tuple[_Coordinate, _Coordinate, _Coordinate] | None = None
+    f_min_px: Annotated[PositiveFloat, at_most(1e6, "pixels")] | None = None
+    move_times: MoveTimesSection = MoveTimesSection()
+    image_delay_s: Annotated[NonNegativeFloat, at_most(10, "seconds")] = 0.1
+
+    @model_validator(mode="after")
+    def _monotonic(self):
+        if self.pan_deg[0] == self.pan_deg[1] or self.tilt_deg[0] == self.tilt_deg[1]:
+            raise ValueError("pan_deg and tilt_deg must each span a range (two different ends)")
+        curve = np.asarray(self.zoom_curve, dtype=float)
+        if np.any(np.diff(curve, axis=0) <= 0):
+            raise ValueError("zoom_curve must increase in both columns, point after point")
+        return self
+
+
+def load_camera_calibration(path: str | Path) -> CameraCalibrationFile:
+    """Read and validate a camera calibration YAML file; a :class:`ScenarioError` of one line if it is not one."""
+    data = read_yaml(path, "camera calibration", ScenarioError)
+    if not isinstance(data, dict):
+        raise ScenarioError(f"{path}: expected a mapping of camera calibration fields (got {type(data).__name__})")
+    try:
+        return CameraCalibrationFile.model_validate(data)
+    except pydantic.ValidationError as error:
+        raise ScenarioError(_first_error_line(error, str(path))) from None
+
+
+# The virtual ONVIF camera of `ptztrack serve-camera` over PETS: spaces wider than the PETS grid, as a
+# real camera's are, and the zoom range of the virtual camera.
+VIRTUAL_CAMERA_CALIBRATION = {
+    "pan_deg": (-90.0, 90.0),
+    "tilt_deg": (-45.0, 45.0),
+    "zoom_curve": [(0.0, 1.0), (1.0, 8.0)],
+}
+
+
+def write_camera_calibration(path: str | Path, calibration: CameraCalibrationFile) -> None:
+    """Write a camera calibration as YAML, atomically (comments of an earlier file are not kept)."""
+    text = yaml.safe_dump(calibration.model_dump(mode="json"), sort_keys=False)
+    write_atomically(Path(path), text.encode())

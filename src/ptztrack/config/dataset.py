@@ -1,0 +1,211 @@
+"""Multi-view datasets and the occupancy-map detector (the LPOM paper): their models, the dataset file's
+reader and the built-in PETS 2009 S2.L1 dataset."""
+
+from importlib import resources
+from pathlib import Path
+from typing import Annotated, Any
+
+import pydantic
+from pydantic import Field, model_validator
+
+from ptztrack.config.fields import _MAX_FRAMES, NonNegativeFloat, Pixels, PositiveFloat, _Strict, at_most, at_most_items
+from ptztrack.config.reading import ScenarioError, _first_error_line, read_yaml
+from ptztrack.config.scenario import Tracker
+
+
+class DatasetView(_Strict):
+    """One fixed camera of a multi-view dataset.
+
+    calibration : a Tsai XML (PETS 2009) or a pinhole JSON (``{view: {K, dist, R, t}}``, world in mm);
+    calibration_view : the view's key in a pinhole JSON (default: ``name``).
+    image_size_px : (width, height); read from a Tsai XML, checked against it when given; needed with
+    a pinhole JSON. video (a file) or images (a folder, frames in sorted name order) : the frames,
+    for motion edges; detections : a MOTChallenge detection file (``frame,-1,left,top,width,height,score,...``,
+    frames from 1), for views without frames and for the clustering baseline. weight : ``w_c``.
+    """
+
+    name: str
+    calibration: str
+    calibration_view: str | None = None
+    image_size_px: tuple[Pixels, Pixels] | None = None
+    video: str | None = None
+    images: str | None = None
+    detections: str | None = None
+    weight: Annotated[PositiveFloat, at_most(1e6, "a relative weight")] = 1.0
+
+    @model_validator(mode="after")
+    def _has_evidence(self):
+        if self.video is not None and self.images is not None:
+            raise ValueError("give video or images, not both")
+        if self.video is None and self.images is None and self.detections is None:
+            raise ValueError("a view needs video, images or detections")
+        return self
+
+
+_PersonHeight = Annotated[PositiveFloat, at_most(10, "metres: a person")]
+_GroundDistance = Annotated[PositiveFloat, at_most(1000, "metres")]
+_LOCUS_MEMORY = "memory: the locus tables hold every block's points for every height"
+MAX_PERSON_HEIGHTS = 100
+MAX_GROUND_CELLS = 10_000_000
+MAX_DATASET_FRAMES = _MAX_FRAMES
+"""Cells of an occupancy map: 80 MB a map in float64, several kept per frame."""
+
+
+class Occupancy(_Strict):
+    """The occupancy-map detector, its baseline and where their parameters come from (README).
+
+    Person model (equation 4, Algorithm 1): heights from min_height_m up to max_height_m in steps of
+    height_step_m (at the steps' midpoints), width_m, samples_per_height tangent points per height.
+    Map: cell_m, kernel_sigma_m (the Gaussian kernel), block_px (locus tables per block of pixels).
+    Modes: separation_m (closest two people), window_m (their mean and covariance), min_strength
+    (fraction of the frame's strongest mode; None: fitted on the other half of the frames).
+    Motion edges: canny_low, canny_high, difference_threshold (grey levels), dilation_px.
+    Boxes: outline_points_per_box, min_box_score. Baseline: linkage_m (complete-linkage cut),
+    min_views (None: fitted like min_strength), blob_min_area_px (blob boxes of views without detections).
+    """
+
+    min_height_m: _PersonHeight = 1.6
+    max_height_m: _PersonHeight = 1.9
+    height_step_m: _PersonHeight = 0.1
+    width_m: Annotated[PositiveFloat, at_most(10, "metres: a person")] = 0.5
+    samples_per_height: Annotated[int, Field(ge=1), at_most(1000, _LOCUS_MEMORY)] = 32
+    cell_m: PositiveFloat = 0.05
+    kernel_sigma_m: _GroundDistance = 0.1
+    block_px: Annotated[int, Field(ge=1), at_most(256, "pixels")] = 4
+    separation_m: _GroundDistance = 0.5
+    window_m: _GroundDistance = 0.25
+    canny_low: Annotated[NonNegativeFloat, at_most(10_000, "a gradient magnitude")] = 50.0
+    canny_high: Annotated[NonNegativeFloat, at_most(10_000, "a gradient magnitude")] = 150.0
+    difference_threshold: Annotated[NonNegativeFloat, at_most(255, "grey levels")] = 15.0
+    dilation_px: Annotated[int, Field(ge=0), at_most(256, "pixels")] = 2
+    outline_points_per_box: Annotated[int, Field(ge=4), at_most(10_000, _LOCUS_MEMORY)] = 64
+    min_box_score: float = Field(0.5, ge=0, le=1)
+    linkage_m: _GroundDistance = 1.0
+    blob_min_area_px: Annotated[int, Field(ge=1), at_most(8192 * 8192, "an image's pixels")] = 400
+
+    @model_validator(mode="after")
+    def _heights_ordered(self):
+        if self.max_height_m < self.min_height_m:
+            raise ValueError(f"max_height_m must be at least min_height_m ({self.min_height_m})")
+        heights = (self.max_height_m - self.min_height_m) / self.height_step_m
+        if heights > MAX_PERSON_HEIGHTS:
+            raise ValueError(
+                f"height_step_m {self.height_step_m:g} gives {heights:.3g} heights; at most "
+                f"{MAX_PERSON_HEIGHTS} ({_LOCUS_MEMORY})"
+            )
+        return self
+
+
+class OccupancyTracker(Tracker):
+    """The ground tracker fed by the occupancy map: the scenario's tracker section, but a track is
+    reported from its second detection on (the map's one-off ghosts, loci of two views crossing by
+    chance, rarely repeat at the same place, as HOG's false positives: ``PETS_HOG_TRACKER``)."""
+
+    confirmation_hits: int = Field(2, ge=1)
+
+
+class MultiViewDataset(_Strict):
+    """A calibrated multi-view recording (README, "The occupancy-map detector"). Relative paths in a
+    dataset file are relative to it.
+
+    area_m : [[x0, y0], [x1, y1]] the ground the map covers, metres (people outside it are not scored);
+    frames : how many frames to use (default: all that every view and the ground truth have);
+    ground_truth : MOTChallenge rows with world x, y in metres in columns 8-9 (frames from 1).
+    """
+
+    name: str = "dataset"
+    frame_rate_hz: Annotated[PositiveFloat, at_most(1000, "frames per second")]
+    frames: (
+        Annotated[int, Field(ge=1), at_most(MAX_DATASET_FRAMES, "memory: every frame's map and modes are kept")] | None
+    ) = None
+    area_m: tuple[tuple[float, float], tuple[float, float]]
+    ground_truth: str | None = None
+    views: Annotated[list[DatasetView], Field(min_length=1), at_most_items(64, "time: every view's loci, every frame")]
+    occupancy: Occupancy = Occupancy()
+    tracker: OccupancyTracker = OccupancyTracker()
+
+    @model_validator(mode="after")
+    def _area_and_names(self):
+        (x0, y0), (x1, y1) = self.area_m
+        if not (x1 > x0 and y1 > y0):
+            raise ValueError("area_m must be [[x0, y0], [x1, y1]] with x1 > x0 and y1 > y0")
+        cells = (x1 - x0) * (y1 - y0) / self.occupancy.cell_m**2
+        if cells > MAX_GROUND_CELLS:
+            raise ValueError(
+                f"area_m at occupancy.cell_m {self.occupancy.cell_m:g} m makes {cells:.3g} cells; at most "
+                f"{MAX_GROUND_CELLS:g} (memory: a map of float64 cells per frame): make the cells larger"
+            )
+        names = [view.name for view in self.views]
+        if len(set(names)) != len(names):
+            raise ValueError(f"view names must differ (got {names})")
+        if self.tracker.association != "hungarian":
+            raise ValueError("the occupancy map's modes are associated by the Hungarian assignment only")
+        return self
+
+
+DATASET_PATH_FIELDS = ("calibration", "video", "images", "detections")
+
+
+def dataset_from_dict(data: Any, source: str = "dataset") -> MultiViewDataset:
+    """Validate a multi-view dataset mapping; a :class:`ScenarioError` of one line naming the field."""
+    if not isinstance(data, dict):
+        raise ScenarioError(f"{source}: expected a mapping of dataset fields (got {type(data).__name__})")
+    try:
+        return MultiViewDataset.model_validate(data)
+    except pydantic.ValidationError as error:
+        raise ScenarioError(_first_error_line(error, source)) from None
+
+
+def load_dataset(path: str | Path) -> MultiViewDataset:
+    """Read and validate a multi-view dataset YAML file, its relative paths made relative to it."""
+    path = Path(path)
+    data = read_yaml(path, "dataset", ScenarioError)
+    if isinstance(data, dict):
+        base = path.parent
+        if isinstance(data.get("ground_truth"), str):
+            data = {**data, "ground_truth": str(base / data["ground_truth"])}
+        if isinstance(data.get("views"), list):
+            views = [
+                {
+                    **view,
+                    **{key: str(base / view[key]) for key in DATASET_PATH_FIELDS if isinstance(view.get(key), str)},
+                }
+                if isinstance(view, dict)
+                else view
+                for view in data["views"]
+            ]
+            data = {**data, "views": views}
+    return dataset_from_dict(data, str(path))
+
+
+# PETS 2009 S2.L1 as a multi-view dataset: the seven views with published detections (View_002 has
+# none), their official Tsai calibrations, View_001's video. The area holds every annotated
+# position with a margin of about a metre. A person in these views is 0.1-0.4 m on the ground per
+# 4-15 px of feet error (the detections' median, README of the data), hence the wider kernel and
+# cells than in the room; 10 fps as in the PETS scenario.
+PETS_VIEWS = ("View_001", "View_003", "View_004", "View_005", "View_006", "View_007", "View_008")
+PETS_OCCUPANCY = {"cell_m": 0.1, "kernel_sigma_m": 0.25}
+
+
+def pets_dataset(**overrides) -> MultiViewDataset:
+    """The built-in PETS 2009 S2.L1 dataset (seven views), from the files shipped with ptztrack."""
+    data_dir = resources.files("ptztrack.data") / "pets2009_s2l1"
+    views = [
+        {
+            "name": view,
+            "calibration": str(data_dir / f"{view}.xml"),
+            "detections": str(data_dir / f"{view}_det.txt.gz"),
+            **({"video": str(data_dir / "View_001.avi")} if view == "View_001" else {}),
+        }
+        for view in PETS_VIEWS
+    ]
+    data = {
+        "name": "pets",
+        "frame_rate_hz": 10.0,
+        "area_m": ((-21.0, -17.5), (8.5, 9.0)),
+        "ground_truth": str(data_dir / "gt_mot15.txt"),
+        "views": views,
+        "occupancy": PETS_OCCUPANCY,
+        **overrides,
+    }
+    return dataset_from_dict(data, "pets")

@@ -1,0 +1,380 @@
+"""One validated configuration object per run, loadable from YAML: the scenario, its people, detector,
+tracker, control and recording sections, and the built-in PETS 2009 S2.L1 scenarios.
+
+The defaults are the synthetic scene of the paper's section 5.1 with the
+camera mounting chosen in :mod:`ptztrack.scene.synthetic`.
+"""
+
+from importlib import resources
+from pathlib import Path
+from typing import Annotated, Literal
+
+import pydantic
+from pydantic import Field, model_validator
+
+from ptztrack.config.camera import Actions, Camera, PoseFeedback
+from ptztrack.config.fields import (
+    _MAX_FRAMES,
+    NonNegativeFloat,
+    Options,
+    Pixels,
+    PositiveFloat,
+    _Coordinate,
+    _registered,
+    _Strict,
+    at_most,
+    at_most_items,
+)
+from ptztrack.config.follow import Follow
+from ptztrack.config.reading import ScenarioError, _first_error_line, read_yaml
+
+_Speed = Annotated[PositiveFloat, at_most(15, "metres per second: faster than anyone runs")]
+_Height = Annotated[PositiveFloat, at_most(3, "metres: taller than anyone")]
+_Stay = Annotated[PositiveFloat, at_most(86_400, "seconds: a day")]
+
+
+class People(_Strict):
+    """The synthetic crowd (:mod:`ptztrack.scene.synthetic`). paired_fraction : the share of the
+    ``count`` people who walk in pairs, side by side ``pair_spacing_m`` apart (pairs: the fraction
+    of count / 2, rounded)."""
+
+    count: Annotated[int, Field(ge=0), at_most(1000, "time: the policies score every person under every action")] = 7
+    speed_m_s: tuple[_Speed, _Speed] = (1.0, 1.5)
+    height_m: tuple[_Height, _Height] = (1.6, 1.9)
+    width_m: Annotated[PositiveFloat, at_most(3, "metres: a person's width")] = 0.62
+    turn_rate_sigma_deg_s: Annotated[NonNegativeFloat, at_most(3600, "degrees per second")] = 40.0
+    enter_leave: bool = False
+    stay_s: tuple[_Stay, _Stay] = (8.0, 20.0)
+    paired_fraction: float = Field(0.85, ge=0, le=1)
+    pair_spacing_m: Annotated[PositiveFloat, at_most(10, "metres between two people walking together")] = 0.75
+
+    @model_validator(mode="after")
+    def _intervals_ordered(self):
+        for name in ("speed_m_s", "height_m", "stay_s"):
+            low, high = getattr(self, name)
+            if high < low:
+                raise ValueError(f"{name} must be [low, high] with low <= high (got {[low, high]})")
+        return self
+
+    @property
+    def pairs(self) -> int:
+        """How many pairs walk side by side (never more than there are people for)."""
+        return min(round(self.paired_fraction * self.count / 2), self.count // 2)
+
+
+# How the policies and the tracker know the detector: its prior curve fixed, learned from the run, or the
+# simulation's own curve (for comparison only); anything else names a detector_model.json to start from.
+DETECTOR_MODELS = ("a-priori", "online", "true")
+
+
+class Detector(_Strict):
+    """The detector: simulated (ideal, realistic), OpenCV's HOG on a recording's virtual view, or any
+    detector registered by another package (``options`` are its parameters).
+
+    The policies plan with recall 1 for 'ideal'; for every other kind they start from the recall
+    curve ``recall_kd``, ``recall_r0_px`` (the paper's equation 13), its r0 shifted by
+    ``prior_shift_px``, and with ``model`` 'online' (the default) learn the curve as the camera runs
+    (:mod:`ptztrack.detect.detector_model`); 'a-priori' keeps the prior, 'true' plans with the
+    simulation's own curve, and a file path starts from what an earlier run learned.
+
+    hog_search : 'ground' scans only the windows where a standing person ``hog_person_height_m``
+    (shortest, tallest) tall could be seen on the walkable area, at their sizes; 'image' scans every
+    window of the pyramid, as OpenCV's ``detectMultiScale`` (:mod:`ptztrack.detect.hog`).
+    """
+
+    kind: Annotated[str, _registered("detectors")] = "realistic"
+    options: Options = Field(default_factory=dict)
+    recall_kd: Annotated[PositiveFloat, at_most(100, "per pixel")] = 0.0098
+    recall_r0_px: Annotated[NonNegativeFloat, at_most(10_000, "pixels")] = 21.29
+    pixel_noise_px: Annotated[NonNegativeFloat, at_most(10_000, "pixels")] = 2.0
+    false_positives_per_frame: Annotated[
+        NonNegativeFloat, at_most(1000, "time and memory: every detection is kept and associated")
+    ] = 0.0
+    hog_upsample: Annotated[PositiveFloat, at_most(16, "memory: the view is upsampled this much each way")] = 6.0
+    hog_hit_threshold: float = 0.0
+    hog_nms_iou: float = Field(0.4, gt=0, le=1)
+    hog_search: Literal["ground", "image"] = "ground"
+    hog_person_height_m: tuple[_Height, _Height] = (1.5, 2.0)
+    model: str = "online"
+    prior_shift_px: Annotated[float, Field(ge=-1000, le=1000)] = 0.0
+
+    @model_validator(mode="after")
+    def _heights_ordered(self):
+        low, high = self.hog_person_height_m
+        if high < low:
+            raise ValueError(f"hog_person_height_m must be [low, high] with low <= high (got {[low, high]})")
+        return self
+
+    @model_validator(mode="after")
+    def _model_known(self):
+        if self.model in DETECTOR_MODELS:
+            if self.model == "true" and self.kind not in ("ideal", "realistic"):
+                raise ValueError(
+                    f"model 'true' (the simulation's own curve) needs a simulated detector, not kind {self.kind!r}"
+                )
+            return self
+        if not Path(self.model).is_file():
+            raise ValueError(
+                f"model {self.model!r} is neither one of {', '.join(DETECTOR_MODELS)} nor a detector model file"
+            )
+        return self
+
+
+class Tracker(_Strict):
+    """The ground-plane tracker: by default (``kind`` 'ekf') one EKF per person, and its data association.
+
+    association : 'hungarian' (one detection per track, assigned on the
+    Mahalanobis distance) or 'cjpdaf' (Fitzgerald's Cheap JPDAF, equation 6
+    of Lisanti et al.: every track is updated with all detections in its
+    gate, weighted by association probabilities; :mod:`ptztrack.track.jpdaf`).
+    clutter_density_per_px2 : the CJPDAF's constant C, which competes with
+    the detections' Gaussian likelihoods p (1/px^2): with one track and one
+    detection, beta = p / (p + C). It is the parametric PDA's
+    lambda (1 - P_D P_G) / P_D, lambda the density of false detections
+    per px^2, P_D the recall, P_G the gate probability. The default 0 is
+    that value for the simulated detectors, which report no false positives
+    (a positive C there only discounts true detections of uncertain tracks:
+    1e-6 costs `intg` and `smpl` 2 MOTA points on the synthetic realistic
+    table, 2e-5 costs 9); the PETS scenario with HOG sets it (see
+    ``PETS_HOG_TRACKER``). The Hungarian association ignores it.
+    measurement_source : 'detector' (every step) or 'spatiogram' (the scale-invariant paper's
+    section 5: the detector runs every ``detector_every_steps`` steps, to start tracks and retake
+    each detected track's colour spatiogram; in between, each track is measured by searching for
+    its spatiogram around its prediction, at the scale the head/feet homology gives;
+    :mod:`ptztrack.track.templates`). Needs a recording with a video.
+    kind : a registered tracker (another package's, with ``options`` its parameters).
+    existence_at_birth, existence_when_detected, existence_to_delete : the track lifecycle, by the
+    probability that a track's person exists (:mod:`ptztrack.track.tracker`); existence_update 'bayes'
+    weighs each detection against the clutter (the learned rate where the detector model learns,
+    else ``clutter_density_per_px2``) and reports tracks of existence ``existence_to_report`` or more;
+    'fixed' sets it to ``existence_when_detected`` at every detection and reports every track.
+    max_position_sigma_m : where people can leave the scene (a recording, or ``people.enter_leave``),
+    a track this uncertain is deleted; where they never leave, uncertainty deletes nobody.
+    report_position_sigma_m : a track more uncertain than this is kept but not reported.
+    """
+
+    kind: Annotated[str, _registered("trackers")] = "ekf"
+    options: Options = Field(default_factory=dict)
+    acceleration_sigma_m_s2: Annotated[PositiveFloat, at_most(100, "metres per second squared")] = 1.5
+    initial_speed_sigma_m_s: Annotated[PositiveFloat, at_most(100, "metres per second")] = 0.9
+    gate_probability: float = Field(0.99, gt=0, lt=1)
+    existence_at_birth: float = Field(0.5, gt=0, lt=1)
+    existence_when_detected: float = Field(0.99, gt=0, lt=1)
+    existence_to_delete: float = Field(0.1, gt=0, lt=1)
+    max_position_sigma_m: Annotated[PositiveFloat, at_most(10_000, "metres")] = 2.0
+    confirmation_hits: Annotated[int, Field(ge=1), at_most(_MAX_FRAMES, "steps")] = 1
+    report_position_sigma_m: Annotated[PositiveFloat, at_most(10_000, "metres")] = 1.0
+    existence_update: Literal["bayes", "fixed"] = "bayes"
+    existence_to_report: float = Field(0.5, gt=0, lt=1)
+    association: Literal["hungarian", "cjpdaf"] = "hungarian"
+    clutter_density_per_px2: Annotated[NonNegativeFloat, at_most(1, "detections per pixel")] = 0.0
+    measurement_source: Literal["detector", "spatiogram"] = "detector"
+    detector_every_steps: Annotated[int, Field(ge=1), at_most(_MAX_FRAMES, "steps")] = 5
+
+
+class Control(_Strict):
+    """Parameters of the information-gain policies (paper sections 4 and 4.4)."""
+
+    samples: Annotated[int, Field(ge=1), at_most(10_000, "time: smpl scores every sample under every action")] = 100
+    beta: Annotated[NonNegativeFloat, at_most(1e6, "a weight")] = 0.0
+    person_height_m: _Height = 1.75
+    exploration_cell_m: Annotated[float, Field(ge=0.05), at_most(1000, "metres")] = 1.0
+    prior_untracked_people: Annotated[NonNegativeFloat, at_most(10_000, "people")] = 1.0
+    arrival_rate_per_s: Annotated[NonNegativeFloat, at_most(1000, "people per second")] = 0.1
+
+
+_VideoFrame = Annotated[int, Field(ge=0), at_most(10_000_000, "video frames: 4 days at 30 Hz")]
+
+
+class Recording(_Strict):
+    """A calibrated recording with ground truth, seen through a virtual PTZ camera (paper section 5.2).
+
+    With a recording, the camera's position and focal length come from the
+    calibration (``camera.image_size_px`` sets the virtual view), and the
+    action grid's pan and tilt are offsets from the pose that shows the whole
+    recorded frame. Relative paths in a scenario file are relative to it.
+    frame_range : [first, stop) video frames (0-based) to run on; default all.
+    area_m : the walkable area, a polygon of [x, y] points in metres; default the ground the
+    recorded view shows (see :func:`ptztrack.builders.world.visible_ground_m`).
+    map_grid_px : the virtual camera computes where each pixel reads the recording exactly every
+    ``map_grid_px`` pixels and interpolates in between (1: every pixel; see
+    :class:`ptztrack.camera.virtual.VirtualPTZ`).
+    """
+
+    ground_truth: str
+    calibration: str
+    view: str = "View_001"
+    video: str | None = None
+    recorded_size_px: tuple[Pixels, Pixels] = (768, 576)
+    frame_step: Annotated[int, Field(ge=1), at_most(_MAX_FRAMES, "video frames")] = 2
+    occluded_above: float = Field(0.25, ge=0, le=1)
+    frame_range: tuple[_VideoFrame, _VideoFrame] | None = None
+    area_m: (
+        Annotated[tuple[tuple[_Coordinate, _Coordinate], ...], at_most_items(1000, "corners of a polygon")] | None
+    ) = None
+    map_grid_px: Annotated[int, Field(ge=1), at_most(64, "pixels between the sampling map's grid points")] = 1
+
+    @model_validator(mode="after")
+    def _range_and_area(self):
+        if self.frame_range is not None and self.frame_range[1] <= self.frame_range[0]:
+            raise ValueError(f"frame_range must be [first, stop) with first < stop (got {list(self.frame_range)})")
+        if self.area_m is not None and len(self.area_m) < 3:
+            raise ValueError(f"area_m must be a polygon of at least 3 [x, y] points (got {len(self.area_m)})")
+        return self
+
+
+_Side = Annotated[PositiveFloat, at_most(1000, "metres: the ground a PTZ camera can cover")]
+
+
+class Scenario(_Strict):
+    """Everything a run needs besides the policy and the seed."""
+
+    area_m: tuple[_Side, _Side] = (15.0, 15.0)
+    frames: Annotated[
+        int, Field(ge=1), at_most(_MAX_FRAMES, "memory: a run keeps every step's history, a few kB a step")
+    ] = 50
+    frame_rate_hz: Annotated[PositiveFloat, at_most(1000, "steps per second")] = 5.0
+    people: People = People()
+    camera: Camera = Camera()
+    actions: Actions = Actions()
+    detector: Detector = Detector()
+    tracker: Tracker = Tracker()
+    control: Control = Control()
+    pose_feedback: PoseFeedback = PoseFeedback()
+    follow: Follow = Follow()
+    recording: Recording | None = None
+
+    @model_validator(mode="after")
+    def _images_need_a_video(self):
+        has_video = self.recording is not None and self.recording.video is not None
+        if self.detector.kind == "hog" and not has_video:
+            raise ValueError("detector.kind 'hog' needs a recording with a video (recording.video)")
+        if self.pose_feedback.source == "registered" and not has_video:
+            raise ValueError("pose_feedback.source 'registered' needs a recording with a video (recording.video)")
+        if self.tracker.measurement_source == "spatiogram" and not has_video:
+            raise ValueError("tracker.measurement_source 'spatiogram' needs a recording with a video (recording.video)")
+        return self
+
+    def required_recording(self, purpose: str) -> Recording:
+        """The scenario's recording; a :class:`ScenarioError` saying that ``purpose`` needs one if it has none."""
+        if self.recording is None:
+            raise ScenarioError(f"{purpose} needs a recording (recording)")
+        return self.recording
+
+    def required_video(self, purpose: str) -> str:
+        """The recording's video; a :class:`ScenarioError` saying that ``purpose`` needs one if it has none."""
+        video = self.required_recording(purpose).video
+        if video is None:
+            raise ScenarioError(f"{purpose} needs a recording with a video (recording.video)")
+        return video
+
+
+def scenario_from_dict(data: dict, source: str = "scenario", **overrides) -> Scenario:
+    """Validate a scenario mapping, with top-level ``overrides`` applied on top.
+
+    Raises :class:`ScenarioError` with one line naming the source, the field and the value.
+    """
+    if not isinstance(data, dict):
+        raise ScenarioError(f"{source}: expected a mapping of scenario fields (got {type(data).__name__})")
+    merged = dict(data)
+    for key, value in overrides.items():
+        section, _, field = key.partition(".")
+        if field:
+            merged[section] = {**merged.get(section, {}), field: value}
+        else:
+            merged[key] = value
+    try:
+        return Scenario.model_validate(merged)
+    except pydantic.ValidationError as error:
+        raise ScenarioError(_first_error_line(error, source)) from None
+
+
+def _pets_recording() -> dict:
+    """The files of the PETS 2009 S2.L1 recording that ship with the package."""
+    data_dir = resources.files("ptztrack.data") / "pets2009_s2l1"
+    return {
+        "ground_truth": str(data_dir / "gt_mot15.txt"),
+        "calibration": str(data_dir / "pinhole.json"),
+        "video": str(data_dir / "View_001.avi"),
+    }
+
+
+def pets_scenario(detector: str = "ideal", **overrides) -> Scenario:
+    """The built-in PETS 2009 S2.L1 scenario: the paper's realistic experiment (section 5.2), with every
+    parameter fixed a priori (the defaults; :mod:`ptztrack.builders.pets` fits the detector's model on
+    frames a table does not score).
+
+    detector : 'ideal' (annotated boxes) or 'hog' (OpenCV's people detector on the view).
+    """
+    if detector not in ("ideal", "hog"):
+        raise ScenarioError(f"pets: detector {detector!r} is not available; expected ideal or hog")
+    recording = _pets_recording()
+    data = {
+        "frames": 398,
+        "frame_rate_hz": 5.0,
+        "camera": {"image_size_px": (160, 120)},
+        "actions": {
+            "pan_deg": {"start": -14.0, "stop": 14.0, "count": 7},
+            "tilt_deg": {"start": -10.0, "stop": 10.0, "count": 5},
+            "zoom": (1.0, 2.0, 3.0, 4.0),
+        },
+        "detector": {"kind": detector},
+        # A person's box as the policies see it: the Caltech benchmark's standardised pedestrian aspect
+        # ratio, width = 0.41 x height (Dollar et al., "Pedestrian detection: an evaluation of the state
+        # of the art", 2012), at the policies' 1.75 m.
+        "people": {"width_m": 0.41 * 1.75},
+        # People come and go here (section 5.2): the patrolling term looks for them.
+        "control": {"beta": 1.0},
+        "recording": recording,
+    }
+    return scenario_from_dict(data, "pets", **overrides)
+
+
+def pets_follow_scenario(tracker: str = "particle", **overrides) -> Scenario:
+    """The follow camera on PETS 2009 S2.L1: every recorded frame (10 Hz), seen by a 640 x 480 virtual view.
+
+    640 x 480 is the paper's camera (section IV). The camera starts at the view of the whole recorded
+    frame (the action grid's only pose). tracker : 'particle', 'csrt' or 'mil'. The person
+    is ``follow.target_id``; :func:`ptztrack.builders.follow.target_scenario` narrows the steps to
+    their annotated frames. The virtual camera interpolates its sampling map over 8 px, which keeps a
+    view's rendering at a few milliseconds (see ``recording.map_grid_px``).
+    """
+    data = {
+        "frames": 795,
+        "frame_rate_hz": 10.0,
+        "camera": {"image_size_px": (640, 480)},
+        # One action: the view of the whole recorded frame, where the camera starts; the policy
+        # commands every other pose itself.
+        "actions": {
+            "pan_deg": {"start": 0.0, "stop": 0.0, "count": 1},
+            "tilt_deg": {"start": 0.0, "stop": 0.0, "count": 1},
+            "zoom": (1.0,),
+        },
+        # The annotations lie about 2 px from the calibrated feet in the 768 px frame (0.5 px at 160 px).
+        "detector": {"kind": "ideal", "pixel_noise_px": 0.5},
+        "tracker": {"kind": tracker},
+        "recording": {**_pets_recording(), "frame_step": 1, "map_grid_px": 8},
+    }
+    return scenario_from_dict(data, "pets follow", **overrides)
+
+
+def load_scenario(path: str | Path, **overrides) -> Scenario:
+    """Read and validate a YAML scenario file (see the README for the format)."""
+    path = Path(path)
+    data = read_yaml(path, "scenario", ScenarioError)
+    if data is None:
+        data = {}
+    if not isinstance(data, dict):
+        raise ScenarioError(f"{path}: expected a mapping of scenario fields (got {type(data).__name__})")
+    recording = data.get("recording")
+    if isinstance(recording, dict):
+        data = {**data, "recording": {**recording, **_resolved_paths(recording, path.parent)}}
+    return scenario_from_dict(data, str(path), **overrides)
+
+
+def _resolved_paths(recording: dict, base: Path) -> dict:
+    return {
+        key: str(base / value)
+        for key, value in recording.items()
+        if key in ("ground_truth", "calibration", "video") and isinstance(value, str)
+    }
