@@ -1,4 +1,4 @@
-"""A real (or virtual) ONVIF PTZ camera's calibration file (README, "Real cameras"): its model, read and
+"""A real (or virtual) ONVIF PTZ camera's calibration file (docs: real cameras): its model, read and
 written."""
 
 from pathlib import Path

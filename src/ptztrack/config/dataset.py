@@ -47,12 +47,12 @@ _GroundDistance = Annotated[PositiveFloat, at_most(1000, "metres")]
 _LOCUS_MEMORY = "memory: the locus tables hold every block's points for every height"
 MAX_PERSON_HEIGHTS = 100
 MAX_GROUND_CELLS = 10_000_000
-MAX_DATASET_FRAMES = _MAX_FRAMES
 """Cells of an occupancy map: 80 MB a map in float64, several kept per frame."""
+MAX_DATASET_FRAMES = _MAX_FRAMES
 
 
 class Occupancy(_Strict):
-    """The occupancy-map detector, its baseline and where their parameters come from (README).
+    """The occupancy-map detector, its baseline and where their parameters come from (docs: the occupancy map).
 
     Person model (equation 4, Algorithm 1): heights from min_height_m up to max_height_m in steps of
     height_step_m (at the steps' midpoints), width_m, samples_per_height tangent points per height.
@@ -99,13 +99,13 @@ class Occupancy(_Strict):
 class OccupancyTracker(Tracker):
     """The ground tracker fed by the occupancy map: the scenario's tracker section, but a track is
     reported from its second detection on (the map's one-off ghosts, loci of two views crossing by
-    chance, rarely repeat at the same place, as HOG's false positives: ``PETS_HOG_TRACKER``)."""
+    chance, rarely repeat at the same place)."""
 
     confirmation_hits: int = Field(2, ge=1)
 
 
 class MultiViewDataset(_Strict):
-    """A calibrated multi-view recording (README, "The occupancy-map detector"). Relative paths in a
+    """A calibrated multi-view recording (docs: multi-view dataset files). Relative paths in a
     dataset file are relative to it.
 
     area_m : [[x0, y0], [x1, y1]] the ground the map covers, metres (people outside it are not scored);

@@ -18,11 +18,11 @@ Patch = tuple[
 
 
 class Follow(_Strict):
-    """The follow camera (the robot-cameraman paper, seed 003): one person kept at an image point and size.
+    """The follow camera (the robot-cameraman paper, Nair et al. 2008): one person kept at an image point and size.
 
     The ``tracker.kind`` 'particle' (the paper's particle filter), 'csrt' or 'mil' (OpenCV's) follows
-    the person and the policy 'follow' moves the camera. Each default's source is in the README
-    ("Follow camera: parameters"); none was tuned on PETS.
+    the person and the policy 'follow' moves the camera. Each default's source is in the docs
+    (the follow camera's parameters); none was tuned on PETS.
 
     target_id : the annotated person followed; the tracker starts from their first annotated box.
     target_point_px : (x*, y*) where the middle of the person should be; null: the image centre.
@@ -43,7 +43,7 @@ class Follow(_Strict):
     exp(-20 D^2) on the patches' mean).
     lambda_loss : the colour likelihood's lambda in the loss test, exp(-sum_p B_p^2 / lambda_loss): the
     weights stay sharp (``lambda_colour``) while the loss test tolerates the appearance changes of a
-    walking person (K / 3: 1.0 chosen for three patches on the even-numbered PETS people; see the README).
+    walking person (K / 3: 1.0 for three patches, chosen on the even-numbered PETS people).
     walk_heights_per_s : random-walk spread of the box position, box heights per second;
     scale_change_per_s : relative random-walk spread of its height per second.
     prediction : 'particle_velocity' (every particle carries its own image velocity, changed each step

@@ -133,10 +133,9 @@ class Tracker(_Strict):
     lambda (1 - P_D P_G) / P_D, lambda the density of false detections
     per px^2, P_D the recall, P_G the gate probability. The default 0 is
     that value for the simulated detectors, which report no false positives
-    (a positive C there only discounts true detections of uncertain tracks:
-    1e-6 costs `intg` and `smpl` 2 MOTA points on the synthetic realistic
-    table, 2e-5 costs 9); the PETS scenario with HOG sets it (see
-    ``PETS_HOG_TRACKER``). The Hungarian association ignores it.
+    (a positive C there only discounts true detections of uncertain tracks);
+    a detector model learned online replaces it by its own estimate every step.
+    The Hungarian association ignores it.
     measurement_source : 'detector' (every step) or 'spatiogram' (the scale-invariant paper's
     section 5: the detector runs every ``detector_every_steps`` steps, to start tracks and retake
     each detected track's colour spatiogram; in between, each track is measured by searching for
@@ -359,7 +358,7 @@ def pets_follow_scenario(tracker: str = "particle", **overrides) -> Scenario:
 
 
 def load_scenario(path: str | Path, **overrides) -> Scenario:
-    """Read and validate a YAML scenario file (see the README for the format)."""
+    """Read and validate a YAML scenario file (docs: scenario files, for the format)."""
     path = Path(path)
     data = read_yaml(path, "scenario", ScenarioError)
     if data is None:
