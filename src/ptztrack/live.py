@@ -40,7 +40,7 @@ import numpy as np
 
 from ptztrack.camera.pose_timeline import PoseTimeline
 from ptztrack.camera.stream import LatestFrame
-from ptztrack.loop import StepObserver, World, command, episode_seeds
+from ptztrack.loop import StepObserver, World, decide, episode_seeds, track
 from ptztrack.roles import Policy, Tracker
 from ptztrack.types import DecisionContext, Detections, PeopleInView
 
@@ -206,8 +206,7 @@ def run_live(
             last_time_s = frame.time_s
             tracker.predict(dt_s)
             view = _CapturedView(frame.image)
-            update = tracker.update(detections, at.pose, partial(view.image, len(rows), at.pose), at.sd)
-            measured = update.measurements if update.measurements is not None else detections
+            update, measured = track(tracker, detections, at.pose, partial(view.image, len(rows), at.pose), at.sd)
             row = {
                 "capture_time_s": frame.time_s,
                 "picked_s": picked_s,
@@ -236,10 +235,7 @@ def run_live(
                 since_s = None if last_decided_s is None else (decided_s - last_decided_s) * time_scale
                 last_decided_s = decided_s
                 context = DecisionContext(len(rows), nearest, reachable, update.tracks, policy_rng, here, since_s)
-                deciding = time.perf_counter()
-                choice = policy.choose(context)
-                row["decision_s"] = time.perf_counter() - deciding
-                action, commanded = command(grid, choice)
+                action, commanded, row["decision_s"] = decide(policy, context, grid)
                 row["sent"] = camera.send(commanded)
                 row["decided_s"] = time.time()
             row["commanded"] = commanded

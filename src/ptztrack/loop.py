@@ -22,8 +22,8 @@ from ptztrack.camera.actions import ActionGrid
 from ptztrack.camera.pose_feedback import LandingError, landed_pose
 from ptztrack.detect.detector_model import OnlineDetectorModel
 from ptztrack.geometry.ptz import PTZCamera
-from ptztrack.roles import CameraBackend, Detector, Policy, PoseSource, Tracker
-from ptztrack.types import DecisionContext, Detections, GroundTruth, Tracks
+from ptztrack.roles import CameraBackend, Detector, ImageSource, Policy, PoseSource, Tracker
+from ptztrack.types import DecisionContext, Detections, GroundTruth, Tracks, TrackUpdate
 
 
 @dataclass(frozen=True)
@@ -105,6 +105,28 @@ def command(grid: ActionGrid, choice: int | np.ndarray) -> tuple[int, np.ndarray
     return -1, pose
 
 
+def decide(policy: Policy, context: DecisionContext, grid: ActionGrid) -> tuple[int, np.ndarray, float]:
+    """The policy's decision in ``context``: (flat action index or -1, the (3,) commanded pose, the wall
+    seconds the policy took). The step both loops share after their tracker's update or prediction."""
+    started = time.perf_counter()
+    choice = policy.choose(context)
+    decision_s = time.perf_counter() - started
+    return (*command(grid, choice), decision_s)
+
+
+def track(
+    tracker: Tracker, detections: Detections | None, pose, image: ImageSource, pose_sd=None
+) -> tuple[TrackUpdate, Detections | None]:
+    """Update ``tracker`` with a picture's ``detections`` at ``pose`` (3,) (``pose_sd`` (3,) its
+    uncertainty, None where exact); returns the update and the measurements it used (the detections,
+    unless the tracker measured on its own, as templates do). The step both loops share after the
+    detector."""
+    # Only a live camera's poses are uncertain: a tracker written for simulated runs need not take pose_sd.
+    uncertain = {} if pose_sd is None else {"pose_sd": pose_sd}
+    update = tracker.update(detections, pose, image, **uncertain)
+    return update, update.measurements if update.measurements is not None else detections
+
+
 def episode_seeds(seed: int) -> list[np.random.SeedSequence]:
     """The independent streams of an episode: scene, detector, policy, the camera's landing errors, tracker,
     and the detector model's draws.
@@ -135,10 +157,8 @@ def run_loop(
     for step in range(steps):
         predicted = tracker.predict()
         context = DecisionContext(step, nearest, grid.reachable(nearest), predicted, policy_rng, commanded)
-        previous, started = commanded, time.perf_counter()
-        choice = policy.choose(context)
-        decision_s = time.perf_counter() - started
-        action, commanded = command(grid, choice)
+        previous = commanded
+        action, commanded, decision_s = decide(policy, context, grid)
         nearest = action if action >= 0 else grid.nearest(commanded)
         if step == 0 or not np.array_equal(commanded, previous):
             pose = landed_pose(commanded, world.landing_error, landing_rng)
@@ -149,8 +169,7 @@ def run_loop(
             detections = world.detector.detect(
                 world.backend, step, pose, np.random.default_rng(frame_seeds[step]), believed_pose=tracker_pose
             )
-        update = tracker.update(detections, tracker_pose, partial(world.backend.image, step, pose))
-        measured = update.measurements if update.measurements is not None else detections
+        _, measured = track(tracker, detections, tracker_pose, partial(world.backend.image, step, pose))
         record = {
             "actions": action,
             "commanded": commanded,
