@@ -45,7 +45,7 @@ from ptztrack.builders.live import (
     live_pictures,
     run_live_episode,
     virtual_calibration,
-    virtual_camera,
+    virtual_onvif_camera,
 )
 from ptztrack.builders.occupancy import ROOM_FRAMES, dataset_runs, room_runs
 from ptztrack.builders.pets import PROTOCOLS, protocol_folds
@@ -355,7 +355,7 @@ def serve_camera_command(args: argparse.Namespace) -> int:
             f"serve-camera: give a user and a password (--user with --credentials or ${PASSWORD_VARIABLE}), "
             "or neither for a camera without authentication"
         )
-    camera, feed = virtual_camera(scenario, args.time_scale, args.port, username, password)
+    camera, feed = virtual_onvif_camera(scenario, args.time_scale, args.port, username, password)
     log_file = None if args.truth_log is None else open(args.truth_log, "w", encoding="utf-8")  # noqa: SIM115
     written = 0
     camera.start()
