@@ -15,7 +15,7 @@ from ptztrack.builders.follow_experiment import (
 )
 from ptztrack.cli.arguments import RUN_FOLDER_FILES
 from ptztrack.cli.experiment import run_experiment_cells
-from ptztrack.cli.scenario import recording_paths
+from ptztrack.cli.scenario import recording_overrides, recording_paths
 from ptztrack.cli.watch import Watch
 from ptztrack.config import Scenario, load_scenario, pets_follow_scenario
 from ptztrack.evaluate.executors import Progress
@@ -34,9 +34,7 @@ from ptztrack.files import check_output_folder, run_folder, write_json
 
 def _follow_scenario(args: argparse.Namespace, tracker: str = "particle") -> Scenario:
     """The follow camera's scenario: the built-in PETS one or a YAML file, with the command line's changes."""
-    overrides: dict[str, object] = {
-        f"recording.{key}": str(path) for key, path in recording_paths(args).items() if path is not None
-    }
+    overrides = recording_overrides(recording_paths(args))
     if args.achromatic_bins:
         overrides["follow.achromatic_bins"] = True
     if getattr(args, "target_point_px", None) is not None:

@@ -22,9 +22,7 @@ def build_scenario(
     measurement_source : 'detector' or 'spatiogram', replacing ``tracker.measurement_source``.
     detector_model, prior_shift_px : replacing ``detector.model`` and ``detector.prior_shift_px``.
     """
-    overrides: dict[str, object] = {
-        f"recording.{key}": str(path) for key, path in (recording_paths or {}).items() if path is not None
-    }
+    overrides = recording_overrides(recording_paths or {})
     if detector_model is not None:
         overrides["detector.model"] = detector_model
     if prior_shift_px is not None:
@@ -47,3 +45,8 @@ def build_scenario(
 def recording_paths(args: argparse.Namespace) -> dict:
     """The recording files of ``--video``, ``--calibration`` and ``--gt`` (None: the scenario's own)."""
     return {"video": args.video, "calibration": args.calibration, "ground_truth": args.gt}
+
+
+def recording_overrides(paths: dict) -> dict[str, object]:
+    """The scenario overrides ``recording.<key>`` of ``paths`` ({key: path}; a None path: the scenario's own)."""
+    return {f"recording.{key}": str(path) for key, path in paths.items() if path is not None}
