@@ -36,7 +36,7 @@ from ptztrack.builders.live import (
     run_live_episode,
     shown_steps,
     virtual_calibration,
-    virtual_camera,
+    virtual_onvif_camera,
 )
 from ptztrack.camera.move_timing import measure_image_delay
 from ptztrack.camera.onvif_client import CameraAddress, ONVIFClient
@@ -75,7 +75,7 @@ def serve(time_scale: float, ready, stop, results) -> None:
     into ``ready``, then, once ``stop`` is set, its truth log and thumbnails into ``results``."""
     scenario = pets_scenario("hog")
     feed = RecordingFeed(episode_world(scenario, 0), 1.0 / scenario.frame_rate_hz, time_scale, thumbnails=[])
-    camera, _ = virtual_camera(scenario, time_scale, 0, "bench", "bench-pass", feed=feed)
+    camera, _ = virtual_onvif_camera(scenario, time_scale, 0, "bench", "bench-pass", feed=feed)
     with camera:
         ready.put(camera.onvif_port)
         stop.wait()

@@ -23,7 +23,7 @@ from ptztrack.builders.live import (
     offline_counterpart,
     run_live_episode,
     virtual_calibration,
-    virtual_camera,
+    virtual_onvif_camera,
 )
 from ptztrack.camera.onvif_client import CameraAddress, CameraError, ONVIFClient
 from ptztrack.camera.stream import open_rtsp
@@ -77,7 +77,7 @@ def test_the_run_goes_on_through_a_camera_that_goes_away_and_comes_back():
     a track that the first pictures after it miss is still within ``max_position_sigma_m``."""
     time_scale = 0.25
     scenario = pets_scenario("hog")
-    camera, feed = virtual_camera(scenario, time_scale, 0, USER, PASSWORD)
+    camera, feed = virtual_onvif_camera(scenario, time_scale, 0, USER, PASSWORD)
     camera.start()
     address = _address(camera)
     result = {}
@@ -97,7 +97,7 @@ def test_the_run_goes_on_through_a_camera_that_goes_away_and_comes_back():
     time.sleep(1.0)
     camera.stop()
     time.sleep(2.0)
-    restarted, _ = virtual_camera(scenario, time_scale, address.port, USER, PASSWORD, feed)
+    restarted, _ = virtual_onvif_camera(scenario, time_scale, address.port, USER, PASSWORD, feed)
     with restarted:
         runner.join(timeout=120)
     assert not runner.is_alive()
@@ -140,7 +140,7 @@ def test_a_web_server_that_is_not_a_camera_exits_2_with_one_line_saying_so(capsy
 
 
 def test_a_wrong_password_exits_2_with_one_line_that_does_not_show_it(capsys):
-    camera, _ = virtual_camera(pets_scenario("hog"), 1.0, 0, USER, PASSWORD)
+    camera, _ = virtual_onvif_camera(pets_scenario("hog"), 1.0, 0, USER, PASSWORD)
     with camera:
         url = f"onvif://{USER}:not-the-password@127.0.0.1:{camera.onvif_port}"
         status = main(["live", "--camera", url, "--calibration", "virtual", "--steps", "3"])
@@ -169,7 +169,7 @@ def test_calibrate_times_the_moves_and_the_streams_delay_and_writes_them_into_th
     decoder) shows a pan within a few frames of the head's turning."""
     path = tmp_path / "camera.yaml"
     write_camera_calibration(path, virtual_calibration())
-    camera, _ = virtual_camera(pets_scenario("hog"), 1.0, 0, USER, PASSWORD)
+    camera, _ = virtual_onvif_camera(pets_scenario("hog"), 1.0, 0, USER, PASSWORD)
     with camera:
         url = f"onvif://{USER}:{PASSWORD}@127.0.0.1:{camera.onvif_port}"
         assert main(["camera", "calibrate", "--camera", url, "--calibration", str(path)]) == 0
@@ -221,7 +221,7 @@ def test_serve_camera_serves_pets_on_127_0_0_1_until_stopped_and_logs_its_truth(
 
 def test_the_client_moves_reads_limits_keeps_presets_and_reads_the_rtsp_stream():
     """Every ONVIF call of the client against the virtual camera, each checked by the pose it leads to."""
-    camera, _ = virtual_camera(pets_scenario("hog"), 1.0, 0, USER, PASSWORD)
+    camera, _ = virtual_onvif_camera(pets_scenario("hog"), 1.0, 0, USER, PASSWORD)
     spaces = camera_spaces(virtual_calibration())
     with camera:
         client = ONVIFClient(_address(camera), timeout_s=5.0)

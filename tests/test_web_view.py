@@ -101,10 +101,10 @@ def test_run_with_view_prints_the_address_starts_when_a_page_connects_and_sends_
 @pytest.mark.onvif
 def test_live_with_view_sends_the_cameras_frames(tmp_path):
     pytest.importorskip("ipycam", reason="the virtual ONVIF camera needs ipycam (pip install --no-deps ipycam==1.3.0)")
-    from ptztrack.builders.live import virtual_camera
+    from ptztrack.builders.live import virtual_onvif_camera
     from ptztrack.config import pets_scenario
 
-    camera, _ = virtual_camera(pets_scenario("hog"), 0.5, 0)
+    camera, _ = virtual_onvif_camera(pets_scenario("hog"), 0.5, 0)
     with camera:
         command = [sys.executable, "-m", "ptztrack.cli", "live", "--camera", f"onvif://127.0.0.1:{camera.onvif_port}"]
         command += ["--calibration", "virtual", "--steps", "4", "--time-scale", "0.5", "--view"]

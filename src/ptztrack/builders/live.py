@@ -171,7 +171,7 @@ def pose_timeline(calibration: CameraCalibrationFile) -> PoseTimeline:
     return PoseTimeline(1.0 / slopes if np.all(slopes > 0) else None)
 
 
-def virtual_camera(
+def virtual_onvif_camera(
     scenario: Scenario,
     time_scale: float,
     port: int,

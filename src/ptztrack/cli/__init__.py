@@ -1,0 +1,71 @@
+"""The ``ptztrack`` command: a thin layer over the Python API.
+
+:func:`main` parses the command line (:mod:`ptztrack.cli.arguments`, which imports no subsystem),
+then imports the body of the command given from the module of its subject: ``run`` and ``view``
+(:mod:`.run`), the PTZ paper's experiments (:mod:`.ptz_paper`), ``msg`` (:mod:`.msg`),
+``registration`` (:mod:`.registration`), ``follow`` (:mod:`.follow`), ``occupancy``
+(:mod:`.occupancy`), and the real and virtual cameras (:mod:`.camera`).
+"""
+
+import argparse
+import importlib
+import logging
+import os
+import sys
+from typing import Any
+
+from ptztrack.cli.arguments import parser
+from ptztrack.files import InputError, check_output_file, check_output_folder
+
+# Names of the command modules that other code uses, imported on first use.
+_HOME = {
+    "build_scenario": "ptztrack.cli.scenario",
+    "DETECTOR_MODEL_FILE": "ptztrack.cli.run",
+    "read_truth_log": "ptztrack.cli.camera",
+}
+
+__all__ = ["main", "parser", "check_outputs", *_HOME]
+
+
+def __getattr__(name: str) -> Any:
+    if name not in _HOME:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    return getattr(importlib.import_module(_HOME[name]), name)
+
+
+def check_outputs(args: argparse.Namespace) -> None:
+    """Refuse, before any work, output paths that could not be written."""
+    for option in ("json", "plot", "trails", "truth_log"):
+        if getattr(args, option, None) is not None:
+            check_output_file(getattr(args, option), f"--{option}")
+    if getattr(args, "index", None) is not None and not args.index.exists():
+        check_output_file(args.index, "--index")
+    if getattr(args, "out", None) is not None:
+        check_output_folder(args.out, "--out", args.overwrite)
+
+
+def main(argv: list[str] | None = None) -> int:
+    """The command line: 0 when done, 2 with one line on stderr for any bad input, 130 on Ctrl-C."""
+    # Before any library configures the root logger (onvif-zeep-async does at import): warnings only,
+    # one line each (a camera lost, back, still unreachable).
+    logging.basicConfig(level=logging.WARNING, format="ptztrack: %(message)s")
+    try:
+        args = parser().parse_args(argv)
+        check_outputs(args)
+        module, _, function = args.handler.partition(":")
+        return getattr(importlib.import_module(module), function)(args)
+    except (InputError, RuntimeError) as error:
+        print(f"ptztrack: error: {error}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("ptztrack: interrupted; nothing was left half-written", file=sys.stderr)
+        return 130
+    except BrokenPipeError:
+        # The reader (say, `head`) has gone: stop quietly, and keep Python from
+        # complaining again when it flushes stdout at exit.
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 1
+    except OSError as error:
+        where = f"{error.filename}: " if error.filename else ""
+        print(f"ptztrack: error: {where}{error.strerror or error}", file=sys.stderr)
+        return 2

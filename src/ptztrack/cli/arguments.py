@@ -1,0 +1,392 @@
+"""The ``ptztrack`` command line's parser: every command, its arguments and their checks.
+
+It imports argparse and the registry's names only, so that ``ptztrack --help`` stays quick; each
+command names its body as ``"module:function"``, which :func:`ptztrack.cli.main` imports when the
+command runs. The choices and defaults below are the command line's copies of the subsystems'
+(their homes are named; tests/test_cli_arguments.py checks that they agree).
+"""
+
+import argparse
+import math
+from pathlib import Path
+
+from ptztrack import registry
+
+# ptztrack.evaluate.report.RUN_FILES and ptztrack.evaluate.view_state.VIEW_STATES_FILE: what run,
+# follow and live write into --out.
+RUN_FOLDER_FILES = (
+    "metrics.json",
+    "steps.csv",
+    "detections.csv",
+    "tracks.csv",
+    "tracks_mot.txt",
+    "truth_mot.txt",
+    "episode.png",
+    "episode.mp4",
+    "view_states.jsonl",
+)
+STRATEGIES = ("fix", "patrol", "rnd", "intg", "smpl")  # ptztrack.builders.experiments
+POSE_SOURCES = ("oracle", "commanded", "registered")  # ptztrack.builders.experiments
+PROTOCOLS = ("a-priori", "two-fold")  # ptztrack.builders.pets
+FOLLOW_TRACKERS = ("particle", "csrt", "mil")  # ptztrack.builders.follow
+OTB_TRACKS = 5  # ptztrack.builders.follow_experiment
+ROOM_FRAMES = 300  # ptztrack.builders.occupancy
+EXECUTORS = ("local", "ray", "serial")  # ptztrack.evaluate.executors
+PASSWORD_VARIABLE = "PTZTRACK_CAMERA_PASSWORD"  # ptztrack.camera.onvif_client
+
+
+class OneLineParser(argparse.ArgumentParser):
+    """Command-line mistakes end in one line on stderr and exit status 2, like every other bad input."""
+
+    def error(self, message: str):
+        self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+
+def parser() -> argparse.ArgumentParser:
+    root = OneLineParser(prog="ptztrack", description="Multi-person tracking with a PTZ camera.")
+    commands = root.add_subparsers(dest="command", required=True)
+    policies, detectors = registry.names("policies"), registry.names("detectors")
+    run = commands.add_parser("run", help="run one closed-loop episode and print its metrics")
+    run.add_argument(
+        "--scenario", default="synthetic", help="'synthetic' or 'pets' (built in), or a scenario YAML file"
+    )
+    run.add_argument("--policy", choices=policies, default="smpl")
+    run.add_argument("--detector", choices=detectors, help="overrides the scenario's detector")
+    _add_detector_model_arguments(run, prior_shift=True)
+    run.add_argument("--seed", type=_non_negative_int, default=0)
+    run.add_argument("--frames", type=_positive_int, help="overrides the scenario's number of frames")
+    _add_tracker_arguments(run)
+    run.add_argument(
+        "--out", type=Path, help=f"directory for {', '.join(RUN_FOLDER_FILES)}; written whole or not at all"
+    )
+    run.add_argument("--overwrite", action="store_true", help="replace a non-empty --out folder")
+    _add_view_argument(run)
+    _add_quiet_argument(run)
+    _add_recording_arguments(run)
+    run.set_defaults(handler="ptztrack.cli.run:run_command")
+
+    view = commands.add_parser("view", help="replay a finished run's --out folder in the web view")
+    view.add_argument("folder", type=Path, help="a folder written by ptztrack run, follow or live with --out")
+    view.add_argument("--port", type=_port, default=0, help="serve on http://127.0.0.1:PORT/ (default: any free one)")
+    view.add_argument("--steps-per-s", type=_positive_float, default=10.0, help="the replay's pace")
+    view.set_defaults(handler="ptztrack.cli.run:view_command")
+
+    experiment = commands.add_parser("experiment", help="run one of the papers' experiments and print its table")
+    experiments = experiment.add_subparsers(
+        dest="name", required=True, metavar="{synthetic,pets,msg,registration,follow,occupancy}"
+    )
+
+    synthetic = experiments.add_parser("synthetic", help="the PTZ paper's Tables 1-2 on the synthetic scene")
+    synthetic.add_argument("--scenario", default="synthetic", help="'synthetic' (built in) or a scenario YAML file")
+    synthetic.add_argument("--detector", choices=detectors, default="realistic")
+    _add_detector_model_arguments(synthetic, prior_shift=True)
+    synthetic.add_argument("--sequences", type=_positive_int, default=12)
+    synthetic.add_argument("--frames", type=_positive_int, help="overrides the scenario's number of frames")
+    synthetic.add_argument("--strategies", nargs="+", choices=_strategies(policies), default=list(STRATEGIES))
+    _add_association_argument(synthetic)
+    _add_executor_arguments(synthetic, "one row per strategy")
+    synthetic.set_defaults(handler="ptztrack.cli.ptz_paper:synthetic_experiment_command")
+
+    pets = experiments.add_parser("pets", help="the PTZ paper's Tables 3-4 on PETS 2009 S2.L1")
+    pets.add_argument("--detector", default="ideal", help="ideal (the annotations) or hog")
+    _add_detector_model_arguments(pets)
+    pets.add_argument(
+        "--beta",
+        type=_non_negative_float,
+        action="append",
+        help="a weight of the patrolling term (repeatable; default 9 and 1)",
+    )
+    pets.add_argument("--strategies", nargs="+", choices=_strategies(policies), default=list(STRATEGIES))
+    pets.add_argument("--frames", type=_positive_int, help="overrides the scenario's number of steps")
+    pets.add_argument(
+        "--protocol",
+        choices=PROTOCOLS,
+        default="a-priori",
+        help="a-priori: every parameter fixed before looking at S2.L1; two-fold: the detector's model fitted on "
+        "one half of the frames, the table scored on the other, both ways",
+    )
+    pets.add_argument("--seeds", type=_positive_int, default=5, help="runs of a strategy whose run depends on its seed")
+    _add_tracker_arguments(pets)
+    _add_executor_arguments(pets, "one row per strategy and beta")
+    _add_recording_arguments(pets)
+    pets.set_defaults(handler="ptztrack.cli.ptz_paper:pets_experiment_command")
+
+    msg = experiments.add_parser("msg", help="the face-capture paper's Figure 7")
+    msg.add_argument("--runs", type=_positive_int, default=414, help="simulations")
+    msg.add_argument("--plot", type=Path, help="M against N_j/s per scheduler (PNG)")
+    msg.add_argument("--trails", type=Path, help="one simulation's trails in (x, y, t) (PNG)")
+    _add_executor_arguments(msg, "one row per run and scheduler")
+    msg.set_defaults(handler="ptztrack.cli.msg:msg_experiment_command")
+
+    registration = experiments.add_parser(
+        "registration", help="the scale-invariant paper: registered PTZ views, and the closed loop on their poses"
+    )
+    registration.add_argument("--scenario", default="pets", help="'pets' (built in) or a recording scenario YAML file")
+    registration.add_argument("--views", type=_positive_int, default=100, help="random live views to register")
+    registration.add_argument(
+        "--seed", type=_non_negative_int, default=0, help="draws the live views' poses and frames"
+    )
+    registration.add_argument(
+        "--index", type=Path, help="reference index file: read if it exists, else built and written (default: built)"
+    )
+    registration.add_argument(
+        "--exact-views",
+        action="store_true",
+        help="exact pinhole views instead of the scenario's camera.live_view (default: the realistic model)",
+    )
+    registration.add_argument("--detector", choices=detectors, default="hog", help="closed-loop detector")
+    _add_detector_model_arguments(registration)
+    registration.add_argument("--policy", choices=policies, default="smpl", help="closed-loop policy")
+    registration.add_argument(
+        "--pose-sources", nargs="+", choices=POSE_SOURCES, default=list(POSE_SOURCES), help="closed-loop pose sources"
+    )
+    registration.add_argument(
+        "--pose-noise-deg",
+        type=_non_negative_float,
+        default=2.0,
+        help="closed loop: pan and tilt landing error, 1 sigma",
+    )
+    registration.add_argument(
+        "--zoom-noise", type=_non_negative_float, default=0.02, help="closed loop: relative zoom landing error, 1 sigma"
+    )
+    registration.add_argument(
+        "--frames", type=_positive_int, help="closed loop: overrides the scenario's number of steps"
+    )
+    _add_tracker_arguments(registration)
+    _add_executor_arguments(registration, "the registration errors and the closed-loop rows")
+    _add_recording_arguments(registration)
+    registration.set_defaults(handler="ptztrack.cli.registration:registration_experiment_command")
+    _add_follow_commands(commands, experiments)
+    _add_occupancy_parser(experiments)
+    _add_camera_commands(commands, policies)
+    return root
+
+
+def _add_camera_commands(commands, policies: list[str]) -> None:
+    """``ptztrack live`` and ``ptztrack serve-camera``: real ONVIF cameras, and a virtual one to test with."""
+    live = commands.add_parser("live", help="drive an ONVIF PTZ camera in real time: capture, detect, track, decide")
+    live.add_argument("--camera", required=True, help="onvif://[user[:password]@]host[:port]")
+    live.add_argument("--credentials", type=Path, help="a YAML file with username and password")
+    live.add_argument(
+        "--calibration", required=True, help="the camera's calibration YAML, or 'virtual' for ptztrack serve-camera"
+    )
+    live.add_argument("--policy", choices=policies, default="smpl")
+    live.add_argument("--scenario", default="pets", help="'pets' (built in) or a scenario YAML file")
+    live.add_argument("--detector", default="hog", help="the scenario's detector (default hog)")
+    _add_detector_model_arguments(live)
+    live.add_argument(
+        "--steps", type=_positive_int, help="use at most this many pictures (default: the scenario's frames)"
+    )
+    live.add_argument(
+        "--time-scale", type=_positive_float, default=1.0, help="the scenario's seconds per second (serve-camera's)"
+    )
+    live.add_argument("--transport", choices=("tcp", "udp"), default="tcp", help="RTSP's transport (default tcp)")
+    live.add_argument("--timeout-s", type=_positive_float, default=5.0, help="the longest wait for any camera call")
+    live.add_argument(
+        "--truth", type=Path, help="score against a virtual camera's truth log (serve-camera --truth-log)"
+    )
+    live.add_argument("--seed", type=_non_negative_int, default=0)
+    live.add_argument(
+        "--out", type=Path, help=f"directory for {', '.join(RUN_FOLDER_FILES)}; written whole, Ctrl-C too"
+    )
+    live.add_argument("--overwrite", action="store_true", help="replace a non-empty --out folder")
+    _add_view_argument(live)
+    live.set_defaults(handler="ptztrack.cli.camera:live_command")
+
+    camera = commands.add_parser("camera", help="tools for a real camera").add_subparsers(dest="tool", required=True)
+    calibrate = camera.add_parser("calibrate", help="time the camera's moves and write them into its calibration")
+    calibrate.add_argument("--camera", required=True, help="onvif://[user[:password]@]host[:port]")
+    calibrate.add_argument("--credentials", type=Path, help="a YAML file with username and password")
+    calibrate.add_argument("--calibration", type=Path, required=True, help="the camera's calibration YAML (updated)")
+    calibrate.add_argument(
+        "--timeout-s", type=_positive_float, default=5.0, help="the longest wait for any camera call"
+    )
+    calibrate.set_defaults(handler="ptztrack.cli.camera:calibrate_camera_command")
+
+    serve = commands.add_parser("serve-camera", help="serve the PETS virtual PTZ camera over ONVIF on 127.0.0.1")
+    serve.add_argument("--port", type=_port, default=8080)
+    serve.add_argument("--scenario", default="pets", help="'pets' (built in) or a recording scenario YAML file")
+    serve.add_argument("--time-scale", type=_positive_float, default=1.0, help="the recording's speed")
+    serve.add_argument("--user", help=f"require this user (password: --credentials or ${PASSWORD_VARIABLE})")
+    serve.add_argument("--credentials", type=Path, help="a YAML file with username and password to require")
+    serve.add_argument("--truth-log", type=Path, help="append every picture's time, step and pose here (CSV)")
+    serve.set_defaults(handler="ptztrack.cli.camera:serve_camera_command")
+
+
+def _add_follow_commands(commands, experiments) -> None:
+    """``ptztrack follow`` and ``ptztrack experiment follow``: the robot-cameraman paper's follow camera."""
+    follow = commands.add_parser("follow", help="follow one annotated PETS person with the virtual PTZ camera")
+    follow.add_argument("--target", type=_non_negative_int, required=True, help="the annotated person's id")
+    follow.add_argument("--tracker", choices=FOLLOW_TRACKERS, default="particle")
+    follow.add_argument("--seed", type=_non_negative_int, default=0)
+    follow.add_argument("--frames", type=_positive_int, help="at most this many steps")
+    follow.add_argument(
+        "--target-point-px",
+        type=_non_negative_float,
+        nargs=2,
+        metavar=("X", "Y"),
+        help="(x*, y*); default: the image centre",
+    )
+    follow.add_argument(
+        "--out",
+        type=Path,
+        help=f"directory for {', '.join(RUN_FOLDER_FILES)} (default follow-TARGET); written whole or not at all",
+    )
+    follow.add_argument("--overwrite", action="store_true", help="replace a non-empty --out folder")
+    _add_view_argument(follow)
+    _add_quiet_argument(follow)
+    _add_follow_scenario_arguments(follow)
+    follow.set_defaults(handler="ptztrack.cli.follow:follow_command")
+
+    experiment = experiments.add_parser(
+        "follow", help="the robot-cameraman paper: every PETS person followed, and the one-pass benchmark"
+    )
+    experiment.add_argument("--trackers", nargs="+", choices=FOLLOW_TRACKERS, default=list(FOLLOW_TRACKERS))
+    experiment.add_argument("--targets", type=_non_negative_int, nargs="+", help="people to follow (default: all)")
+    experiment.add_argument(
+        "--otb-tracks", type=_non_negative_int, default=OTB_TRACKS, help="longest tracks of the one-pass benchmark"
+    )
+    experiment.add_argument("--seed", type=_non_negative_int, default=0)
+    _add_follow_scenario_arguments(experiment)
+    _add_executor_arguments(experiment, '{"closed_loop": [...], "otb": [...]} and the rows per person')
+    experiment.set_defaults(handler="ptztrack.cli.follow:follow_experiment_command")
+
+
+def _add_follow_scenario_arguments(command: argparse.ArgumentParser) -> None:
+    command.add_argument(
+        "--scenario", default="pets", help="'pets' (built in) or a recording scenario YAML file with a follow section"
+    )
+    command.add_argument(
+        "--achromatic-bins",
+        action="store_true",
+        help="the particle filter bins greys by value (Perez et al.) besides the paper's hue-saturation bins",
+    )
+    _add_recording_arguments(command)
+
+
+def _add_occupancy_parser(experiments) -> None:
+    occupancy = experiments.add_parser(
+        "occupancy", help="the LPOM paper: people on the ground from several calibrated views, against clustering"
+    )
+    occupancy.add_argument("dataset", help="'synthetic-room' or 'pets' (built in), or a multi-view dataset YAML file")
+    occupancy.add_argument(
+        "--frames", type=_positive_int, help=f"frames to use (synthetic-room: {ROOM_FRAMES} per sequence; else all)"
+    )
+    occupancy.add_argument(
+        "--seed", type=_non_negative_int, default=0, help="synthetic-room: draws people and textures"
+    )
+    occupancy.add_argument(
+        "--out", type=Path, help="directory for maps, video, detections and tracks per recording; written whole"
+    )
+    occupancy.add_argument("--overwrite", action="store_true", help="replace a non-empty --out folder")
+    occupancy.add_argument("--images-every", type=_positive_int, default=10, help="a map picture every N frames")
+    occupancy.add_argument("--json", type=Path, help="write one row per method (and people count) here")
+    _add_quiet_argument(occupancy)
+    occupancy.set_defaults(handler="ptztrack.cli.occupancy:occupancy_experiment_command")
+
+
+def _strategies(policies: list[str]) -> list[str]:
+    """The tables' strategy names ('rnd' for the 'random' policy) and every other registered policy."""
+    return list(dict.fromkeys([*STRATEGIES, *(name for name in policies if name != "random")]))
+
+
+def _add_executor_arguments(command: argparse.ArgumentParser, rows: str) -> None:
+    command.add_argument("--executor", choices=EXECUTORS, default="local")
+    command.add_argument("--workers", type=_positive_int, help="processes of the local executor (default: all cores)")
+    command.add_argument("--json", type=Path, help=f"write {rows} here")
+    _add_quiet_argument(command)
+
+
+def _add_quiet_argument(command: argparse.ArgumentParser) -> None:
+    command.add_argument(
+        "--quiet", action="store_true", help="no progress bar (there is none either where stderr is not a terminal)"
+    )
+
+
+def _add_view_argument(command: argparse.ArgumentParser) -> None:
+    command.add_argument(
+        "--view",
+        type=_port,
+        nargs="?",
+        const=0,
+        metavar="PORT",
+        help="serve a live view of the run on http://127.0.0.1:PORT/ (no PORT or 0: any free one)",
+    )
+
+
+def _add_detector_model_arguments(command: argparse.ArgumentParser, prior_shift: bool = False) -> None:
+    """``--detector-model``, after ``--prior-shift-px`` with ``prior_shift``."""
+    if prior_shift:
+        command.add_argument(
+            "--prior-shift-px",
+            type=float,
+            help="shifts the prior recall curve's r0 by this many pixels from the detector's own "
+            "(a test of the learning)",
+        )
+    command.add_argument(
+        "--detector-model",
+        help="what the policies and the tracker know of the detector: online (learned as the camera runs; the "
+        "default), a-priori (the prior curve, kept), true (a simulation's own curve) or an earlier run's "
+        "detector_model.json as the prior",
+    )
+
+
+def _add_tracker_arguments(command: argparse.ArgumentParser) -> None:
+    _add_association_argument(command)
+    command.add_argument(
+        "--measurement-source",
+        choices=("detector", "spatiogram"),
+        help="overrides the scenario's tracker.measurement_source (spatiogram: templates between detector steps)",
+    )
+
+
+def _add_association_argument(command: argparse.ArgumentParser) -> None:
+    command.add_argument(
+        "--association", choices=("hungarian", "cjpdaf"), help="overrides the scenario's tracker.association"
+    )
+
+
+def _add_recording_arguments(command: argparse.ArgumentParser) -> None:
+    """Files of a recording that replace the scenario's (the built-in PETS ones with ``pets``)."""
+    recording = command.add_argument_group("recording files (replace the scenario's)")
+    recording.add_argument("--video", type=Path, help="the recorded video")
+    recording.add_argument("--calibration", type=Path, help="pinhole JSON or Tsai XML calibration of the recording")
+    recording.add_argument("--gt", type=Path, help="MOTChallenge ground truth with world positions in metres")
+
+
+def _non_negative_float(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number (got {text!r})") from None
+    if not (math.isfinite(value) and value >= 0):
+        raise argparse.ArgumentTypeError(f"must be a finite number of at least 0 (got {text})")
+    return value
+
+
+def _non_negative_int(text: str) -> int:
+    value = int(text)
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"must be at least 0 (got {value})")
+    return value
+
+
+def _positive_int(text: str) -> int:
+    value = int(text)
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be at least 1 (got {value})")
+    return value
+
+
+def _positive_float(text: str) -> float:
+    value = _non_negative_float(text)
+    if value == 0:
+        raise argparse.ArgumentTypeError(f"must be above 0 (got {text})")
+    return value
+
+
+def _port(text: str) -> int:
+    value = _non_negative_int(text)
+    if value > 65535:
+        raise argparse.ArgumentTypeError(f"must be a port from 0 to 65535 (got {value})")
+    return value

@@ -1,0 +1,167 @@
+"""Real and virtual cameras: ``ptztrack live`` drives an ONVIF PTZ camera, ``ptztrack camera calibrate``
+times one's moves, ``ptztrack serve-camera`` serves the PETS virtual camera over ONVIF."""
+
+import argparse
+import os
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from ptztrack.builders.live import (
+    TRUTH_LOG_HEADER,
+    camera_spaces,
+    live_as_episode,
+    live_pictures,
+    run_live_episode,
+    virtual_calibration,
+    virtual_onvif_camera,
+)
+from ptztrack.camera.move_timing import measure_image_delay, measure_move_times, timed_move
+from ptztrack.camera.onvif_client import PASSWORD_VARIABLE, ONVIFClient, camera_address
+from ptztrack.camera.stream import FrameStream, rtsp_pictures
+from ptztrack.cli.arguments import RUN_FOLDER_FILES
+from ptztrack.cli.run import format_metrics
+from ptztrack.cli.scenario import build_scenario
+from ptztrack.cli.watch import Watch
+from ptztrack.config import (
+    MoveTimesSection,
+    ScenarioError,
+    load_camera_calibration,
+    read_yaml,
+    write_camera_calibration,
+)
+from ptztrack.evaluate.metrics import episode_metrics
+from ptztrack.evaluate.report import write_outputs
+from ptztrack.evaluate.view_state import ViewState
+from ptztrack.files import read_text, run_folder
+
+
+def _credentials(args: argparse.Namespace) -> dict | None:
+    """The ``--credentials`` file's {username, password}, if given (a YAML or JSON mapping)."""
+    if args.credentials is None:
+        return None
+    data = read_yaml(args.credentials, "credentials", ScenarioError)
+    if not isinstance(data, dict) or not set(data) <= {"username", "password"}:
+        raise ScenarioError(f"{args.credentials}: expected a mapping with username and password")
+    return {key: str(value) for key, value in data.items()}
+
+
+def live_command(args: argparse.Namespace) -> int:
+    scenario = build_scenario(args.scenario, args.detector, detector_model=args.detector_model)
+    calibration = virtual_calibration() if args.calibration == "virtual" else load_camera_calibration(args.calibration)
+    address = camera_address(args.camera, _credentials(args))
+    truth_log = None if args.truth is None else read_truth_log(args.truth)
+    steps = args.steps or scenario.frames
+    print(f"live: {args.policy} on {address}, up to {steps} pictures, RTSP over {args.transport}")
+    label = f"live {args.policy}"
+    with Watch(args.view, args.out is not None, lambda w, p: ViewState(w, p, steps, label, truth=False)) as watch:
+        world, live = run_live_episode(
+            scenario, calibration, address, args.policy, steps, args.time_scale, args.seed, args.timeout_s,
+            watch.observe, args.transport, keep_images=args.out is not None,
+        )  # fmt: skip
+    episode = live_as_episode(world, live, truth_log)
+    rates = live.rates()
+    print(
+        f"{len(live.capture_time_s)} pictures used ({rates['frames_used_per_s']:.2f} per second) of "
+        f"{live.frames_received} received, {int(np.isfinite(live.decided_s).sum())} decisions "
+        f"({rates['decisions_per_s']:.2f} per second, median {1e3 * rates['median_decision_s']:.1f} ms, "
+        f"95 % on a picture at most {rates['frame_age_s_p95']:.2f} s old), {int(live.sent.sum())} new targets sent"
+    )
+    metrics = episode_metrics(episode)
+    if truth_log is not None:
+        print(format_metrics(metrics))
+    if args.out is not None:
+        title = f"live {args.policy}, {scenario.detector.kind} detector: {len(live.capture_time_s)} pictures"
+        with run_folder(args.out, args.overwrite) as folder:
+            write_outputs(folder, episode, metrics, title, live_pictures(live))
+            watch.write(folder)
+        print(f"wrote {', '.join(RUN_FOLDER_FILES)} into {args.out}")
+    return 0
+
+
+def read_truth_log(path: Path) -> np.ndarray:
+    """A virtual camera's truth log (``ptztrack serve-camera --truth-log``), (n, 5)."""
+    lines = read_text(path, "truth log", 1_000_000_000, ScenarioError).splitlines()
+    if not lines or lines[0] != TRUTH_LOG_HEADER:
+        raise ScenarioError(f"{path}: expected a truth log starting with the line {TRUTH_LOG_HEADER}")
+    try:
+        rows = np.array([[float(value) for value in line.split(",")] for line in lines[1:] if line], dtype=float)
+    except ValueError:
+        raise ScenarioError(f"{path}: a line of the truth log is not five numbers") from None
+    if rows.ndim != 2 or rows.shape[1:] != (5,) or not np.all(np.isfinite(rows)):
+        raise ScenarioError(f"{path}: expected rows of five finite numbers ({TRUTH_LOG_HEADER})")
+    return rows
+
+
+def calibrate_camera_command(args: argparse.Namespace) -> int:
+    calibration = load_camera_calibration(args.calibration)
+    client = ONVIFClient(camera_address(args.camera, _credentials(args)), args.timeout_s)
+    stream = None
+    try:
+        client.connect()
+        spaces = camera_spaces(calibration)
+        home = client.status().position  # where the camera was put to look: its stream's delay is timed there
+        uri = client.stream_uri()
+        stream = FrameStream(rtsp_pictures(uri), delay_s=0.0)
+        stream.start()  # opening a stream takes seconds: it opens while the moves are timed
+        move_times, samples = measure_move_times(client, spaces)
+        timed_move(client, home)
+        for axis, (distances, seconds) in samples.items():
+            intercept, slope = getattr(move_times, axis)
+            unit = "zoom" if axis == "zoom" else "deg"
+            print(
+                f"{axis}: {intercept:.3f} s + {slope:.4f} s/{unit} "
+                f"({len(seconds)} moves of {distances.max():.3g} {unit} at most)"
+            )
+        image_delay_s, delays = measure_image_delay(client, spaces, move_times, stream.latest)
+        print(f"image delay: {image_delay_s:.3f} s (median of {len(delays)} pans, {np.ptp(delays):.3f} s apart)")
+    finally:
+        if stream is not None:
+            stream.stop()
+        client.close()
+    section = MoveTimesSection(pan=move_times.pan, tilt=move_times.tilt, zoom=move_times.zoom)
+    update = {"move_times": section, "image_delay_s": round(image_delay_s, 4)}
+    write_camera_calibration(args.calibration, calibration.model_copy(update=update))
+    print(f"wrote move_times and image_delay_s into {args.calibration}")
+    return 0
+
+
+def serve_camera_command(args: argparse.Namespace) -> int:
+    scenario = build_scenario(args.scenario)
+    credentials = _credentials(args) or {}
+    username = args.user or credentials.get("username", "")
+    password = credentials.get("password") or os.environ.get(PASSWORD_VARIABLE, "")
+    if bool(username) != bool(password):
+        raise ScenarioError(
+            f"serve-camera: give a user and a password (--user with --credentials or ${PASSWORD_VARIABLE}), "
+            "or neither for a camera without authentication"
+        )
+    camera, feed = virtual_onvif_camera(scenario, args.time_scale, args.port, username, password)
+    log_file = None if args.truth_log is None else open(args.truth_log, "w", encoding="utf-8")  # noqa: SIM115
+    written = 0
+    camera.start()
+    try:
+        print(f"virtual ONVIF camera: onvif://127.0.0.1:{camera.onvif_port} (calibration: virtual)", flush=True)
+        if camera.rtsp_port is not None:
+            print(f"RTSP: rtsp://127.0.0.1:{camera.rtsp_port}/", flush=True)
+        print(f"the recording plays in a loop, {feed.duration_s:.0f} s a play at this time scale", flush=True)
+        if log_file is not None:
+            log_file.write(TRUTH_LOG_HEADER + "\n")
+        while True:
+            time.sleep(0.5)
+            if log_file is not None:
+                rows = feed.rows(written)
+                log_file.writelines(
+                    f"{row[0]:.6f},{int(row[1])},{row[2]:.6f},{row[3]:.6f},{row[4]:.6f}\n" for row in rows
+                )
+                log_file.flush()
+                written += len(rows)
+    except KeyboardInterrupt:
+        print("virtual ONVIF camera stopped", file=sys.stderr)
+    finally:
+        camera.stop()
+        if log_file is not None:
+            log_file.close()
+    return 0

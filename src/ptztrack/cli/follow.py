@@ -1,0 +1,96 @@
+"""``ptztrack follow`` and ``ptztrack experiment follow``: the robot-cameraman paper's follow camera."""
+
+import argparse
+import sys
+from pathlib import Path
+
+from ptztrack.builders.follow_experiment import (
+    FollowCell,
+    follow_cells,
+    follow_row,
+    follow_run,
+    otb_cells,
+    run_follow_cell,
+    run_otb_cell,
+)
+from ptztrack.cli.arguments import RUN_FOLDER_FILES
+from ptztrack.cli.experiment import run_experiment_cells
+from ptztrack.cli.scenario import recording_overrides, recording_paths
+from ptztrack.cli.watch import Watch
+from ptztrack.config import Scenario, load_scenario, pets_follow_scenario
+from ptztrack.evaluate.executors import Progress
+from ptztrack.evaluate.follow import (
+    FOLLOW_FIGURES,
+    OTB_FIGURES,
+    format_follow_people,
+    format_follow_table,
+    summarise_follow,
+)
+from ptztrack.evaluate.report import write_outputs
+from ptztrack.evaluate.video import view_renderer
+from ptztrack.evaluate.view_state import ViewState
+from ptztrack.files import check_output_folder, run_folder, write_json
+
+
+def _follow_scenario(args: argparse.Namespace, tracker: str = "particle") -> Scenario:
+    """The follow camera's scenario: the built-in PETS one or a YAML file, with the command line's changes."""
+    overrides = recording_overrides(recording_paths(args))
+    if args.achromatic_bins:
+        overrides["follow.achromatic_bins"] = True
+    if getattr(args, "target_point_px", None) is not None:
+        overrides["follow.target_point_px"] = tuple(args.target_point_px)
+    if args.scenario == "pets":
+        return pets_follow_scenario(tracker, **overrides)
+    return load_scenario(args.scenario, **overrides, **{"tracker.kind": tracker})
+
+
+def follow_command(args: argparse.Namespace) -> int:
+    out = args.out or Path(f"follow-{args.target}")
+    check_output_folder(out, "--out", args.overwrite)
+    scenario = _follow_scenario(args, args.tracker)
+    if args.frames is not None:
+        scenario = scenario.model_copy(update={"frames": args.frames})
+    label = f"follow person {args.target}, {args.tracker}"
+
+    def view(world, policy) -> ViewState:
+        target_point_px = policy.parameters.target_point_px
+        steps = world.truth.positions_m.shape[0]
+        return ViewState(world, policy, steps, label, view_renderer(world), grid=False, target_point_px=target_point_px)
+
+    with Watch(args.view, True, view, Progress("step", args.quiet)) as watch:
+        narrowed, world, episode = follow_run(FollowCell(scenario, args.tracker, args.target, args.seed), watch.observe)
+    row = follow_row(narrowed, world, episode)
+    frame_range = narrowed.required_recording("the follow camera").frame_range
+    first_frame = frame_range[0] if frame_range is not None else 0
+    print(f"person {args.target} followed by {args.tracker} from frame {first_frame}, {row['steps']} steps")
+    print(format_follow_table([row], FOLLOW_FIGURES))
+    title = f"person {args.target}, {args.tracker}: in view {row['in_view_fraction']:.0%}"
+    with run_folder(out, args.overwrite) as folder:
+        write_outputs(folder, episode, row, title, view_renderer(world))
+        watch.write(folder)
+    print(f"wrote {', '.join(RUN_FOLDER_FILES)} into {out}")
+    return 0
+
+
+def follow_experiment_command(args: argparse.Namespace) -> int:
+    scenario = _follow_scenario(args)
+    cells = follow_cells(scenario, args.trackers, args.targets, args.seed)
+    print(f"{len(cells)} closed-loop runs, {args.executor} executor", file=sys.stderr)
+    people = run_experiment_cells(args, cells, run_follow_cell)
+    otb_runs = otb_cells(scenario, args.trackers, args.otb_tracks, args.seed)
+    print(f"{len(otb_runs)} one-pass runs on the still recording", file=sys.stderr)
+    otb_people = run_experiment_cells(args, otb_runs, run_otb_cell, "run")
+    closed_loop, otb = summarise_follow(people, FOLLOW_FIGURES), summarise_follow(otb_people, OTB_FIGURES)
+    print(
+        f"Follow camera, {scenario.camera.image_size_px[0]} x {scenario.camera.image_size_px[1]} view, "
+        f"person {scenario.follow.target_height_px:g} px tall wanted; per person:"
+    )
+    print(format_follow_people(people))
+    print(format_follow_table(closed_loop, FOLLOW_FIGURES, "\nMeans over the people:"))
+    tracks = ", ".join(str(row["target_id"]) for row in otb_people[: len(otb_people) // len(args.trackers)])
+    print(format_follow_table(otb, OTB_FIGURES, f"\nOne-pass (OTB) on the still recording, people {tracks}:"))
+    if args.json is not None:
+        document = {"closed_loop": closed_loop, "otb": otb, "people": people, "otb_people": otb_people}
+        write_json(args.json, document)
+        print(f"wrote {args.json}")
+    return 0

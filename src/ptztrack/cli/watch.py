@@ -1,0 +1,62 @@
+"""What watches a run of ``run``, ``follow`` or ``live``: its web view, its view states, its progress bar."""
+
+from pathlib import Path
+
+from ptztrack.evaluate.executors import Progress
+from ptztrack.evaluate.view_state import VIEW_STATES_FILE, StepView, ViewState
+from ptztrack.evaluate.web_view import ViewHub, ViewServer
+from ptztrack.loop import StepObserver
+
+
+class Watch:
+    """What watches a run of ``run``, ``follow`` or ``live``: the web view on 127.0.0.1:``port`` (None:
+    none; a context manager: the server runs inside the block), where ``keep``, every step's view
+    state, for the run folder's view_states.jsonl (what ``ptztrack view`` replays), and a progress bar
+    of the steps (``progress``; None: none).
+
+    view : ``view(world, policy)`` gives the run's :class:`ViewState`.
+    """
+
+    def __init__(self, port: int | None, keep: bool, view, progress: Progress | None = None):
+        self.view, self.port, self.keep, self.progress = view, port, keep, progress
+        self.views: list[StepView] = []
+        self.view_state: ViewState | None = None
+        # A run started with a view waits after its first step for a page to open it.
+        self.hub = None if port is None else ViewHub(paused=True, resume_on_connect=True)
+        self._server: ViewServer | None = None
+
+    def __enter__(self) -> "Watch":
+        if self.hub is not None and self.port is not None:
+            self._server = ViewServer(self.hub, self.port).__enter__()
+            print(f"view at {self._server.address} (the run starts when a page opens it)", flush=True)
+        return self
+
+    def __exit__(self, *failure) -> None:
+        if self.progress is not None:
+            self.progress.close()
+        if self._server is not None:
+            self._server.__exit__(*failure)
+
+    def observe(self, world, policy) -> StepObserver | None:
+        """The run's step observer (None when nothing watches)."""
+        view_state = self.view_state = self.view(world, policy)
+        watching = None
+        if self.hub is not None or self.keep:
+            watching = view_state.observer(
+                None if self.hub is None else self.hub.after_step, self.views if self.keep else None
+            )
+        progress = self.progress
+        if progress is None:
+            return watching
+
+        def observe(step: int, context, record: dict) -> None:
+            if watching is not None:
+                watching(step, context, record)
+            progress(step + 1, view_state.steps)
+
+        return observe
+
+    def write(self, folder: Path) -> None:
+        """view_states.jsonl into the run's folder."""
+        assert self.view_state is not None, "observe() gives the run its observer first"
+        self.view_state.write(folder / VIEW_STATES_FILE, self.views)
