@@ -6,11 +6,12 @@ import cv2
 import numpy as np
 import pytest
 
-from ptztrack.builders.experiments import STRATEGIES, run_cell, scene_statistics, synthetic_cells
+from ptztrack.builders.experiments import run_cell, scene_statistics, synthetic_cells
 from ptztrack.cli import main
 from ptztrack.config import scenario_from_dict
 from ptztrack.evaluate.executors import run_cells
 from ptztrack.evaluate.tables import format_table, paired_difference, summarise
+from ptztrack.names import STRATEGIES
 
 SMALL = scenario_from_dict({"frames": 8})
 

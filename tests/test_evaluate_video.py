@@ -7,7 +7,6 @@ import pytest
 from ptztrack.builders.episode import episode_world, run_episode
 from ptztrack.cli import DETECTOR_MODEL_FILE, main
 from ptztrack.config import scenario_from_dict
-from ptztrack.evaluate.report import RUN_FILES
 from ptztrack.evaluate.video import (
     FRAME_SIZE_PX,
     PANEL_SIZE_PX,
@@ -18,9 +17,9 @@ from ptztrack.evaluate.video import (
     view_renderer,
     write_episode_video,
 )
-from ptztrack.evaluate.view_state import VIEW_STATES_FILE
 from ptztrack.geometry.area import bounds_m
 from ptztrack.geometry.ptz import PTZCamera
+from ptztrack.names import RUN_FILES, VIEW_STATES_FILE
 from test_camera_recorded import EXCERPT, excerpt_scenario
 
 

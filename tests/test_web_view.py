@@ -21,8 +21,9 @@ from ptztrack.builders.episode import episode_world, make_policy, run_episode
 from ptztrack.cli import main
 from ptztrack.config import scenario_from_dict
 from ptztrack.evaluate.video import view_renderer
-from ptztrack.evaluate.view_state import VIEW_STATES_FILE, ViewState
+from ptztrack.evaluate.view_state import ViewState
 from ptztrack.evaluate.web_view import ViewHub, ViewServer
+from ptztrack.names import VIEW_STATES_FILE
 
 CHROMIUM = Path("/usr/bin/chromium")  # Debian's (apt-get install chromium); Playwright's own is not downloadable here
 # Where the screenshots are kept for CI to publish (else in the test's temporary folder only).

@@ -26,15 +26,14 @@ from ptztrack.evaluate.metrics import episode_metrics
 from ptztrack.evaluate.registration import registration_errors
 from ptztrack.geometry.registration import ReferenceIndex
 from ptztrack.loop import episode_seeds
+from ptztrack.names import POSE_SOURCES, STRATEGIES
 from ptztrack.scene.pets import RecordedVideo, load_mot_ground_truth
 
-STRATEGIES = ("fix", "patrol", "rnd", "intg", "smpl")
 # The paper's column names; 'rnd' is the 'random' policy.
 POLICY_OF_STRATEGY = {"rnd": "random"}
 INFORMATION_STRATEGIES = ("intg", "smpl")
 # The strategies that draw from their random stream (the others are deterministic given the detections).
 RANDOM_STRATEGIES = ("rnd", "smpl")
-POSE_SOURCES = ("oracle", "commanded", "registered")
 GROUND_GRID_POINTS = 25
 
 

@@ -16,11 +16,10 @@ from ptztrack.control.follow import FollowParameters, FollowPolicy, framing_pose
 from ptztrack.geometry.calibration import load_calibration
 from ptztrack.geometry.ptz import PTZCamera, aim_at
 from ptztrack.loop import World
+from ptztrack.names import FOLLOW_TRACKERS
 from ptztrack.scene.pets import load_mot_ground_truth
 from ptztrack.track.particle_filter import ParticleFilterParameters
 from ptztrack.track.target import OpenCVSource, ParticleSource, TargetSource, TargetTracker, opencv_tracker_factory
-
-FOLLOW_TRACKERS = ("particle", "csrt", "mil")
 
 
 def particle_filter_parameters(scenario: Scenario) -> ParticleFilterParameters:

@@ -21,10 +21,9 @@ from ptztrack.config import Scenario
 from ptztrack.evaluate.follow import follow_metrics, one_pass_scores, target_in_views
 from ptztrack.geometry.calibration import load_calibration, standing_height_px
 from ptztrack.loop import Episode, StepObserver, World, episode_seeds
+from ptztrack.names import OTB_TRACKS
 from ptztrack.roles import Policy
 from ptztrack.scene.pets import Annotations, RecordedVideo, load_mot_ground_truth
-
-OTB_TRACKS = 5
 
 
 @dataclass(frozen=True)

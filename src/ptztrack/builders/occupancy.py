@@ -31,7 +31,6 @@ from ptztrack.track.tracker import TrackerParameters
 ROOM_AREA_M = ((0.0, 0.0), (5.0, 6.0))
 ROOM_PEOPLE = (1, 3)
 # 20 s at 15 Hz per sequence (the paper's were 3.5 and 7 minutes long).
-ROOM_FRAMES = 300
 ROOM = RoomLayout()
 
 

@@ -22,9 +22,9 @@ import numpy as np
 from ptztrack.builders.world import build_world
 from ptztrack.config import Scenario, scenario_from_dict
 from ptztrack.detect.recall_fit import detection_trials, fit_recall
+from ptztrack.names import PROTOCOLS
 from ptztrack.scene.pets import load_mot_ground_truth
 
-PROTOCOLS = ("a-priori", "two-fold")
 # The fit looks at every 20th step of the training half, at every zoom of the grid's views within 2 pan
 # and 1 tilt steps of the whole-frame view (people are fully visible there, at every size the policies
 # meet).

@@ -26,10 +26,11 @@ from urllib.parse import quote, unquote, urlsplit
 import cv2
 import numpy as np
 
+from ptztrack.names import PASSWORD_VARIABLE
+
 # Connecting also parses the ONVIF WSDLs (0.7 s of CPU on an idle core, several seconds on a loaded
 # one), which is not the camera's answer time that ``timeout_s`` bounds.
 CONNECT_TIMEOUT_S = 15.0
-PASSWORD_VARIABLE = "PTZTRACK_CAMERA_PASSWORD"
 USER_VARIABLE = "PTZTRACK_CAMERA_USER"
 DEFAULT_ONVIF_PORT = 80
 POLL_S = 0.02

@@ -1,9 +1,8 @@
 """The ``ptztrack`` command line's parser: every command, its arguments and their checks.
 
-It imports argparse and the registry's names only, so that ``ptztrack --help`` stays quick; each
-command names its body as ``"module:function"``, which :func:`ptztrack.cli.main` imports when the
-command runs. The choices and defaults below are the command line's copies of the subsystems'
-(their homes are named; tests/test_cli_arguments.py checks that they agree).
+It imports argparse, the registry's names and :mod:`ptztrack.names` only, so that ``ptztrack --help``
+stays quick; each command names its body as ``"module:function"``, which :func:`ptztrack.cli.main`
+imports when the command runs.
 """
 
 import argparse
@@ -11,28 +10,20 @@ import math
 from pathlib import Path
 
 from ptztrack import registry
-
-# ptztrack.evaluate.report.RUN_FILES and ptztrack.evaluate.view_state.VIEW_STATES_FILE: what run,
-# follow and live write into --out.
-RUN_FOLDER_FILES = (
-    "metrics.json",
-    "steps.csv",
-    "detections.csv",
-    "tracks.csv",
-    "tracks_mot.txt",
-    "truth_mot.txt",
-    "episode.png",
-    "episode.mp4",
-    "view_states.jsonl",
+from ptztrack.names import (
+    EXECUTORS,
+    FOLLOW_TRACKERS,
+    OTB_TRACKS,
+    PASSWORD_VARIABLE,
+    POSE_SOURCES,
+    PROTOCOLS,
+    ROOM_FRAMES,
+    RUN_FILES,
+    STRATEGIES,
+    VIEW_STATES_FILE,
 )
-STRATEGIES = ("fix", "patrol", "rnd", "intg", "smpl")  # ptztrack.builders.experiments
-POSE_SOURCES = ("oracle", "commanded", "registered")  # ptztrack.builders.experiments
-PROTOCOLS = ("a-priori", "two-fold")  # ptztrack.builders.pets
-FOLLOW_TRACKERS = ("particle", "csrt", "mil")  # ptztrack.builders.follow
-OTB_TRACKS = 5  # ptztrack.builders.follow_experiment
-ROOM_FRAMES = 300  # ptztrack.builders.occupancy
-EXECUTORS = ("local", "ray", "serial")  # ptztrack.evaluate.executors
-PASSWORD_VARIABLE = "PTZTRACK_CAMERA_PASSWORD"  # ptztrack.camera.onvif_client
+
+RUN_FOLDER_FILES = (*RUN_FILES, VIEW_STATES_FILE)
 
 
 class OneLineParser(argparse.ArgumentParser):

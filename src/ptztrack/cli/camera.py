@@ -19,7 +19,7 @@ from ptztrack.builders.live import (
     virtual_onvif_camera,
 )
 from ptztrack.camera.move_timing import measure_image_delay, measure_move_times, timed_move
-from ptztrack.camera.onvif_client import PASSWORD_VARIABLE, ONVIFClient, camera_address
+from ptztrack.camera.onvif_client import ONVIFClient, camera_address
 from ptztrack.camera.stream import FrameStream, rtsp_pictures
 from ptztrack.cli.arguments import RUN_FOLDER_FILES
 from ptztrack.cli.run import format_metrics
@@ -36,6 +36,7 @@ from ptztrack.evaluate.metrics import episode_metrics
 from ptztrack.evaluate.report import write_outputs
 from ptztrack.evaluate.view_state import ViewState
 from ptztrack.files import read_text, run_folder
+from ptztrack.names import PASSWORD_VARIABLE
 
 
 def _credentials(args: argparse.Namespace) -> dict | None:

@@ -7,7 +7,6 @@ import tempfile
 from pathlib import Path
 
 from ptztrack.builders.experiments import (
-    POSE_SOURCES,
     closed_loop_cells,
     live_view_settings,
     registration_views,
@@ -20,6 +19,7 @@ from ptztrack.config import LiveView, PoseError, ScenarioError
 from ptztrack.evaluate.executors import Progress
 from ptztrack.evaluate.registration import summarise_registration
 from ptztrack.files import write_json
+from ptztrack.names import POSE_SOURCES
 
 
 def registration_experiment_command(args: argparse.Namespace) -> int:

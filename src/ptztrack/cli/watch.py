@@ -3,9 +3,10 @@
 from pathlib import Path
 
 from ptztrack.evaluate.executors import Progress
-from ptztrack.evaluate.view_state import VIEW_STATES_FILE, StepView, ViewState
+from ptztrack.evaluate.view_state import StepView, ViewState
 from ptztrack.evaluate.web_view import ViewHub, ViewServer
 from ptztrack.loop import StepObserver
+from ptztrack.names import VIEW_STATES_FILE
 
 
 class Watch:

@@ -17,7 +17,8 @@ from contextlib import contextmanager
 import cv2
 from tqdm import tqdm
 
-EXECUTORS = ("local", "ray", "serial")
+from ptztrack.names import EXECUTORS
+
 _IGNORE_CTRL_C = (signal.SIGINT, signal.SIG_IGN)
 
 

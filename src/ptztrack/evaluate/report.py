@@ -46,16 +46,6 @@ STEP_COLUMNS = (
 )
 DETECTION_COLUMNS = ("step", "feet_u_px", "feet_v_px", "height_px", "score", "x_m", "y_m", "person")
 MOT_COLUMNS = ("frame", "id", "left", "top", "width", "height", "conf", "x", "y", "z")
-RUN_FILES = (
-    "metrics.json",
-    "steps.csv",
-    "detections.csv",
-    "tracks.csv",
-    "tracks_mot.txt",
-    "truth_mot.txt",
-    "episode.png",
-    "episode.mp4",
-)
 
 
 def metrics_json(metrics: dict) -> bytes:

@@ -28,12 +28,12 @@ from ptztrack.evaluate.video import SIGMAS, RenderView, ellipse_axes, image_elli
 from ptztrack.files import InputError, read_text, write_atomically
 from ptztrack.geometry.ptz import ground_footprint
 from ptztrack.loop import StepObserver, World
+from ptztrack.names import VIEW_STATES_FILE
 from ptztrack.types import DecisionContext, Detections, Tracks
 
 JPEG_QUALITY = 80  # enough to see people; a 640 x 480 synthetic view is then some 10 kB
 FOOTPRINT_RANGE_M = 60.0  # a view of the horizon ends here on the map
 RATE_WINDOW_STEPS = 20  # the step rate over the last steps: a pause leaves it soon
-VIEW_STATES_FILE = "view_states.jsonl"
 MAX_VIEW_STATES_BYTES = 4_000_000_000
 
 
