@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ptztrack.track import msg
+from ptztrack.facecapture import msg
 
 # The traversal reference is test code, not part of the installed package.
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))

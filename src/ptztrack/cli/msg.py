@@ -6,8 +6,8 @@ import sys
 import numpy as np
 
 from ptztrack.cli.experiment import run_experiment_cells
-from ptztrack.control.msg_scheduler import SCHEDULERS
-from ptztrack.evaluate.msg import (
+from ptztrack.evaluate.report import write_figure
+from ptztrack.facecapture.experiment import (
     ambiguity_figure,
     format_ambiguity_table,
     format_paired_differences,
@@ -17,9 +17,9 @@ from ptztrack.evaluate.msg import (
     summarise_by_ambiguity,
     trails_figure,
 )
-from ptztrack.evaluate.report import write_figure
+from ptztrack.facecapture.roads import walk_roads
+from ptztrack.facecapture.scheduler import SCHEDULERS
 from ptztrack.files import write_json
-from ptztrack.scene.roads import walk_roads
 
 
 def msg_experiment_command(args: argparse.Namespace) -> int:

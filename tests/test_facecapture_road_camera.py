@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from ptztrack.scene.road_camera import ZOOMED_HALF_WIDTH_M, RoadCamera, Zoom
-from ptztrack.scene.roads import RoadScene
+from ptztrack.facecapture.road_camera import ZOOMED_HALF_WIDTH_M, RoadCamera, Zoom
+from ptztrack.facecapture.roads import RoadScene
 
 CENTRE_M = (20.0, 20.0)
 

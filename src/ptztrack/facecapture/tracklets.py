@@ -1,8 +1,8 @@
 """A tracklet tracker for face capture (MSG paper, sections 3.1 and 4): the MSG from what the camera saw.
 
 It reads nothing but its observations, step by step (:class:`Observation`,
-made by a sensor such as :mod:`ptztrack.scene.road_camera`), and keeps the
-Multi-Strand Tracking Graph (:mod:`ptztrack.track.msg`):
+made by a sensor such as :mod:`ptztrack.facecapture.road_camera`), and keeps the
+Multi-Strand Tracking Graph (:mod:`ptztrack.facecapture.msg`):
 
 - zoomed out, the camera sees every unit (a walker alone or a group walking
   together; everyone looks alike at low resolution) and follows it from
@@ -20,7 +20,7 @@ Multi-Strand Tracking Graph (:mod:`ptztrack.track.msg`):
   of its size, continues that tracklet; any other unit starts a vertex with
   an edge from each candidate (none: someone new);
 - a captured face labels the tracklet of the unit it was captured on, which
-  matches and untangles the graph (:func:`ptztrack.track.msg.label`).
+  matches and untangles the graph (:func:`ptztrack.facecapture.msg.label`).
 
 Its predictions for the scheduler extrapolate each unit at constant
 velocity: its heading times the speed it walked over the last step (or
@@ -38,7 +38,7 @@ from dataclasses import dataclass, field
 import networkx as nx
 import numpy as np
 
-from ptztrack.track import msg
+from ptztrack.facecapture import msg
 
 
 @dataclass(frozen=True)

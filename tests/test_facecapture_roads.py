@@ -3,7 +3,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from ptztrack.scene.roads import RoadScene, RoadSceneConfig, joins_and_splits, walk_roads
+from ptztrack.facecapture.roads import RoadScene, RoadSceneConfig, joins_and_splits, walk_roads
 
 
 def walk(seed=0, **fields):

@@ -5,7 +5,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from msg_traversal import traversal_data
-from ptztrack.track import msg
+from ptztrack.facecapture import msg
 
 # Weighted so that labels often come after joins and splits: untangling through compound vertices.
 OPERATIONS = (

@@ -1,9 +1,9 @@
 """The face-capture experiment (MSG paper, section 4): simulate, schedule, score M against N_j/s.
 
-One run: a road-grid scene (:mod:`ptztrack.scene.roads`) watched by one PTZ
-camera at the area's centre (:mod:`ptztrack.scene.road_camera`), whose
-observations alone feed the tracklet tracker (:mod:`ptztrack.track.tracklets`).
-Every zoomed-out step the scheduler (:mod:`ptztrack.control.msg_scheduler`)
+One run: a road-grid scene (:mod:`ptztrack.facecapture.roads`) watched by one PTZ
+camera at the area's centre (:mod:`ptztrack.facecapture.road_camera`), whose
+observations alone feed the tracklet tracker (:mod:`ptztrack.facecapture.tracklets`).
+Every zoomed-out step the scheduler (:mod:`ptztrack.facecapture.scheduler`)
 either stays zoomed out or zooms in on one walker for ``zoom_steps`` to
 capture a face, aimed where the tracker predicts the walker at the capture;
 a captured face labels the walker's tracklet, matches it and (for the
@@ -27,11 +27,11 @@ import networkx as nx
 import numpy as np
 from matplotlib.figure import Figure
 
-from ptztrack.control.msg_scheduler import SCHEDULERS
 from ptztrack.evaluate.tables import standard_error
-from ptztrack.scene.road_camera import ZOOMED_HALF_WIDTH_M, Blob, RoadCamera, Zoom
-from ptztrack.scene.roads import RoadScene, RoadSceneConfig, walk_roads
-from ptztrack.track.tracklets import TrackletTracker, TrackletTrackerConfig
+from ptztrack.facecapture.road_camera import ZOOMED_HALF_WIDTH_M, Blob, RoadCamera, Zoom
+from ptztrack.facecapture.roads import RoadScene, RoadSceneConfig, walk_roads
+from ptztrack.facecapture.scheduler import SCHEDULERS
+from ptztrack.facecapture.tracklets import TrackletTracker, TrackletTrackerConfig
 
 DEFAULT_ZOOM_OUT_SCORE = 5.0
 

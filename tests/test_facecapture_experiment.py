@@ -6,9 +6,9 @@ import networkx as nx
 import numpy as np
 import pytest
 
-from ptztrack.control.msg_scheduler import SCHEDULERS
 from ptztrack.evaluate.executors import run_cells
-from ptztrack.evaluate.msg import (
+from ptztrack.facecapture import msg
+from ptztrack.facecapture.experiment import (
     EXPERIMENT_SCENE,
     labelled_fraction,
     msg_cells,
@@ -17,10 +17,10 @@ from ptztrack.evaluate.msg import (
     run_msg_cell,
     summarise_by_ambiguity,
 )
-from ptztrack.scene.road_camera import Blob
-from ptztrack.scene.roads import RoadScene, walk_roads
-from ptztrack.track import msg
-from ptztrack.track.tracklets import TrackletTrackerConfig
+from ptztrack.facecapture.road_camera import Blob
+from ptztrack.facecapture.roads import RoadScene, walk_roads
+from ptztrack.facecapture.scheduler import SCHEDULERS
+from ptztrack.facecapture.tracklets import TrackletTrackerConfig
 
 BUSY = replace(EXPERIMENT_SCENE, people=15, join_probability=0.7)
 

@@ -1,6 +1,6 @@
 """Whom to zoom in on for a face, or whether to stay zoomed out (face-capture paper, sections 3.4-3.5).
 
-The schedulers read only the tracklet tracker (:mod:`ptztrack.track.tracklets`):
+The schedulers read only the tracklet tracker (:mod:`ptztrack.facecapture.tracklets`):
 its graph and its predictions. A candidate is a tracklet in view that is
 solo, unlabelled and whose capture the tracker expects to succeed (E_s).
 
@@ -34,8 +34,8 @@ from dataclasses import dataclass
 
 import networkx as nx
 
-from ptztrack.track.msg import refresh
-from ptztrack.track.tracklets import TrackletTracker
+from ptztrack.facecapture.msg import refresh
+from ptztrack.facecapture.tracklets import TrackletTracker
 
 # alpha's boost for a source and beta for a target expected to leave within this many zoom durations.
 SOURCE_WEIGHT = 2.0

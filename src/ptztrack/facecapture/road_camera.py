@@ -1,8 +1,8 @@
 """What a PTZ camera watching the road grid observes, step by step (MSG paper, section 4).
 
-A sensor over the simulated truth (:mod:`ptztrack.scene.roads`) that reads
+A sensor over the simulated truth (:mod:`ptztrack.facecapture.roads`) that reads
 only the step it observes, and reports it as a tracker sees it
-(:class:`ptztrack.track.tracklets.Observation`):
+(:class:`ptztrack.facecapture.tracklets.Observation`):
 
 - zoomed out, every unit in the area: a walker alone or a group walking
   together, its size, position and heading, and a blob id the camera keeps
@@ -28,8 +28,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ptztrack.scene.roads import RoadScene
-from ptztrack.track.tracklets import FaceCapture, Observation, UnitSighting
+from ptztrack.facecapture.roads import RoadScene
+from ptztrack.facecapture.tracklets import FaceCapture, Observation, UnitSighting
 
 # The zoomed view is 1.2 m wide on the ground: a 0.15 m face then spans 1/8 of the image (80 px of 640).
 ZOOMED_HALF_WIDTH_M = 0.6

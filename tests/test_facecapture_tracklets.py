@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from ptztrack.track.tracklets import (
+from ptztrack.facecapture.tracklets import (
     FaceCapture,
     Observation,
     TrackletTracker,
