@@ -24,11 +24,11 @@ import numpy as np  # noqa: E402
 
 from ptztrack.builders.occupancy import lpom_parameters, room_recording  # noqa: E402
 from ptztrack.config import Occupancy  # noqa: E402
-from ptztrack.detect.lpom import LpomDetector  # noqa: E402
-from ptztrack.detect.motion import motion_edges  # noqa: E402
-from ptztrack.detect.occupancy import map_modes, occupancy_map, table_map  # noqa: E402
 from ptztrack.files import write_atomically  # noqa: E402
-from ptztrack.scene.multiview import CameraView  # noqa: E402
+from ptztrack.occupancy.detectors import LpomDetector  # noqa: E402
+from ptztrack.occupancy.lpom import map_modes, occupancy_map, table_map  # noqa: E402
+from ptztrack.occupancy.motion_edges import motion_edges  # noqa: E402
+from ptztrack.occupancy.multiview import CameraView  # noqa: E402
 
 
 def main() -> None:

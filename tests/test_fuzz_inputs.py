@@ -30,7 +30,7 @@ from ptztrack.config import (
 from ptztrack.files import InputError
 from ptztrack.geometry.calibration import load_calibration
 from ptztrack.geometry.registration import ReferenceIndex, load_index, save_index
-from ptztrack.scene.multiview import load_mot_detections
+from ptztrack.occupancy.multiview import load_mot_detections
 from ptztrack.scene.pets import RecordedVideo, load_cvml, load_mot_ground_truth
 
 EXAMPLES = 200

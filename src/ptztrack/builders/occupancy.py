@@ -1,5 +1,5 @@
 """The occupancy-map experiment's inputs: a dataset file or the synthetic room made into a
-:class:`~ptztrack.scene.multiview.MultiViewRecording`, and the detectors' parameters from the configuration."""
+:class:`~ptztrack.occupancy.multiview.MultiViewRecording`, and the detectors' parameters from the configuration."""
 
 import functools
 from collections.abc import Callable
@@ -17,15 +17,15 @@ from ptztrack.config import (
     OccupancyTracker,
     Tracker,
 )
-from ptztrack.detect.lpom import ClusteringDetector, LpomDetector, LpomParameters
-from ptztrack.detect.motion import MotionEdgeParameters
-from ptztrack.detect.occupancy import LocusSampling, sampled_heights
-from ptztrack.evaluate.occupancy import OccupancyRun, detect_frames, score_recording
 from ptztrack.geometry.calibration import PinholeCalibration, load_pinhole, load_tsai, pinhole_from_tsai
-from ptztrack.geometry.locus import PERSON, ConeModel
-from ptztrack.scene.multiview import CameraView, ImageFolder, MultiViewRecording, load_mot_detections, mot_truth
+from ptztrack.occupancy.detectors import ClusteringDetector, LpomDetector, LpomParameters
+from ptztrack.occupancy.evaluation import OccupancyRun, detect_frames, score_recording
+from ptztrack.occupancy.locus import PERSON, ConeModel
+from ptztrack.occupancy.lpom import LocusSampling, sampled_heights
+from ptztrack.occupancy.motion_edges import MotionEdgeParameters
+from ptztrack.occupancy.multiview import CameraView, ImageFolder, MultiViewRecording, load_mot_detections, mot_truth
+from ptztrack.occupancy.room import RoomLayout, RoomRenderer, room_truth
 from ptztrack.scene.pets import DatasetError, RecordedVideo
-from ptztrack.scene.room import RoomLayout, RoomRenderer, room_truth
 from ptztrack.track.tracker import TrackerParameters
 
 ROOM_AREA_M = ((0.0, 0.0), (5.0, 6.0))

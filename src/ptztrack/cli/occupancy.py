@@ -6,9 +6,9 @@ import argparse
 from ptztrack.builders.occupancy import dataset_runs, room_runs
 from ptztrack.config import load_dataset, pets_dataset
 from ptztrack.evaluate.executors import Progress
-from ptztrack.evaluate.occupancy_output import write_occupancy_outputs
 from ptztrack.files import run_folder, write_json
 from ptztrack.names import ROOM_FRAMES
+from ptztrack.occupancy.output import write_occupancy_outputs
 
 OCCUPANCY_COLUMNS = (
     ("method", "{}"),

@@ -252,7 +252,7 @@ def update_tracks_on_ground(
     tracks: Tracks, position_m, covariance_m2, parameters: TrackerParameters, detectable
 ) -> TrackUpdate:
     """Associate, update, start and delete with measurements of ground positions (a multi-camera
-    occupancy map's modes, :mod:`ptztrack.detect.occupancy`), the tracker's step after prediction.
+    occupancy map's modes, :mod:`ptztrack.occupancy.lpom`), the tracker's step after prediction.
 
     position_m : (K, 2) measured positions; covariance_m2 : (K, 2, 2) their noise ``R``. The
     observation is linear, ``z = [I 0] x + r``; association is the Hungarian assignment on the

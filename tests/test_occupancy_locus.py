@@ -4,7 +4,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from ptztrack.geometry.calibration import load_calibration, pixel_rays, project_pinhole
-from ptztrack.geometry.locus import PERSON, ConeModel, person_locus, profile, touching_positions
+from ptztrack.occupancy.locus import PERSON, ConeModel, person_locus, profile, touching_positions
 
 PETS = "src/ptztrack/data/pets2009_s2l1"
 

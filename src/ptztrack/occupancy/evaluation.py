@@ -1,7 +1,7 @@
 """The occupancy-map experiment: LPOM and the clustering baseline on a multi-view recording, scored.
 
 Every frame of the recording goes through both detectors
-(:mod:`ptztrack.detect.lpom`) in order. Each method has one threshold, which
+(:mod:`ptztrack.occupancy.detectors`) in order. Each method has one threshold, which
 is fitted on disjoint frames: the frames are split into a first and a
 second half, each half is scored with the threshold that gives the best
 MODA on the other half (two-fold cross-validation; a recording too short to
@@ -29,11 +29,11 @@ import numpy as np
 from scipy.optimize import linear_sum_assignment
 from scipy.spatial.distance import cdist
 
-from ptztrack.detect.clustering import Clusters
-from ptztrack.detect.lpom import ClusteringDetector, LpomDetector
-from ptztrack.detect.occupancy import GroundGrid, Modes
 from ptztrack.evaluate.metrics import clear_metrics
-from ptztrack.scene.multiview import MultiViewRecording
+from ptztrack.occupancy.clustering import Clusters
+from ptztrack.occupancy.detectors import ClusteringDetector, LpomDetector
+from ptztrack.occupancy.lpom import GroundGrid, Modes
+from ptztrack.occupancy.multiview import MultiViewRecording
 from ptztrack.track.kalman import constant_velocity_model
 from ptztrack.track.tracker import TrackerParameters, predict_tracks, update_tracks_on_ground
 from ptztrack.types import Tracks

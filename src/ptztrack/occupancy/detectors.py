@@ -1,11 +1,11 @@
 """People on the ground of a multi-view recording, frame by frame: the LPOM detector and the clustering baseline.
 
 :class:`LpomDetector` builds each frame's occupancy map
-(:mod:`ptztrack.detect.occupancy`) from every view's motion pixels: motion
-edges where the view has video (:func:`ptztrack.detect.motion.motion_edges`,
+(:mod:`ptztrack.occupancy.lpom`) from every view's motion pixels: motion
+edges where the view has video (:func:`ptztrack.occupancy.motion_edges.motion_edges`,
 against the previous frame), else the outlines of its detector's boxes.
 :class:`ClusteringDetector` clusters the views' box feet on the ground
-(:mod:`ptztrack.detect.clustering`), with blob boxes for views that have
+(:mod:`ptztrack.occupancy.clustering`), with blob boxes for views that have
 only video. Both are fed the frames in order.
 """
 
@@ -13,9 +13,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ptztrack.detect.clustering import BlobBoxes, Clusters, cluster_feet, feet_on_ground
-from ptztrack.detect.motion import MotionEdgeParameters, box_outline_points, motion_edges
-from ptztrack.detect.occupancy import (
+from ptztrack.occupancy.clustering import BlobBoxes, Clusters, cluster_feet, feet_on_ground
+from ptztrack.occupancy.lpom import (
     GroundGrid,
     LocusSampling,
     LocusTable,
@@ -26,7 +25,8 @@ from ptztrack.detect.occupancy import (
     points_map,
     table_map,
 )
-from ptztrack.scene.multiview import CameraView, MultiViewRecording
+from ptztrack.occupancy.motion_edges import MotionEdgeParameters, box_outline_points, motion_edges
+from ptztrack.occupancy.multiview import CameraView, MultiViewRecording
 
 
 @dataclass(frozen=True)

@@ -9,10 +9,10 @@ import pytest
 
 from ptztrack.cli import main
 from ptztrack.config import dataset_from_dict, load_dataset, pets_dataset
-from ptztrack.detect.occupancy import Modes
-from ptztrack.evaluate.occupancy import detection_metrics, fitted_selection, halves, track_on_ground
 from ptztrack.geometry.calibration import project_pinhole
-from ptztrack.scene.room import RoomLayout, RoomRenderer, room_truth
+from ptztrack.occupancy.evaluation import detection_metrics, fitted_selection, halves, track_on_ground
+from ptztrack.occupancy.lpom import Modes
+from ptztrack.occupancy.room import RoomLayout, RoomRenderer, room_truth
 from test_track_ground import PARAMETERS as GROUND_TRACKER
 
 PETS = Path(__file__).resolve().parents[1] / "src" / "ptztrack" / "data" / "pets2009_s2l1"

@@ -1,7 +1,7 @@
 """The locus-based probabilistic occupancy map (LPOM) and its modes: people found on the ground.
 
 Algorithm 1 of Hu, Mutlu and Lanz (ICIAP 2013): every motion pixel of every
-view adds its locus (:mod:`ptztrack.geometry.locus`) for each sampled
+view adds its locus (:mod:`ptztrack.occupancy.locus`) for each sampled
 height, weighted by its view's weight; the weights are normalised to sum to
 1 and a kernel turns the loci into a density (equations 8 and 9). Here the
 loci are accumulated on a ground grid (each locus sample adds its ``dt`` to
@@ -31,7 +31,7 @@ import numpy as np
 from scipy import ndimage, sparse
 
 from ptztrack.geometry.calibration import PinholeCalibration, pixel_rays
-from ptztrack.geometry.locus import ConeModel, person_locus
+from ptztrack.occupancy.locus import ConeModel, person_locus
 
 # Rays per chunk when building a table: about 0.5 GB of temporaries at 4 heights x 48 samples.
 RAYS_PER_CHUNK = 20_000

@@ -1,4 +1,4 @@
-"""Motion pixels of a view: the evidence the occupancy map (:mod:`ptztrack.detect.occupancy`) is built from.
+"""Motion pixels of a view: the evidence the occupancy map (:mod:`ptztrack.occupancy.lpom`) is built from.
 
 The LPOM paper extracts "motion edges" with the SUSAN edge detector. Here a
 motion edge is an edge of the current frame (OpenCV's Canny detector on the

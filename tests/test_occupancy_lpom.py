@@ -4,9 +4,9 @@ from scipy.stats import multivariate_normal
 
 from ptztrack.builders.occupancy import lpom_parameters, room_recording
 from ptztrack.config import Occupancy
-from ptztrack.detect.lpom import LpomDetector
-from ptztrack.detect.motion import box_outline_points
-from ptztrack.detect.occupancy import (
+from ptztrack.occupancy.detectors import LpomDetector
+from ptztrack.occupancy.locus import PERSON
+from ptztrack.occupancy.lpom import (
     GroundGrid,
     LocusSampling,
     block_counts,
@@ -17,8 +17,8 @@ from ptztrack.detect.occupancy import (
     sampled_heights,
     table_map,
 )
-from ptztrack.geometry.locus import PERSON
-from ptztrack.scene.room import RoomLayout, room_cameras
+from ptztrack.occupancy.motion_edges import box_outline_points
+from ptztrack.occupancy.room import RoomLayout, room_cameras
 
 
 def test_a_single_person_in_the_synthetic_room_gives_one_mode_near_the_truth():

@@ -5,7 +5,7 @@ whatever it came from: a video, a folder of images or a MOTChallenge
 detection file per view, and ground truth in the MOTChallenge layout with
 world metres (columns 8-9). The builders assemble one from a dataset file
 (:mod:`ptztrack.builders.occupancy`) or from the synthetic room
-(:mod:`ptztrack.scene.room`). Any problem with a file gets a
+(:mod:`ptztrack.occupancy.room`). Any problem with a file gets a
 :class:`~ptztrack.scene.pets.DatasetError` naming it.
 """
 
