@@ -33,8 +33,8 @@ from ptztrack.builders.follow import initial_box, target_scenario, target_source
 from ptztrack.builders.follow_experiment import FollowCell, follow_run  # noqa: E402
 from ptztrack.config import pets_follow_scenario  # noqa: E402
 from ptztrack.files import write_json  # noqa: E402
+from ptztrack.follow.target import box_corners_carried  # noqa: E402
 from ptztrack.geometry.ptz import rotation_homography, standing_height_px  # noqa: E402
-from ptztrack.track.target import box_corners_carried  # noqa: E402
 
 # The paper's head, torso and legs ([left, top, width, height] of the box), with the lambdas set for three
 # patches (lambda_colour K / 20, lambda_loss K / 3; see the docs, the follow camera).

@@ -1,8 +1,8 @@
 """The follow camera from a scenario: its trackers ('particle', 'csrt', 'mil') and its policy ('follow').
 
 The scenario's ``follow`` section holds the parameters (rates per second);
-here they become the per-step dataclasses of :mod:`ptztrack.track.particle_filter`,
-:mod:`ptztrack.track.target` and :mod:`ptztrack.control.follow`. The person
+here they become the per-step dataclasses of :mod:`ptztrack.follow.particle_filter`,
+:mod:`ptztrack.follow.target` and :mod:`ptztrack.follow.controller`. The person
 followed is ``follow.target_id``, started from their annotated box at the
 first step, moved into the view the camera is at before it.
 """
@@ -12,14 +12,14 @@ import numpy as np
 from ptztrack.camera.recorded import RecordedPTZ
 from ptztrack.camera.virtual import virtual_ptz
 from ptztrack.config import Actions, Scenario, ScenarioError
-from ptztrack.control.follow import FollowParameters, FollowPolicy, framing_pose
+from ptztrack.follow.controller import FollowParameters, FollowPolicy, framing_pose
+from ptztrack.follow.particle_filter import ParticleFilterParameters
+from ptztrack.follow.target import OpenCVSource, ParticleSource, TargetSource, TargetTracker, opencv_tracker_factory
 from ptztrack.geometry.calibration import load_calibration
 from ptztrack.geometry.ptz import PTZCamera, aim_at
 from ptztrack.loop import World
 from ptztrack.names import FOLLOW_TRACKERS
 from ptztrack.scene.pets import load_mot_ground_truth
-from ptztrack.track.particle_filter import ParticleFilterParameters
-from ptztrack.track.target import OpenCVSource, ParticleSource, TargetSource, TargetTracker, opencv_tracker_factory
 
 
 def particle_filter_parameters(scenario: Scenario) -> ParticleFilterParameters:

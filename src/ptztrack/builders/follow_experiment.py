@@ -18,7 +18,7 @@ from ptztrack.builders.episode import episode_world, make_policy, run_episode
 from ptztrack.builders.follow import follow_parameters, target_scenario, target_source
 from ptztrack.camera.recorded import RecordedPTZ
 from ptztrack.config import Scenario
-from ptztrack.evaluate.follow import follow_metrics, one_pass_scores, target_in_views
+from ptztrack.follow.evaluation import follow_metrics, one_pass_scores, target_in_views
 from ptztrack.geometry.calibration import load_calibration, standing_height_px
 from ptztrack.loop import Episode, StepObserver, World, episode_seeds
 from ptztrack.names import OTB_TRACKS
@@ -86,7 +86,7 @@ def _boxes_by_frame(annotations: Annotations, target_id: int, frames) -> np.ndar
 
 
 def follow_row(scenario: Scenario, world: World, episode: Episode) -> dict:
-    """The figures of one followed person (:func:`ptztrack.evaluate.follow.follow_metrics`) and the
+    """The figures of one followed person (:func:`ptztrack.follow.evaluation.follow_metrics`) and the
     mean ground distance of the track from the person while the tracker was not lost (``ground_error_m``)."""
     target_id = scenario.follow.target_id
     assert target_id is not None

@@ -19,17 +19,17 @@ from ptztrack.cli.scenario import recording_overrides, recording_paths
 from ptztrack.cli.watch import Watch
 from ptztrack.config import Scenario, load_scenario, pets_follow_scenario
 from ptztrack.evaluate.executors import Progress
-from ptztrack.evaluate.follow import (
+from ptztrack.evaluate.report import write_outputs
+from ptztrack.evaluate.video import view_renderer
+from ptztrack.evaluate.view_state import ViewState
+from ptztrack.files import check_output_folder, run_folder, write_json
+from ptztrack.follow.evaluation import (
     FOLLOW_FIGURES,
     OTB_FIGURES,
     format_follow_people,
     format_follow_table,
     summarise_follow,
 )
-from ptztrack.evaluate.report import write_outputs
-from ptztrack.evaluate.video import view_renderer
-from ptztrack.evaluate.view_state import ViewState
-from ptztrack.files import check_output_folder, run_folder, write_json
 
 
 def _follow_scenario(args: argparse.Namespace, tracker: str = "particle") -> Scenario:

@@ -5,8 +5,8 @@ from dataclasses import dataclass, field
 import numpy as np
 import pytest
 
+from ptztrack.follow.target import TargetEstimate, TargetTracker, box_corners_carried
 from ptztrack.geometry.ptz import PTZCamera, look_at, projection_matrix, rotation_homography
-from ptztrack.track.target import TargetEstimate, TargetTracker, box_corners_carried
 
 CAMERA = PTZCamera((0.0, 0.0, 7.0), 640, 480, 800.0)
 POSE = look_at(CAMERA, [0.0, 15.0], 2.0)

@@ -1,7 +1,7 @@
 """One person followed in the image, reported as one ground-plane track: the follow camera's tracker.
 
 A *target source* follows the person's box from view to view: the
-robot-cameraman paper's particle filter (:mod:`ptztrack.track.particle_filter`)
+robot-cameraman paper's particle filter (:mod:`ptztrack.follow.particle_filter`)
 or an OpenCV tracker (CSRT, MIL) as the comparator. :class:`TargetTracker`
 wraps either into a :class:`ptztrack.roles.Tracker`: it asks for no
 detections, reads the view, gives the source the homography from the
@@ -39,6 +39,13 @@ from typing import Protocol
 import cv2
 import numpy as np
 
+from ptztrack.follow.particle_filter import (
+    ParticleFilter,
+    ParticleFilterParameters,
+    StandingHeight,
+    start_filter,
+    step_filter,
+)
 from ptztrack.geometry.ptz import (
     PTZCamera,
     apply_homography,
@@ -49,13 +56,6 @@ from ptztrack.geometry.ptz import (
     standing_height_px,
 )
 from ptztrack.roles import ImageSource
-from ptztrack.track.particle_filter import (
-    ParticleFilter,
-    ParticleFilterParameters,
-    StandingHeight,
-    start_filter,
-    step_filter,
-)
 from ptztrack.types import Detections, Tracks, TrackUpdate
 
 TRACK_ID = 0

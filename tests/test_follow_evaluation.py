@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from ptztrack.evaluate.follow import (
+from ptztrack.follow.evaluation import (
     FOLLOW_FIGURES,
     box_iou,
     follow_metrics,

@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 
 from ptztrack.camera.virtual import virtual_ptz
+from ptztrack.follow.motion_image import first_motion_image, motion_image_of, next_motion_image, non_motion_fraction
 from ptztrack.geometry.calibration import load_pinhole
 from ptztrack.geometry.ptz import rotation_homography
 from ptztrack.scene.pets import read_video
-from ptztrack.track.motion_image import first_motion_image, motion_image_of, next_motion_image, non_motion_fraction
 
 EXCERPT = Path(__file__).parent / "data" / "pets_s2l1_excerpt"
 

@@ -8,7 +8,7 @@ import pytest
 
 from ptztrack.builders.follow import particle_filter_parameters
 from ptztrack.config import scenario_from_dict
-from ptztrack.track.particle_filter import (
+from ptztrack.follow.particle_filter import (
     MAX_HEIGHT_Z,
     carry_states,
     height_log_prior,

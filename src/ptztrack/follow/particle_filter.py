@@ -19,7 +19,7 @@ Each step (:func:`step_filter`):
    or the paper's random walk, equation 1: Gaussian steps of ``walk_sigma``
    box heights in x and y);
 3. weigh by the product of the colour and motion likelihoods (equations 3-5;
-   :mod:`ptztrack.track.colour_model`, :mod:`ptztrack.track.motion_image`),
+   :mod:`ptztrack.follow.colour_model`, :mod:`ptztrack.follow.motion_image`),
    computed in logarithms so that no weight underflows;
 4. output the weighted mean (equation 6), whose colour likelihood
    ``P(z_col | s_t)`` decides on a loss.
@@ -80,9 +80,9 @@ from typing import NamedTuple
 
 import numpy as np
 
+from ptztrack.follow import colour_model
+from ptztrack.follow.motion_image import MotionImage, first_motion_image, next_motion_image, non_motion_fraction
 from ptztrack.geometry.ptz import apply_homography
-from ptztrack.track import colour_model
-from ptztrack.track.motion_image import MotionImage, first_motion_image, next_motion_image, non_motion_fraction
 
 # A box is never smaller than this many pixels high: the random walk would otherwise shrink one
 # that lost its person to nothing.
@@ -103,11 +103,11 @@ class ParticleFilterParameters:
     ``follow`` section gives them and their sources).
 
     particles, search_particles : while tracking, and while lost.
-    patches : (K, 4) (left, top, width, height) in box units (:mod:`ptztrack.track.colour_model`).
+    patches : (K, 4) (left, top, width, height) in box units (:mod:`ptztrack.follow.colour_model`).
     bins : N of the N x N hue-saturation histograms; achromatic : N more bins by value for greys
-    (:func:`ptztrack.track.colour_model.colour_bins`); samples : grid points per patch axis.
+    (:func:`ptztrack.follow.colour_model.colour_bins`); samples : grid points per patch axis.
     background_ring_scale : the background-weighted histograms' ring, the box scaled by this much
-    (:func:`ptztrack.track.colour_model.background_weights`); None: unweighted, the paper's.
+    (:func:`ptztrack.follow.colour_model.background_weights`); None: unweighted, the paper's.
     lambda_colour, lambda_motion : equations 3 and 4.
     lambda_loss : the colour likelihood's lambda in the loss test (``likelihood``, ``P_ref``).
     height_log_sigma : the spread of ``ln(h / h_standing)``, h_standing the calibrated height of a

@@ -4,7 +4,7 @@ import cv2
 import numpy as np
 import pytest
 
-from ptztrack.track.colour_model import (
+from ptztrack.follow.colour_model import (
     background_weights,
     bhattacharyya_distance,
     bin_count,

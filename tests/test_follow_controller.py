@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from ptztrack.control.follow import FollowParameters, FollowPolicy, framing_pose
+from ptztrack.follow.controller import FollowParameters, FollowPolicy, framing_pose
 from ptztrack.geometry.ptz import PTZCamera, look_at, project_people, projection_matrix
 from ptztrack.types import DecisionContext, Tracks
 
