@@ -1,11 +1,11 @@
 """The regression corpus of bad inputs (tests/bad_inputs.py) through the real command, and Ctrl-C.
 
 Every case runs in-process through ``ptztrack.cli.main``: exit 2 with one line of at most 300 characters
-on stderr (file descriptor 2, warnings logged and Python warnings counted as lines too) and no traceback
-(or exit 0 where the input is legitimate), in less than 1 GB of resident memory: the resident memory a
-fresh process has after importing the command, plus what the case's run adds to the peak of this one
-(Linux's peak resident memory, reset before each case). The memory bombs, a legitimate input and an argparse error also run in a fresh process as
-a user runs the command: the exit status, the one line, and under 1 GB of peak resident memory.
+on stderr (file descriptor 2; records logged and Python warnings count as lines too) and no traceback (or
+exit 0 where the input is legitimate), in less than 1 GB of resident memory: what a fresh process holds
+after importing the command, plus what the case's run adds to this process's peak (Linux's peak resident
+memory, reset before each case). The memory bombs, a legitimate input and an argparse error also run in a
+fresh process as a user runs the command: the exit status, the one line, under 1 GB of peak resident memory.
 Neither checks how long a case takes on the clock: a case that hangs is stopped after ``HANG_S`` and
 fails; one that does the work a bad input asked for shows in its memory.
 """

@@ -46,18 +46,17 @@ def test_a_scenario_file_runs(tmp_path, capsys):
     assert "3 people" in capsys.readouterr().out
 
 
-def test_bad_scenario_file_exits_2_with_one_line_and_no_traceback(tmp_path):
-    for text, field in (("area_m: [-15, 15]\n", "area_m.0"), ("speed: 3\n", "speed: unknown key")):
-        path = tmp_path / "bad.yaml"
-        path.write_text(text)
-        result = subprocess.run(
-            [sys.executable, "-m", "ptztrack.cli", "run", "--scenario", str(path)], capture_output=True, text=True
-        )
-        assert result.returncode == 2
-        lines = result.stderr.strip().splitlines()
-        assert len(lines) == 1, result.stderr
-        assert field in lines[0] and str(path) in lines[0]
-        assert "Traceback" not in result.stderr
+@pytest.mark.parametrize("text, field", [("area_m: [-15, 15]\n", "area_m.0"), ("speed: 3\n", "speed: unknown key")])
+def test_bad_scenario_file_exits_2_with_one_line_and_no_traceback(tmp_path, capfd, text, field):
+    """In-process (stderr at file descriptor 2); tests/test_bad_inputs.py runs such cases in a fresh process too."""
+    path = tmp_path / "bad.yaml"
+    path.write_text(text)
+    assert main(["run", "--scenario", str(path)]) == 2
+    stderr = capfd.readouterr().err
+    lines = stderr.strip().splitlines()
+    assert len(lines) == 1, stderr
+    assert field in lines[0] and str(path) in lines[0]
+    assert "Traceback" not in stderr
 
 
 def test_an_output_path_that_cannot_be_a_directory_exits_2_naming_it(tmp_path, capsys):

@@ -1,6 +1,5 @@
 """The MSG traversal reference against the paper's examples, brute-force path enumeration and the literal recursions."""
 
-
 import networkx as nx
 import pytest
 from hypothesis import given, settings
