@@ -3,7 +3,8 @@
 Each case is the files it needs (written into a scratch directory), the command line
 (``{dir}`` is the scratch directory, ``{data}`` the built-in PETS folder) and the exit status
 expected: 2 for a clean one-line error, 0 where the input is legitimate.
-Used by tests/test_bad_inputs.py and benchmarks/bad_inputs.py.
+Used by tests/test_bad_inputs.py: every case in-process (:func:`run_case_in_process`), a few also in a
+fresh process (:func:`run_case`).
 """
 
 import functools
@@ -263,9 +264,8 @@ class Outcome:
     peak_memory_mb: float
 
 
-def run_case(case: Case, directory: Path, timeout_s: float = 60.0) -> Outcome:
-    """Write the case's files into ``directory`` and run the command in a fresh process, measuring its
-    wall time and peak resident memory."""
+def write_case(case: Case, directory: Path) -> list[str]:
+    """Write the case's files into ``directory``; its command line there."""
     for name, content in case.files.items():
         if content is None:
             continue
@@ -275,7 +275,13 @@ def run_case(case: Case, directory: Path, timeout_s: float = 60.0) -> Outcome:
             path.write_bytes(content)
         else:
             path.write_text(content)
-    argv = [part.replace("{dir}", str(directory)) for part in case.argv]
+    return [part.replace("{dir}", str(directory)) for part in case.argv]
+
+
+def run_case(case: Case, directory: Path, timeout_s: float = 60.0) -> Outcome:
+    """Write the case's files into ``directory`` and run the command in a fresh process, measuring its
+    wall time and peak resident memory (killed after ``timeout_s``)."""
+    argv = write_case(case, directory)
     with tempfile.TemporaryFile("w+") as stderr:
         start = time.perf_counter()
         process = subprocess.Popen(

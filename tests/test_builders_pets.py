@@ -1,5 +1,7 @@
 """The PETS tables' protocols: nothing a table scores is used to fit it, and the area comes from the scene."""
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -7,10 +9,13 @@ from ptztrack.builders.experiments import recording_cells, shared_views_key
 from ptztrack.builders.pets import fit_detector, halves, protocol_folds
 from ptztrack.builders.world import build_scene
 from ptztrack.geometry.area import inside
-from test_camera_recorded import EXCERPT, excerpt_scenario
+
+EXCERPT = Path(__file__).parent / "data" / "pets_s2l1_excerpt"
 
 
-def test_a_priori_is_the_scenario_itself_and_two_fold_scores_each_half_with_the_other_halfs_fit(tmp_path):
+def test_a_priori_is_the_scenario_itself_and_two_fold_scores_each_half_with_the_other_halfs_fit(
+    tmp_path, excerpt_scenario
+):
     scenario = excerpt_scenario(tmp_path, **{"recording.video": str(EXCERPT / "View_001.avi")})
     (assert_single,) = protocol_folds(scenario, "a-priori")
     assert assert_single.scenario is scenario and assert_single.fitted == {} and assert_single.index is None
@@ -26,7 +31,7 @@ def test_a_priori_is_the_scenario_itself_and_two_fold_scores_each_half_with_the_
         protocol_folds(scenario, "leave-one-out")
 
 
-def test_the_fitted_pixel_noise_and_width_are_the_annotations_own(tmp_path):
+def test_the_fitted_pixel_noise_and_width_are_the_annotations_own(tmp_path, excerpt_scenario):
     """The annotated feet lie a median 2.2 px from the calibrated ones in the 768 px frame (the data's
     README): about half a pixel at 160 px; the annotated boxes are about 0.36 times as wide as tall."""
     scenario = excerpt_scenario(tmp_path)
@@ -36,7 +41,7 @@ def test_the_fitted_pixel_noise_and_width_are_the_annotations_own(tmp_path):
     assert 0.30 * 1.75 < fitted["width_m"] < 0.42 * 1.75
 
 
-def test_the_walkable_area_comes_from_the_calibrated_view_not_the_annotations(tmp_path):
+def test_the_walkable_area_comes_from_the_calibrated_view_not_the_annotations(tmp_path, excerpt_scenario):
     scenario = excerpt_scenario(tmp_path)
     scene = build_scene(scenario, np.random.default_rng(0))
     assert inside(scene.area_polygon_m, scene.recording.annotations.ground_m).mean() > 0.95
@@ -55,7 +60,7 @@ def test_the_walkable_area_comes_from_the_calibrated_view_not_the_annotations(tm
     )
 
 
-def test_only_runs_that_depend_on_their_seed_run_several_seeds(tmp_path):
+def test_only_runs_that_depend_on_their_seed_run_several_seeds(tmp_path, excerpt_scenario):
     hog = excerpt_scenario(tmp_path, **{"detector.kind": "hog", "recording.video": str(EXCERPT / "View_001.avi")})
     # With the online detector model, intg plans with draws of it, so it depends on its seed too.
     cells = recording_cells(hog, [1.0], ["fix", "rnd", "intg", "smpl"], seeds=3)
@@ -72,7 +77,9 @@ def test_only_runs_that_depend_on_their_seed_run_several_seeds(tmp_path):
     assert [cell.seed for cell in ideal] == [0, 1, 2]
 
 
-def test_the_information_gain_runs_of_one_fold_and_beta_share_their_views_and_no_other_runs_do(tmp_path):
+def test_the_information_gain_runs_of_one_fold_and_beta_share_their_views_and_no_other_runs_do(
+    tmp_path, excerpt_scenario
+):
     hog = excerpt_scenario(tmp_path, **{"detector.kind": "hog", "recording.video": str(EXCERPT / "View_001.avi")})
     cells = [
         cell for fold in (0, 1) for cell in recording_cells(hog, [9.0, 1.0], ["fix", "rnd", "intg", "smpl"], 3, fold)

@@ -150,8 +150,11 @@ def test_every_socket_is_on_127_0_0_1_and_nothing_multicasts(rtsp_reader):
 
 
 def test_an_absolute_move_takes_the_time_the_axis_speed_gives_and_ends_on_the_target():
-    """34 degrees of pan at 17 deg/s: MOVING at once (the zoom, not asked to move, IDLE), IDLE after about
-    2 s, GetStatus on the target, and the last rendered image taken at the target pose."""
+    """34 degrees of pan at 17 deg/s: MOVING at once (the zoom, not asked to move, IDLE), IDLE once there,
+    GetStatus on the target, and the last rendered image taken at the target pose. The time the move
+    takes is read on the camera's own clock, from the poses of the images rendered on the way (17 deg/s
+    between any two of them: 2 s for the 34 degrees), not from when the client saw it end (later on a
+    loaded machine); the client saw MOVING for at least 1.6 s (a lower bound, which load cannot break)."""
     target_pose = np.array([34.0, 20.0, 1.0])
     target = SPACES.normalised(target_pose)
 
@@ -163,7 +166,7 @@ def test_an_absolute_move_takes_the_time_the_axis_speed_gives_and_ends_on_the_ta
         sent_s = time.monotonic()
         await ptz.AbsoluteMove({"ProfileToken": token, "Position": position})
         first = status = await ptz.GetStatus({"ProfileToken": token})
-        while status.MoveStatus.PanTilt == "MOVING" and time.monotonic() - sent_s < 5.0:
+        while status.MoveStatus.PanTilt == "MOVING" and time.monotonic() - sent_s < 60.0:  # only stops a hang
             await asyncio.sleep(0.05)
             status = await ptz.GetStatus({"ProfileToken": token})
         return first, status, time.monotonic() - sent_s
@@ -173,13 +176,18 @@ def test_an_absolute_move_takes_the_time_the_axis_speed_gives_and_ends_on_the_ta
         time.sleep(0.3)  # a few more images at the target
         elapsed_s, poses = cam.truth()
     assert (first.MoveStatus.PanTilt, first.MoveStatus.Zoom) == ("MOVING", "IDLE")
-    assert last.MoveStatus.PanTilt == "IDLE" and 1.6 <= travel_s <= 3.0, travel_s
+    assert last.MoveStatus.PanTilt == "IDLE" and travel_s >= 1.6, travel_s
     position = last.Position
     assert np.allclose([position.PanTilt.x, position.PanTilt.y, position.Zoom.x], target, atol=1e-3)
     assert np.allclose(poses[-1], target_pose, rtol=0.0, atol=1e-6)
-    # The images on the way saw the head between its ends, at about the rate asked for.
+    # The images on the way saw the head between its ends, turning at 17 deg/s on the camera's clock,
+    # and none came faster than the rate asked for (10 per second; a loaded machine can only make them later).
     assert np.any((poses[:, 0] > 5.0) & (poses[:, 0] < 29.0))
-    assert np.all(np.diff(elapsed_s) > 0) and 0.08 < np.mean(np.diff(elapsed_s)) < 0.15
+    on_the_way = (poses[:, 0] > START_POSE[0] + 1e-3) & (poses[:, 0] < target_pose[0] - 1e-3)  # not at rest
+    assert np.count_nonzero(on_the_way) >= 2, elapsed_s
+    pan_speed = np.diff(poses[on_the_way, 0]) / np.diff(elapsed_s[on_the_way])
+    assert np.allclose(pan_speed, SPEEDS.pan_deg_s, rtol=1e-6), pan_speed
+    assert np.all(np.diff(elapsed_s) > 0) and 0.08 < np.mean(np.diff(elapsed_s))
 
 
 def test_relative_and_continuous_moves_stop_and_presets_and_a_position_out_of_range():
@@ -205,7 +213,7 @@ def test_relative_and_continuous_moves_stop_and_presets_and_a_position_out_of_ra
         seen["relative"] = await still()
         sent_s = time.monotonic()
         await ptz.ContinuousMove({**profile, "Velocity": {"PanTilt": {"x": -0.5, "y": 0.0}}, "Timeout": "PT0.5S"})
-        seen["continuous"], seen["continuous_s"] = await still(), time.monotonic() - sent_s
+        seen["continuous"], seen["continuous_s"] = await still(), time.monotonic() - sent_s  # MOVING till then
         await ptz.ContinuousMove({**profile, "Velocity": {"PanTilt": {"x": 0.5, "y": 0.0}, "Zoom": {"x": 1.0}}})
         await asyncio.sleep(0.2)
         await ptz.Stop({**profile, "PanTilt": False, "Zoom": True})
@@ -232,7 +240,9 @@ def test_relative_and_continuous_moves_stop_and_presets_and_a_position_out_of_ra
     assert np.allclose(seen["relative"], start + [0.1, 0.2, 0.5], atol=1e-6)
     # Half of 170 deg/s for 0.5 s: 42.5 degrees, a quarter of the normalised pan range.
     assert np.allclose(seen["continuous"], seen["relative"] - [0.25, 0.0, 0.0], atol=1e-6)
-    assert 0.45 <= seen["continuous_s"] <= 0.9, seen["continuous_s"]
+    # The head stopped at the Timeout (the position above: 0.5 s of turning), and GetStatus said MOVING
+    # until then (a lower bound on the client's wait, which load cannot break; an upper one could).
+    assert seen["continuous_s"] >= 0.45, seen["continuous_s"]
     assert seen["stopped"] == ("MOVING", "IDLE")
     assert np.allclose(seen["home"], start, atol=1e-6) and np.allclose(seen["back"], seen["preset"], atol=1e-6)
     assert seen["presets"] == [("1", "door")] and not seen["removed"]
@@ -294,9 +304,7 @@ def test_stop_ends_ffmpeg_joins_its_threads_and_frees_the_port_for_a_new_camera(
             assert capture.read()[0] and ffmpeg_children(), "the RTSP session has no ffmpeg encoder"
         else:
             call(port, nothing)  # connections, whose TIME_WAIT the new camera's bind must not mind
-        stopping_s = time.monotonic()
         first.stop()
-        stop_s = time.monotonic() - stopping_s
     finally:
         first.stop()
         if capture is not None:
@@ -305,7 +313,6 @@ def test_stop_ends_ffmpeg_joins_its_threads_and_frees_the_port_for_a_new_camera(
     ports = {port, first.rtsp_port}
     assert not [entry for entry in sockets() if entry[3].port in ports and entry[5] == psutil.CONN_LISTEN]
     assert set(threading.enumerate()) <= threads_before, set(threading.enumerate()) - threads_before
-    assert stop_s < 5.0, stop_s
     with camera(port=port) as second:
         assert second.onvif_port == port
         call(port, nothing)

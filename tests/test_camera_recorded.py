@@ -1,4 +1,3 @@
-import os
 from pathlib import Path
 
 import numpy as np
@@ -6,34 +5,14 @@ import numpy as np
 from ptztrack.builders.episode import run_episode
 from ptztrack.builders.world import build_world
 from ptztrack.camera.live_view import recorded_to_live, view_lens
-from ptztrack.config import load_scenario, pets_scenario
+from ptztrack.config import pets_scenario
 from ptztrack.evaluate.metrics import episode_metrics
 from ptztrack.geometry.ptz import apply_homography, ground_to_image
 
 EXCERPT = Path(__file__).parent / "data" / "pets_s2l1_excerpt"
 
 
-def excerpt_scenario(tmp_path, **overrides):
-    path = tmp_path / "pets.yaml"
-    path.write_text(
-        f"""
-frames: 15
-frame_rate_hz: 5.0
-camera: {{image_size_px: [160, 120]}}
-actions:
-  pan_deg: {{start: -14, stop: 14, count: 7}}
-  tilt_deg: {{start: -10, stop: 10, count: 5}}
-  zoom: [1, 2, 3, 4]
-detector: {{kind: ideal, pixel_noise_px: 0.0}}
-recording:
-  ground_truth: {os.path.relpath(EXCERPT / "gt_mot15.txt", tmp_path)}
-  calibration: {EXCERPT / "pinhole.json"}
-"""
-    )
-    return load_scenario(path, **overrides)
-
-
-def test_a_scenario_file_names_its_recording_relative_to_itself(tmp_path):
+def test_a_scenario_file_names_its_recording_relative_to_itself(tmp_path, excerpt_scenario):
     scenario = excerpt_scenario(tmp_path)
     assert Path(scenario.recording.ground_truth).resolve() == (EXCERPT / "gt_mot15.txt").resolve()
     world = build_world(scenario, np.random.default_rng(0))
@@ -41,7 +20,7 @@ def test_a_scenario_file_names_its_recording_relative_to_itself(tmp_path):
     assert world.truth.positions_m.shape[0] == 15
 
 
-def test_the_ideal_detector_reports_annotated_feet_where_the_virtual_camera_sees_them(tmp_path):
+def test_the_ideal_detector_reports_annotated_feet_where_the_virtual_camera_sees_them(tmp_path, excerpt_scenario):
     world = build_world(excerpt_scenario(tmp_path), np.random.default_rng(0))
     wide = int(np.argmin(np.abs(world.grid.axis_indices - [3, 2, 0]).sum(axis=1)))
     pose = world.grid.poses[wide]
@@ -65,7 +44,7 @@ def test_the_built_in_pets_scenario_runs_from_the_package_data():
     assert 10 < metrics["height_px"] < 30
 
 
-def test_a_camera_with_a_live_view_shows_the_annotated_people_through_its_lens(tmp_path):
+def test_a_camera_with_a_live_view_shows_the_annotated_people_through_its_lens(tmp_path, excerpt_scenario):
     scenario = excerpt_scenario(tmp_path, camera={"image_size_px": (160, 120), "live_view": {}})
     world = build_world(scenario, np.random.default_rng(0))
     backend = world.backend

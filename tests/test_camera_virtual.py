@@ -7,7 +7,7 @@ import pytest
 from ptztrack.camera.virtual import MM_PER_M, virtual_ptz
 from ptztrack.geometry.calibration import load_pinhole, project_pinhole, standing_height_px
 from ptztrack.geometry.ptz import apply_homography, ground_to_image, image_to_ground
-from ptztrack.scene.pets import load_mot_ground_truth, read_video
+from ptztrack.scene.pets import load_mot_ground_truth
 
 EXCERPT = Path(__file__).parent / "data" / "pets_s2l1_excerpt"
 RECORDING = load_pinhole(EXCERPT / "pinhole.json")
@@ -56,8 +56,8 @@ def test_ignoring_the_distortion_would_misplace_the_corners_of_the_wide_view():
     np.testing.assert_allclose(sampled, project_pinhole(RECORDING, points_mm), atol=1e-3)
 
 
-def test_rendered_views_show_the_recording():
-    frame = read_video(EXCERPT / "View_001.avi")[0]
+def test_rendered_views_show_the_recording(excerpt_frames):
+    frame = excerpt_frames[0]
     wide = VIRTUAL.render(frame, CENTRE_POSE)
     assert wide.shape == (120, 160, 3)
     assert np.mean(wide.sum(axis=-1) == 0) < 0.03

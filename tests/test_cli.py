@@ -5,9 +5,9 @@ import os
 import pty
 import re
 import struct
-import subprocess
 import sys
 import termios
+import threading
 from pathlib import Path
 
 import pytest
@@ -46,18 +46,17 @@ def test_a_scenario_file_runs(tmp_path, capsys):
     assert "3 people" in capsys.readouterr().out
 
 
-def test_bad_scenario_file_exits_2_with_one_line_and_no_traceback(tmp_path):
-    for text, field in (("area_m: [-15, 15]\n", "area_m.0"), ("speed: 3\n", "speed: unknown key")):
-        path = tmp_path / "bad.yaml"
-        path.write_text(text)
-        result = subprocess.run(
-            [sys.executable, "-m", "ptztrack.cli", "run", "--scenario", str(path)], capture_output=True, text=True
-        )
-        assert result.returncode == 2
-        lines = result.stderr.strip().splitlines()
-        assert len(lines) == 1, result.stderr
-        assert field in lines[0] and str(path) in lines[0]
-        assert "Traceback" not in result.stderr
+@pytest.mark.parametrize("text, field", [("area_m: [-15, 15]\n", "area_m.0"), ("speed: 3\n", "speed: unknown key")])
+def test_bad_scenario_file_exits_2_with_one_line_and_no_traceback(tmp_path, capfd, text, field):
+    """In-process (stderr at file descriptor 2); tests/test_bad_inputs.py runs such cases in a fresh process too."""
+    path = tmp_path / "bad.yaml"
+    path.write_text(text)
+    assert main(["run", "--scenario", str(path)]) == 2
+    stderr = capfd.readouterr().err
+    lines = stderr.strip().splitlines()
+    assert len(lines) == 1, stderr
+    assert field in lines[0] and str(path) in lines[0]
+    assert "Traceback" not in stderr
 
 
 def test_an_output_path_that_cannot_be_a_directory_exits_2_naming_it(tmp_path, capsys):
@@ -151,34 +150,42 @@ def test_the_registration_experiment_uses_realistic_live_views_and_says_which(tm
     ]
 
 
-def _stderr(command: list[str]) -> str:
-    """What a command writes on stderr into a pseudo-terminal, as a user sees it."""
+def _stderr(argv: list[str], monkeypatch) -> str:
+    """What ``ptztrack argv`` writes on stderr into a pseudo-terminal, as a user sees it: run in-process
+    with sys.stderr the terminal's end (tqdm asks it whether it is a terminal, and its size)."""
     controller, terminal_end = pty.openpty()
     fcntl.ioctl(terminal_end, termios.TIOCSWINSZ, struct.pack("HHHH", 24, 120, 0, 0))  # 24 rows, 120 columns
     chunks = []
-    with subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=terminal_end) as process:
-        os.close(terminal_end)
+
+    def read() -> None:
         while True:
             try:
                 chunk = os.read(controller, 4096)
-            except OSError:  # EIO: the command has closed its end
+            except OSError:  # EIO: the terminal's end is closed and all it had is read
                 break
             if not chunk:
                 break
             chunks.append(chunk)
+
+    reader = threading.Thread(target=read)
+    reader.start()
+    with monkeypatch.context() as patch, open(terminal_end, "w", buffering=1) as terminal:
+        patch.setattr(sys, "stderr", terminal)
+        status = main(argv)
+    reader.join()
     os.close(controller)
-    assert process.returncode == 0
+    assert status == 0
     return b"".join(chunks).decode()
 
 
-def test_a_progress_bar_in_a_terminal_and_none_with_quiet():
+def test_a_progress_bar_in_a_terminal_and_none_with_quiet(monkeypatch):
     """tqdm's bar: what is counted, the share done, done / all, elapsed < left, the rate. Off a terminal
     there is none either (the in-process tests, whose stderr is captured, check it)."""
-    experiment = [sys.executable, "-m", "ptztrack.cli", "experiment", "synthetic", "--sequences", "2"]
+    experiment = ["experiment", "synthetic", "--sequences", "2"]
     experiment += ["--frames", "4", "--strategies", "fix", "rnd", "--executor", "serial"]
-    shown = _stderr(experiment)
+    shown = _stderr(experiment, monkeypatch)
     assert re.search(r"episodes: 100%\|.*\| 4/4 \[\d\d:\d\d<00:00, +[\d.]+episode/s\]", shown), shown
-    quiet = _stderr([*experiment, "--quiet"])
+    quiet = _stderr([*experiment, "--quiet"], monkeypatch)
     assert "episodes:" not in quiet and "%|" not in quiet and "4 episodes, serial executor" in quiet
-    run = _stderr([sys.executable, "-m", "ptztrack.cli", "run", "--frames", "6", "--policy", "fix"])
+    run = _stderr(["run", "--frames", "6", "--policy", "fix"], monkeypatch)
     assert re.search(r"steps: 100%\|.*\| 6/6 \[\d\d:\d\d<00:00, +[\d.]+step/s\]", run), run

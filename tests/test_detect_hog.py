@@ -1,3 +1,5 @@
+from pathlib import Path
+
 import cv2
 import numpy as np
 import pytest
@@ -20,8 +22,9 @@ from ptztrack.detect.hog import (
 from ptztrack.geometry.area import inside
 from ptztrack.geometry.calibration import load_pinhole
 from ptztrack.geometry.ptz import PTZCamera, apply_homography, ground_to_image, pixels_to_ground, project_people
-from ptztrack.scene.pets import DatasetError, RecordedVideo, load_mot_ground_truth, read_video
-from test_camera_recorded import EXCERPT, excerpt_scenario
+from ptztrack.scene.pets import DatasetError, RecordedVideo, load_mot_ground_truth
+
+EXCERPT = Path(__file__).parent / "data" / "pets_s2l1_excerpt"
 
 
 def test_feet_sit_one_eighth_of_the_box_above_its_bottom_and_the_person_is_three_quarters_of_it():
@@ -30,11 +33,11 @@ def test_feet_sit_one_eighth_of_the_box_above_its_bottom_and_the_person_is_three
     np.testing.assert_allclose(height, [24.0])
 
 
-def test_hog_finds_the_people_of_a_zoomed_virtual_view_at_their_annotated_feet():
+def test_hog_finds_the_people_of_a_zoomed_virtual_view_at_their_annotated_feet(excerpt_frames):
     virtual, whole_frame = virtual_ptz(load_pinhole(EXCERPT / "pinhole.json"))
     pose = whole_frame * [1, 1, 2]
     frame = 10
-    view = virtual.render(read_video(EXCERPT / "View_001.avi")[frame], pose)
+    view = virtual.render(excerpt_frames[frame], pose)
     boxes, scores = HogPeopleDetector().boxes(view)
     assert len(boxes) >= 1 and np.all(scores > 0)
     truth = load_mot_ground_truth(EXCERPT / "gt_mot15.txt")
@@ -49,8 +52,8 @@ def test_hog_finds_nobody_in_an_empty_image():
     assert boxes.shape == (0, 4) and scores.shape == (0,)
 
 
-def test_recorded_video_reads_forwards_and_reopens_to_go_back():
-    frames = read_video(EXCERPT / "View_001.avi")
+def test_recorded_video_reads_forwards_and_reopens_to_go_back(excerpt_frames):
+    frames = excerpt_frames  # read_video's
     video = RecordedVideo(EXCERPT / "View_001.avi", (768, 576))
     np.testing.assert_array_equal(video.frame(4), frames[4])
     np.testing.assert_array_equal(video.frame(10), frames[10])
@@ -67,7 +70,7 @@ def test_hog_needs_a_recording_with_video():
 
 
 @pytest.fixture(scope="module")
-def hog_world(tmp_path_factory):
+def hog_world(tmp_path_factory, excerpt_scenario):
     """The excerpt seen by the 160 x 120 virtual camera of the PETS protocol, with the ground search."""
     scenario = excerpt_scenario(
         tmp_path_factory.mktemp("hog"), **{"detector.kind": "hog", "recording.video": str(EXCERPT / "View_001.avi")}

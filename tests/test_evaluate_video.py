@@ -1,4 +1,5 @@
 import os
+from pathlib import Path
 
 import cv2
 import numpy as np
@@ -20,7 +21,8 @@ from ptztrack.evaluate.video import (
 from ptztrack.geometry.area import bounds_m
 from ptztrack.geometry.ptz import PTZCamera
 from ptztrack.names import RUN_FILES, VIEW_STATES_FILE
-from test_camera_recorded import EXCERPT, excerpt_scenario
+
+EXCERPT = Path(__file__).parent / "data" / "pets_s2l1_excerpt"
 
 
 def read_video(path):
@@ -72,7 +74,7 @@ def test_the_synthetic_view_shows_the_people_the_detector_saw():
         assert np.all(view[v - 5, u] < background)
 
 
-def test_a_pets_excerpt_video_shows_the_recording_through_the_virtual_camera(tmp_path):
+def test_a_pets_excerpt_video_shows_the_recording_through_the_virtual_camera(tmp_path, excerpt_scenario):
     scenario = excerpt_scenario(tmp_path, **{"recording.video": str(EXCERPT / "View_001.avi")})
     episode = run_episode(scenario, "fix", 0)
     world = episode_world(scenario, 0)

@@ -9,15 +9,14 @@ from ptztrack.camera.virtual import virtual_ptz
 from ptztrack.follow.motion_image import first_motion_image, motion_image_of, next_motion_image, non_motion_fraction
 from ptztrack.geometry.calibration import load_pinhole
 from ptztrack.geometry.ptz import rotation_homography
-from ptztrack.scene.pets import read_video
 
 EXCERPT = Path(__file__).parent / "data" / "pets_s2l1_excerpt"
 
 
 @pytest.fixture(scope="module")
-def still_scene():
+def still_scene(excerpt_frames):
     """A static scene (one recorded frame) and the virtual camera that turns and zooms over it."""
-    frame = read_video(EXCERPT / "View_001.avi")[0]
+    frame = excerpt_frames[0]
     virtual, whole_frame_pose = virtual_ptz(load_pinhole(EXCERPT / "pinhole.json"), image_size_px=(320, 240))
     return frame, virtual, whole_frame_pose
 

@@ -150,7 +150,10 @@ def test_a_wrong_password_exits_2_with_one_line_that_does_not_show_it(capsys):
 
 
 def test_a_camera_that_stops_answering_times_out_instead_of_hanging():
-    """A listener that accepts and never answers: every call gives up after its timeout."""
+    """A listener that accepts and never answers: every call gives up after its timeout, saying so. The
+    client waits at most its timeout and a second's grace; the bound here, far beyond that (parsing the
+    ONVIF WSDLs alone can take seconds of CPU on a loaded machine), is only what tells a hang from giving
+    up, which is what this test is about."""
     with socket.socket() as silent:
         silent.bind(("127.0.0.1", 0))
         silent.listen()
@@ -160,7 +163,7 @@ def test_a_camera_that_stops_answering_times_out_instead_of_hanging():
         with pytest.raises(CameraError, match="no answer within 1 s"):
             client.connect()
         client.close()
-    assert time.monotonic() - started < 3.0
+    assert time.monotonic() - started < 30.0
 
 
 def test_calibrate_times_the_moves_and_the_streams_delay_and_writes_them_into_the_file(tmp_path, capsys):

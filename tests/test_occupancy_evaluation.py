@@ -1,6 +1,4 @@
 import json
-import subprocess
-import sys
 from pathlib import Path
 
 import cv2
@@ -113,22 +111,14 @@ def test_a_dataset_in_the_generic_format_runs_and_writes_its_outputs(tmp_path, c
     assert "lpom" in capsys.readouterr().out
 
 
-def run_cli(*arguments) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "ptztrack.cli", *arguments], capture_output=True, text=True)
-
-
-def one_line_error(result: subprocess.CompletedProcess) -> str:
-    assert result.returncode == 2, result.stderr
-    assert "Traceback" not in result.stderr
-    lines = result.stderr.strip().splitlines()
-    assert len(lines) == 1, result.stderr
-    return lines[0]
-
-
-def test_a_malformed_dataset_file_exits_2_with_one_line_naming_file_and_field(tmp_path, capsys):
+def test_a_malformed_dataset_file_exits_2_with_one_line_naming_file_and_field(tmp_path, capfd):
     path = tmp_path / "bad.yaml"
     path.write_text("frame_rate_hz: 10\nviews: [\n")
-    line = one_line_error(run_cli("experiment", "occupancy", str(path)))  # the command itself: no traceback
+    assert main(["experiment", "occupancy", str(path)]) == 2  # the command itself: no traceback
+    stderr = capfd.readouterr().err
+    lines = stderr.strip().splitlines()
+    assert "Traceback" not in stderr and len(lines) == 1, stderr
+    line = lines[0]
     assert str(path) in line and "not valid YAML" in line, line
     area = "frame_rate_hz: 10\narea_m: [[0, 0], [1, 1]]\n"
     for text, expected in (
@@ -142,7 +132,7 @@ def test_a_malformed_dataset_file_exits_2_with_one_line_naming_file_and_field(tm
     ):
         path.write_text(text)
         assert main(["experiment", "occupancy", str(path)]) == 2
-        lines = capsys.readouterr().err.strip().splitlines()
+        lines = capfd.readouterr().err.strip().splitlines()
         assert len(lines) == 1 and str(path) in lines[0] and expected in lines[0], lines
 
 

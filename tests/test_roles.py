@@ -179,14 +179,12 @@ def test_the_flat_api_names_what_a_user_needs():
         ptztrack.no_such_thing  # noqa: B018
 
 
-def test_experiment_subcommands_take_only_their_own_flags():
-    result = subprocess.run(
-        [sys.executable, "-m", "ptztrack.cli", "experiment", "synthetic", "--views", "3"],
-        capture_output=True,
-        text=True,
-    )
-    assert result.returncode == 2
-    assert result.stderr.count("\n") == 1 and "unrecognized arguments: --views 3" in result.stderr
+def test_experiment_subcommands_take_only_their_own_flags(capfd):
+    with pytest.raises(SystemExit) as exited:  # argparse's exit, status 2 (tests/test_bad_inputs.py: in a process)
+        main(["experiment", "synthetic", "--views", "3"])
+    assert exited.value.code == 2
+    stderr = capfd.readouterr().err
+    assert stderr.count("\n") == 1 and "unrecognized arguments: --views 3" in stderr
 
 
 def test_a_run_can_be_rescored_from_its_files_with_motmetrics_alone(tmp_path):

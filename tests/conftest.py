@@ -1,0 +1,54 @@
+"""Fixtures that more than one test file uses.
+
+Session-scoped ones are built once and are read-only (the arrays are marked so): a test that needs to
+change one works on a copy.
+"""
+
+import os
+from pathlib import Path
+
+import pytest
+
+from ptztrack.config import load_scenario
+from ptztrack.scene.pets import read_video
+
+EXCERPT = Path(__file__).parent / "data" / "pets_s2l1_excerpt"
+"""Frames 0-29 of PETS 2009 S2L1 View_001 (video, ground truth, both calibrations)."""
+
+
+@pytest.fixture(scope="session")
+def excerpt_frames():
+    """The excerpt's 30 frames, (30, 576, 768, 3) uint8 BGR, decoded once; read-only."""
+    frames = read_video(EXCERPT / "View_001.avi")
+    frames.flags.writeable = False
+    return frames
+
+
+def _excerpt_scenario(directory: Path, **overrides):
+    """A small PETS scenario on the excerpt (15 frames at 5 Hz, a 160 x 120 camera, a few actions, the
+    ideal detector without noise), written as a file into ``directory`` that names its ground truth
+    relative to itself, and loaded with ``overrides``."""
+    path = directory / "pets.yaml"
+    path.write_text(
+        f"""
+frames: 15
+frame_rate_hz: 5.0
+camera: {{image_size_px: [160, 120]}}
+actions:
+  pan_deg: {{start: -14, stop: 14, count: 7}}
+  tilt_deg: {{start: -10, stop: 10, count: 5}}
+  zoom: [1, 2, 3, 4]
+detector: {{kind: ideal, pixel_noise_px: 0.0}}
+recording:
+  ground_truth: {os.path.relpath(EXCERPT / "gt_mot15.txt", directory)}
+  calibration: {EXCERPT / "pinhole.json"}
+"""
+    )
+    return load_scenario(path, **overrides)
+
+
+@pytest.fixture(scope="session")
+def excerpt_scenario():
+    """``excerpt_scenario(directory, **overrides)``: the small PETS scenario file of the excerpt, written
+    into ``directory`` (a test's tmp_path) and loaded."""
+    return _excerpt_scenario
