@@ -1,6 +1,6 @@
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from ptztrack.geometry.calibration import load_calibration, pixel_rays, project_pinhole
@@ -53,6 +53,12 @@ models = st.builds(
 
 
 @settings(max_examples=200, deadline=None)
+@example(
+    model=ConeModel((0.0, 0.729765336868212, 1.0), (0.0625, 0.0, 0.0), 0.25),
+    height_m=2.0,
+    camera=(0.0, 0.0, 11.0),
+    direction=(0.0, 1.0, -0.0703125),
+)
 @given(
     model=models,
     height_m=st.floats(1.2, 2.1),
@@ -75,11 +81,12 @@ def test_every_locus_point_puts_the_model_tangent_to_its_ray(model, height_m, ca
     on_ray = centre_m + t_m[:, None] * unit
     offset = on_ray[:, :2] - points_m[valid]
     rho, slope = profile(model, z_m, height_m)
-    np.testing.assert_allclose(np.linalg.norm(offset, axis=-1), rho, atol=1e-9)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        radial = np.where(rho[:, None] > 0, offset / rho[:, None], 0)
-    normal = np.concatenate([radial, -slope[:, None]], axis=-1)
-    np.testing.assert_allclose(np.where(rho > 0, normal @ unit, 0), 0, atol=1e-9)
+    # Rounding grows with the distance along the ray (about 150 m for a shallow ray from 11 m up).
+    atol_m = 1e-9 * max(1.0, t_m.max(initial=0.0))
+    np.testing.assert_allclose(np.linalg.norm(offset, axis=-1), rho, atol=atol_m)
+    # rho times the surface's normal, (offset, -slope rho): no division by a radius that may be tiny.
+    scaled_normal = np.concatenate([offset, -(slope * rho)[:, None]], axis=-1)
+    np.testing.assert_allclose(scaled_normal @ unit, 0, atol=atol_m)
     assert np.all(t_m > 0)
 
 
