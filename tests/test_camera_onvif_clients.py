@@ -45,6 +45,7 @@ from ptztrack.geometry.ptz import rotation_world_to_camera  # noqa: E402
 pytestmark = pytest.mark.onvif
 
 
+@pytest.mark.slow
 def test_a_fov_relative_move_centres_the_point_seen_there_within_the_limits():
     """The node offers TranslationSpaceFov; RelativeMove by FOV (x, y) brings the scene point seen at pixel
     (W/2 + x W/2, H/2 - y H/2) to the image centre, exactly on the model, at zoom 1 and zoomed in (a
@@ -129,6 +130,7 @@ sys.exit(0 if read and cv2.imwrite(sys.argv[2], frame) else 1)
 """
 
 
+@pytest.mark.slow
 def test_rtsp_streams_over_udp_and_tcp_to_opencv(tmp_path, caplog):
     """OpenCV's ffmpeg reads the stream with rtsp_transport udp (an RTP/AVP session, relayed from
     sockets on 127.0.0.1) and with tcp (interleaved); both frames are the rendered image."""
@@ -174,6 +176,7 @@ def rtsp_request(connection: socket.socket, request: str) -> str:
     return answer.decode(errors="replace")
 
 
+@pytest.mark.slow
 def test_clients_that_go_away_mid_answer_leave_no_traceback_and_no_warning(caplog, capfd, monkeypatch):
     """Clients reset their connections in the middle of a snapshot, an MJPEG stream, a SOAP request and
     an RTSP stream (TCP-interleaved), and one leaves a UDP session to a closed port: nothing is logged

@@ -106,6 +106,7 @@ def ffmpeg_children() -> list[psutil.Process]:
     return [child for child in psutil.Process().children(recursive=True) if "ffmpeg" in child.name()]
 
 
+@pytest.mark.slow
 def test_every_socket_is_on_127_0_0_1_and_nothing_multicasts(rtsp_reader):
     """While an ONVIF client, an MJPEG viewer, an RTSP reader (TCP) and an RTSP session over UDP are
     open, every new socket of this process and of its children (ffmpeg) is bound to 127.0.0.1 and talks
@@ -149,6 +150,7 @@ def test_every_socket_is_on_127_0_0_1_and_nothing_multicasts(rtsp_reader):
     assert groups_during == groups_before
 
 
+@pytest.mark.slow
 def test_an_absolute_move_takes_the_time_the_axis_speed_gives_and_ends_on_the_target():
     """34 degrees of pan at 17 deg/s: MOVING at once (the zoom, not asked to move, IDLE), IDLE once there,
     GetStatus on the target, and the last rendered image taken at the target pose. The time the move
@@ -190,6 +192,7 @@ def test_an_absolute_move_takes_the_time_the_axis_speed_gives_and_ends_on_the_ta
     assert np.all(np.diff(elapsed_s) > 0) and 0.08 < np.mean(np.diff(elapsed_s))
 
 
+@pytest.mark.slow
 def test_relative_and_continuous_moves_stop_and_presets_and_a_position_out_of_range():
     """A translation adds to the normalised position; a ContinuousMove runs until its Timeout at its
     fraction of full speed; Stop stops only the axes it names; a preset brings the head back after
@@ -263,6 +266,7 @@ def test_a_wrong_password_is_a_fault_and_one_log_line_without_the_password(caplo
         assert PASSWORD not in record.getMessage() and "not-the-password" not in record.getMessage()
 
 
+@pytest.mark.slow
 def test_the_snapshot_is_the_rendered_image_and_the_rtsp_stream_has_its_size(rtsp_reader):
     async def snapshot(client, token: str) -> tuple[bytes, str]:
         return await client.get_snapshot(token, basic_auth=True), await client.get_snapshot_uri(token)
@@ -289,6 +293,7 @@ def test_the_snapshot_is_the_rendered_image_and_the_rtsp_stream_has_its_size(rts
     assert read and frame.shape == (HEIGHT_PX, WIDTH_PX, 3)
 
 
+@pytest.mark.slow
 def test_stop_ends_ffmpeg_joins_its_threads_and_frees_the_port_for_a_new_camera(rtsp_reader):
     """stop() while an RTSP reader is still connected: no ffmpeg left (not even unreaped), nothing listening
     on the camera's ports, no thread of the camera left, and a new camera binds the same port at once and

@@ -68,6 +68,7 @@ def test_a_live_smpl_run_with_hog_at_the_recordings_pace_scores_near_the_offline
     assert abs(live_mota - offline_mota) <= 0.20, (live_mota, offline_mota)
 
 
+@pytest.mark.slow
 def test_the_run_goes_on_through_a_camera_that_goes_away_and_comes_back():
     """Once the run has tracks, the camera stops and a new one comes up on its port 2 s later, the
     recording going on: no picture is used in between, the tracker keeps its tracks on predictions, and
@@ -165,6 +166,7 @@ def test_a_camera_that_stops_answering_times_out_instead_of_hanging():
     assert time.monotonic() - started < 30.0
 
 
+@pytest.mark.slow
 def test_calibrate_times_the_moves_and_the_streams_delay_and_writes_them_into_the_file(tmp_path, capsys):
     """The virtual camera turns at 90 deg/s and zooms at 3 per second: the fitted slopes are their
     inverses, the intercepts about the polling interval; its stream (25 fps through an encoder and a
@@ -185,6 +187,7 @@ def test_calibrate_times_the_moves_and_the_streams_delay_and_writes_them_into_th
     assert "wrote move_times and image_delay_s" in capsys.readouterr().out
 
 
+@pytest.mark.slow
 def test_serve_camera_serves_pets_on_127_0_0_1_until_stopped_and_logs_its_truth(tmp_path):
     """`ptztrack serve-camera` as a user runs it: a client reads its status, every socket of the command
     and of its children is on 127.0.0.1 and none is UDP 3702, Ctrl-C stops it with status 0, and its
@@ -221,6 +224,7 @@ def test_serve_camera_serves_pets_on_127_0_0_1_until_stopped_and_logs_its_truth(
     assert all(len(line.split(",")) == 5 for line in lines[1:])
 
 
+@pytest.mark.slow
 def test_the_client_moves_reads_limits_keeps_presets_and_reads_the_rtsp_stream():
     """Every ONVIF call of the client against the virtual camera, each checked by the pose it leads to."""
     camera, _ = virtual_onvif_camera(pets_scenario("hog"), 1.0, 0, USER, PASSWORD)

@@ -87,6 +87,7 @@ def test_view_of_a_folder_without_view_states_exits_2_with_one_line(tmp_path, ca
     assert error.count("\n") == 1 and "line 2 is not a step's state" in error
 
 
+@pytest.mark.slow
 def test_run_with_view_prints_the_address_starts_when_a_page_connects_and_sends_the_final_state():
     command = [sys.executable, "-m", "ptztrack.cli", "run", "--frames", "12", "--policy", "intg", "--view"]
     with _served(command) as (address, run):
@@ -100,6 +101,7 @@ def test_run_with_view_prints_the_address_starts_when_a_page_connects_and_sends_
 
 
 @pytest.mark.onvif
+@pytest.mark.slow
 def test_live_with_view_sends_the_cameras_frames(tmp_path):
     pytest.importorskip("ipycam", reason="the virtual ONVIF camera needs ipycam (pip install --no-deps ipycam==1.3.0)")
     from ptztrack.builders.live import virtual_onvif_camera
@@ -233,6 +235,7 @@ def test_a_browser_draws_the_run_pauses_steps_resumes_and_keeps_the_final_state(
 
 
 @pytest.mark.browser
+@pytest.mark.slow
 def test_a_browser_replays_a_run_folder_with_pause_step_and_resume(chromium, tmp_path):
     out = tmp_path / "run"
     assert main(["run", "--frames", "20", "--policy", "intg", "--out", str(out)]) == 0
@@ -269,6 +272,7 @@ def test_a_browser_replays_a_run_folder_with_pause_step_and_resume(chromium, tmp
 
 
 @pytest.mark.browser
+@pytest.mark.slow
 def test_a_browser_follows_the_follow_camera(chromium, tmp_path):
     frames = 8
     command = [sys.executable, "-m", "ptztrack.cli", "follow", "--target", "19", "--frames", str(frames)]
