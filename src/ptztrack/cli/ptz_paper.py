@@ -8,7 +8,7 @@ from ptztrack.builders.budget import refuse_if_too_large
 from ptztrack.builders.experiments import recording_cells, run_cell, shared_views_key, synthetic_cells
 from ptztrack.builders.pets import protocol_folds
 from ptztrack.cli.experiment import run_experiment_cells
-from ptztrack.cli.scenario import build_scenario, recording_paths
+from ptztrack.cli.scenario import build_scenario, command_scenario
 from ptztrack.evaluate.tables import format_table, paired_difference, summarise
 from ptztrack.files import write_json
 
@@ -34,15 +34,7 @@ def synthetic_experiment_command(args: argparse.Namespace) -> int:
 
 
 def pets_experiment_command(args: argparse.Namespace) -> int:
-    scenario = build_scenario(
-        "pets",
-        args.detector,
-        args.frames,
-        recording_paths(args),
-        args.association,
-        args.measurement_source,
-        args.detector_model,
-    )
+    scenario = command_scenario(args, "pets")
     folds = protocol_folds(scenario, args.protocol)
     for fold in folds:
         if fold.fitted:

@@ -14,7 +14,7 @@ from ptztrack.builders.experiments import (
 )
 from ptztrack.builders.registration import reference_index
 from ptztrack.cli.experiment import run_experiment_cells
-from ptztrack.cli.scenario import build_scenario, recording_paths
+from ptztrack.cli.scenario import command_scenario
 from ptztrack.config import LiveView, PoseError, ScenarioError
 from ptztrack.evaluate.executors import Progress
 from ptztrack.evaluate.registration import summarise_registration
@@ -23,15 +23,7 @@ from ptztrack.names import POSE_SOURCES
 
 
 def registration_experiment_command(args: argparse.Namespace) -> int:
-    scenario = build_scenario(
-        args.scenario,
-        args.detector,
-        args.frames,
-        recording_paths(args),
-        args.association,
-        args.measurement_source,
-        args.detector_model,
-    )
+    scenario = command_scenario(args, args.scenario)
     if scenario.recording is None or scenario.recording.video is None:
         raise ScenarioError(f"{args.scenario}: the registration experiment needs a recording with a video")
     live_view = None if args.exact_views else scenario.camera.live_view or LiveView()

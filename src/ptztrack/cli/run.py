@@ -6,7 +6,7 @@ from functools import partial
 from ptztrack.builders.budget import refuse_if_too_large
 from ptztrack.builders.episode import episode_world, make_policy, run_episode
 from ptztrack.cli.arguments import RUN_FOLDER_FILES
-from ptztrack.cli.scenario import build_scenario, recording_paths
+from ptztrack.cli.scenario import command_scenario
 from ptztrack.cli.watch import Watch
 from ptztrack.evaluate.executors import Progress
 from ptztrack.evaluate.metrics import DISPLAY, episode_metrics
@@ -27,16 +27,7 @@ def format_metrics(metrics: dict) -> str:
 
 
 def run_command(args: argparse.Namespace) -> int:
-    scenario = build_scenario(
-        args.scenario,
-        args.detector,
-        args.frames,
-        recording_paths(args),
-        args.association,
-        args.measurement_source,
-        args.detector_model,
-        args.prior_shift_px,
-    )
+    scenario = command_scenario(args, args.scenario)
     refuse_if_too_large(scenario, (args.policy,))
     world = episode_world(scenario, args.seed)
     policy = make_policy(args.policy, scenario, world)

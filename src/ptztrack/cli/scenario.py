@@ -23,23 +23,35 @@ def build_scenario(
     detector_model, prior_shift_px : replacing ``detector.model`` and ``detector.prior_shift_px``.
     """
     overrides = recording_overrides(recording_paths or {})
-    if detector_model is not None:
-        overrides["detector.model"] = detector_model
-    if prior_shift_px is not None:
-        overrides["detector.prior_shift_px"] = prior_shift_px
-    if association is not None:
-        overrides["tracker.association"] = association
-    if measurement_source is not None:
-        overrides["tracker.measurement_source"] = measurement_source
-    if detector is not None:
-        overrides["detector.kind"] = detector
-    if frames is not None:
-        overrides["frames"] = frames
+    options = {
+        "detector.model": detector_model,
+        "detector.prior_shift_px": prior_shift_px,
+        "tracker.association": association,
+        "tracker.measurement_source": measurement_source,
+        "detector.kind": detector,
+        "frames": frames,
+    }
+    overrides.update({field: value for field, value in options.items() if value is not None})
     if name_or_path == "synthetic":
         return scenario_from_dict({}, "synthetic", **overrides)
     if name_or_path == "pets":
         return pets_scenario(str(overrides.pop("detector.kind", "ideal")), **overrides)
     return load_scenario(name_or_path, **overrides)
+
+
+def command_scenario(args: argparse.Namespace, name_or_path: str) -> Scenario:
+    """The scenario of a command that takes the recording's files, ``--detector``, ``--frames``, the
+    tracker's options and the detector model's (run, experiment pets, experiment registration)."""
+    return build_scenario(
+        name_or_path,
+        args.detector,
+        args.frames,
+        recording_paths(args),
+        args.association,
+        args.measurement_source,
+        args.detector_model,
+        getattr(args, "prior_shift_px", None),
+    )
 
 
 def recording_paths(args: argparse.Namespace) -> dict:
