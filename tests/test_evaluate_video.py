@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 from ptztrack.builders.episode import episode_world, run_episode
-from ptztrack.cli import DETECTOR_MODEL_FILE, main
+from ptztrack.cli import main
+from ptztrack.cli.run import DETECTOR_MODEL_FILE
 from ptztrack.config import scenario_from_dict
 from ptztrack.evaluate.video import (
     FRAME_SIZE_PX,

@@ -27,7 +27,8 @@ from ptztrack.builders.live import (
 )
 from ptztrack.camera.onvif_client import CameraAddress, CameraError, ONVIFClient
 from ptztrack.camera.stream import open_rtsp
-from ptztrack.cli import main, read_truth_log
+from ptztrack.cli import main
+from ptztrack.cli.camera import read_truth_log
 from ptztrack.config import load_camera_calibration, pets_scenario, write_camera_calibration
 from ptztrack.evaluate.metrics import episode_metrics
 

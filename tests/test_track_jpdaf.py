@@ -6,7 +6,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.stats import chi2, multivariate_normal
 
-from ptztrack.cli import build_scenario, main
+from ptztrack.cli import main
+from ptztrack.cli.scenario import build_scenario
 from ptztrack.config import ScenarioError, scenario_from_dict
 from ptztrack.track import jpdaf, kalman
 from ptztrack.track.kalman import constant_velocity_model

@@ -28,8 +28,8 @@ import numpy as np
 
 from ptztrack.names import PASSWORD_VARIABLE
 
-# Connecting also parses the ONVIF WSDLs (0.7 s of CPU on an idle core, several seconds on a loaded
-# one), which is not the camera's answer time that ``timeout_s`` bounds.
+# Connecting also parses the ONVIF WSDLs, local work that a loaded machine slows and that is not the
+# camera's answer time, which ``timeout_s`` bounds.
 CONNECT_TIMEOUT_S = 15.0
 USER_VARIABLE = "PTZTRACK_CAMERA_USER"
 DEFAULT_ONVIF_PORT = 80

@@ -12,25 +12,11 @@ import importlib
 import logging
 import os
 import sys
-from typing import Any
 
 from ptztrack.cli.arguments import parser
 from ptztrack.files import InputError, check_output_file, check_output_folder
 
-# Names of the command modules that other code uses, imported on first use.
-_HOME = {
-    "build_scenario": "ptztrack.cli.scenario",
-    "DETECTOR_MODEL_FILE": "ptztrack.cli.run",
-    "read_truth_log": "ptztrack.cli.camera",
-}
-
-__all__ = ["main", "parser", "check_outputs", *_HOME]
-
-
-def __getattr__(name: str) -> Any:
-    if name not in _HOME:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    return getattr(importlib.import_module(_HOME[name]), name)
+__all__ = ["main", "parser", "check_outputs"]
 
 
 def check_outputs(args: argparse.Namespace) -> None:
