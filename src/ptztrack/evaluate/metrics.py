@@ -2,7 +2,8 @@
 
 MOTA and IDF1 as usual; MOTP is the mean distance in metres between matched
 truth and track positions (lower is better, as in the paper), with a match
-allowed only within ``gate_m`` (1 m).
+allowed only within ``gate_m`` (1 m). Over several runs, the standard error of a
+figure's mean.
 """
 
 import motmetrics as mm
@@ -90,6 +91,12 @@ def episode_metrics(episode: Episode) -> dict:
     metrics["detections"] = int(sum(len(d) for d in episode.detections))
     metrics["zoom"] = float(np.mean(episode.poses[:, 2]))
     return metrics
+
+
+def standard_error(values) -> float:
+    """The standard error of the mean of ``values`` (sample standard deviation / sqrt(n)); 0 for one value."""
+    values = np.asarray(values, dtype=float)
+    return float(values.std(ddof=1) / np.sqrt(len(values))) if len(values) > 1 else 0.0
 
 
 def with_undefined_noted(metrics: dict) -> dict:

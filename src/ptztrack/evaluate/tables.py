@@ -4,7 +4,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ptztrack.evaluate.metrics import DISPLAY
+from ptztrack.evaluate.metrics import DISPLAY, standard_error
 
 # The paper's rows.
 SUMMARY_KEYS = ("mota", "motp_m", "height_px", "detections", "zoom")
@@ -42,12 +42,6 @@ def summarise(rows: Sequence[dict]) -> list[dict]:
             ]
         summary.append(entry)
     return summary
-
-
-def standard_error(values) -> float:
-    """The standard error of the mean of ``values`` (sample standard deviation / sqrt(n)); 0 for one value."""
-    values = np.asarray(values, dtype=float)
-    return float(values.std(ddof=1) / np.sqrt(len(values))) if len(values) > 1 else 0.0
 
 
 def paired_difference(summary: Sequence[dict], first: str, second: str) -> tuple[float, float, int]:

@@ -27,7 +27,7 @@ import networkx as nx
 import numpy as np
 from matplotlib.figure import Figure
 
-from ptztrack.evaluate.tables import standard_error
+from ptztrack.evaluate.metrics import standard_error
 from ptztrack.facecapture.road_camera import ZOOMED_HALF_WIDTH_M, Blob, RoadCamera, Zoom
 from ptztrack.facecapture.roads import RoadScene, RoadSceneConfig, walk_roads
 from ptztrack.facecapture.scheduler import SCHEDULERS
