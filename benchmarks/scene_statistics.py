@@ -15,8 +15,8 @@ mounting and crowd were chosen with them (see the docs, the information-gain PTZ
 import argparse
 from pathlib import Path
 
-from ptztrack.builders.experiments import scene_statistics
 from ptztrack.config import load_scenario, scenario_from_dict
+from ptztrack.experiments.ptz_tables import scene_statistics
 from ptztrack.files import write_json
 
 

@@ -14,12 +14,12 @@ import ptztrack
 from overhead import overhead_scenario
 from ptztrack import registry
 from ptztrack.builders.episode import run_episode
-from ptztrack.builders.experiments import run_cell, synthetic_cells
 from ptztrack.cli import main
 from ptztrack.config import ScenarioError, scenario_from_dict
 from ptztrack.evaluate.executors import run_cells
 from ptztrack.evaluate.metrics import episode_metrics
-from ptztrack.evaluate.tables import summarise
+from ptztrack.experiments.cells import run_cell
+from ptztrack.experiments.ptz_tables import summarise, synthetic_cells
 from ptztrack.geometry.ptz import look_at, project_people
 from ptztrack.types import DecisionContext, Detections
 

@@ -50,13 +50,13 @@ _HOME = {
     "build_world": ".builders.world",
     "episode_world": ".builders.episode",
     "run_episode": ".builders.episode",
-    "Cell": ".builders.experiments",
-    "synthetic_cells": ".builders.experiments",
-    "recording_cells": ".builders.experiments",
-    "run_cell": ".builders.experiments",
+    "Cell": ".experiments.cells",
+    "synthetic_cells": ".experiments.ptz_tables",
+    "recording_cells": ".experiments.ptz_tables",
+    "run_cell": ".experiments.cells",
     "run_cells": ".evaluate.executors",
-    "summarise": ".evaluate.tables",
-    "format_table": ".evaluate.tables",
+    "summarise": ".experiments.ptz_tables",
+    "format_table": ".experiments.ptz_tables",
     "episode_metrics": ".evaluate.metrics",
     "write_outputs": ".evaluate.report",
 }
@@ -66,14 +66,14 @@ __all__ = ["__version__", *_HOME, *_RENAMED]
 
 if TYPE_CHECKING:
     from .builders.episode import episode_world, run_episode
-    from .builders.experiments import Cell, recording_cells, run_cell, synthetic_cells
     from .builders.world import BuiltScene, build_world
     from .camera.actions import ActionGrid
     from .config import Scenario, ScenarioError, load_scenario, pets_follow_scenario, pets_scenario, scenario_from_dict
     from .evaluate.executors import run_cells
     from .evaluate.metrics import episode_metrics
     from .evaluate.report import write_outputs
-    from .evaluate.tables import format_table, summarise
+    from .experiments.cells import Cell, run_cell
+    from .experiments.ptz_tables import format_table, recording_cells, summarise, synthetic_cells
     from .geometry.ptz import PTZCamera
     from .loop import Episode, World, run_loop
     from .registry import names as registered_names

@@ -21,7 +21,7 @@ STRATEGIES = ("fix", "patrol", "rnd", "intg", "smpl")
 POSE_SOURCES = ("oracle", "commanded", "registered")
 """Where the tracker takes the camera's pose from (:mod:`ptztrack.camera.pose_feedback`)."""
 PROTOCOLS = ("a-priori", "two-fold")
-"""How the PETS tables fix their detector's parameters (:mod:`ptztrack.builders.pets`)."""
+"""How the PETS tables fix their detector's parameters (:func:`ptztrack.experiments.ptz_tables.protocol_folds`)."""
 FOLLOW_TRACKERS = ("particle", "csrt", "mil")
 """The follow camera's trackers: the paper's particle filter and OpenCV's two."""
 OTB_TRACKS = 5

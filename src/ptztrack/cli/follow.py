@@ -14,7 +14,6 @@ from ptztrack.builders.follow_experiment import (
     run_otb_cell,
 )
 from ptztrack.cli.arguments import RUN_FOLDER_FILES
-from ptztrack.cli.experiment import run_experiment_cells
 from ptztrack.cli.scenario import recording_overrides, recording_paths
 from ptztrack.cli.watch import Watch
 from ptztrack.config import Scenario, load_scenario, pets_follow_scenario
@@ -22,6 +21,7 @@ from ptztrack.evaluate.executors import Progress
 from ptztrack.evaluate.report import write_outputs
 from ptztrack.evaluate.video import view_renderer
 from ptztrack.evaluate.view_state import ViewState
+from ptztrack.experiments.cells import Execution, run_experiment_cells
 from ptztrack.files import check_output_folder, run_folder, write_json
 from ptztrack.follow.evaluation import (
     FOLLOW_FIGURES,
@@ -76,10 +76,11 @@ def follow_experiment_command(args: argparse.Namespace) -> int:
     scenario = _follow_scenario(args)
     cells = follow_cells(scenario, args.trackers, args.targets, args.seed)
     print(f"{len(cells)} closed-loop runs, {args.executor} executor", file=sys.stderr)
-    people = run_experiment_cells(args, cells, run_follow_cell)
+    execution = Execution(args.executor, args.workers, args.quiet)
+    people = run_experiment_cells(cells, run_follow_cell, execution)
     otb_runs = otb_cells(scenario, args.trackers, args.otb_tracks, args.seed)
     print(f"{len(otb_runs)} one-pass runs on the still recording", file=sys.stderr)
-    otb_people = run_experiment_cells(args, otb_runs, run_otb_cell, "run")
+    otb_people = run_experiment_cells(otb_runs, run_otb_cell, execution, "run")
     closed_loop, otb = summarise_follow(people, FOLLOW_FIGURES), summarise_follow(otb_people, OTB_FIGURES)
     print(
         f"Follow camera, {scenario.camera.image_size_px[0]} x {scenario.camera.image_size_px[1]} view, "

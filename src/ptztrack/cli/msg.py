@@ -5,8 +5,8 @@ import sys
 
 import numpy as np
 
-from ptztrack.cli.experiment import run_experiment_cells
 from ptztrack.evaluate.report import write_figure
+from ptztrack.experiments.cells import Execution, run_experiment_cells
 from ptztrack.facecapture.experiment import (
     ambiguity_figure,
     format_ambiguity_table,
@@ -25,7 +25,8 @@ from ptztrack.files import write_json
 def msg_experiment_command(args: argparse.Namespace) -> int:
     cells = msg_cells(args.runs)
     print(f"{len(cells)} simulations x {len(SCHEDULERS)} schedulers, {args.executor} executor", file=sys.stderr)
-    rows = [row for rows in run_experiment_cells(args, cells, run_msg_cell, "simulation") for row in rows]
+    execution = Execution(args.executor, args.workers, args.quiet)
+    rows = [row for rows in run_experiment_cells(cells, run_msg_cell, execution, "simulation") for row in rows]
     print("Face capture on the MSG: M by N_j/s bin, mean +- standard deviation (runs)")
     print(format_ambiguity_table(summarise_by_ambiguity(rows)))
     print(format_paired_differences(rows))

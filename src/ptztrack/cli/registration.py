@@ -6,18 +6,18 @@ import sys
 import tempfile
 from pathlib import Path
 
-from ptztrack.builders.experiments import (
+from ptztrack.builders.registration import reference_index
+from ptztrack.cli.scenario import command_scenario
+from ptztrack.config import LiveView, PoseError, ScenarioError
+from ptztrack.evaluate.executors import Progress
+from ptztrack.evaluate.registration import summarise_registration
+from ptztrack.experiments.cells import Execution, run_experiment_cells
+from ptztrack.experiments.registration import (
     closed_loop_cells,
     live_view_settings,
     registration_views,
     run_closed_loop_cell,
 )
-from ptztrack.builders.registration import reference_index
-from ptztrack.cli.experiment import run_experiment_cells
-from ptztrack.cli.scenario import command_scenario
-from ptztrack.config import LiveView, PoseError, ScenarioError
-from ptztrack.evaluate.executors import Progress
-from ptztrack.evaluate.registration import summarise_registration
 from ptztrack.files import write_json
 from ptztrack.names import POSE_SOURCES
 
@@ -43,7 +43,8 @@ def registration_experiment_command(args: argparse.Namespace) -> int:
         pose_error = PoseError(pan_tilt_sigma_deg=args.pose_noise_deg, zoom_sigma=args.zoom_noise)
         cells = closed_loop_cells(scenario, pose_error, args.policy, args.pose_sources)
         print(f"{len(cells)} closed-loop runs, {args.executor} executor", file=sys.stderr)
-        closed_loop = run_experiment_cells(args, cells, run_closed_loop_cell)
+        execution = Execution(args.executor, args.workers, args.quiet)
+        closed_loop = run_experiment_cells(cells, run_closed_loop_cell, execution)
     size = scenario.pose_feedback.image_size_px
     print(
         f"Registration of {summary['views']} live views at random reachable poses, {size[0]} x {size[1]} px, "

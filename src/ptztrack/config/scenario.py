@@ -300,8 +300,8 @@ def _pets_recording() -> dict:
 
 def pets_scenario(detector: str = "ideal", **overrides) -> Scenario:
     """The built-in PETS 2009 S2.L1 scenario: the paper's realistic experiment (section 5.2), with every
-    parameter fixed a priori (the defaults; :mod:`ptztrack.builders.pets` fits the detector's model on
-    frames a table does not score).
+    parameter fixed a priori (the defaults; :func:`ptztrack.experiments.ptz_tables.protocol_folds` fits the
+    detector's model on frames a table does not score).
 
     detector : 'ideal' (annotated boxes) or 'hog' (OpenCV's people detector on the view).
     """

@@ -1,71 +1,34 @@
-import importlib.util
-import json
-import os
+"""The PTZ paper's tables: cells, summaries and the table, the commands, and the PETS tables' protocols
+(nothing a table scores is used to fit it, and the area comes from the scene)."""
 
-import cv2
+import json
+from pathlib import Path
+
 import numpy as np
 import pytest
 
-from ptztrack.builders.experiments import run_cell, scene_statistics, synthetic_cells
+from ptztrack.builders.world import build_scene
 from ptztrack.cli import main
 from ptztrack.config import scenario_from_dict
 from ptztrack.evaluate.executors import run_cells
-from ptztrack.evaluate.tables import format_table, paired_difference, summarise
+from ptztrack.experiments.cells import run_cell
+from ptztrack.experiments.ptz_tables import (
+    fit_detector,
+    format_table,
+    halves,
+    paired_difference,
+    protocol_folds,
+    recording_cells,
+    scene_statistics,
+    shared_views_key,
+    summarise,
+    synthetic_cells,
+)
+from ptztrack.geometry.area import inside
 from ptztrack.names import STRATEGIES
 
 SMALL = scenario_from_dict({"frames": 8})
-
-
-def test_serial_and_local_process_executors_give_identical_rows():
-    cells = synthetic_cells(SMALL, sequences=2)
-    progress = []
-    local = run_cells(cells, run_cell, "local", workers=2, progress=lambda done, total: progress.append((done, total)))
-    assert local == run_cells(cells, run_cell, "serial")
-    assert [row["strategy"] for row in local] == [cell.strategy for cell in cells]
-    assert progress[-1] == (len(cells), len(cells)) and len(progress) == len(cells)
-
-
-def worker_and_threads(value: int) -> tuple[int, int, int, int]:
-    """A cell's value, the process that ran it, OpenCV's threads there and a sum OpenCV computed there."""
-    image = np.full((600, 800), value, np.uint8)
-    return value, os.getpid(), cv2.getNumThreads(), int(cv2.resize(image, (400, 300)).sum())
-
-
-def test_cells_run_together_in_one_worker_with_one_opencv_thread_and_come_back_in_order():
-    threads = cv2.getNumThreads()
-    # This process's OpenCV threads have worked before the pool forks (a worker that then set its own
-    # threads would wait forever for them).
-    cv2.resize(np.zeros((2000, 2000), np.uint8), (1000, 1000))
-    progress = []
-    rows = run_cells(
-        list(range(7)),
-        worker_and_threads,
-        "local",
-        workers=2,
-        progress=lambda done, total: progress.append((done, total)),
-        together=lambda value: value % 3 == 0,
-    )
-    assert [row[0] for row in rows] == list(range(7))
-    assert [row[3] for row in rows] == [value * 400 * 300 for value in range(7)]
-    assert {row[1] for row in rows if row[0] % 3 == 0} != {os.getpid()}
-    assert len({row[1] for row in rows if row[0] % 3 == 0}) == 1 == len({row[1] for row in rows if row[0] % 3})
-    assert {row[2] for row in rows} == {1}
-    assert cv2.getNumThreads() == threads
-    assert progress[-1] == (7, 7) and len(progress) == 2
-    serial = run_cells(list(range(7)), worker_and_threads, "serial", together=lambda value: value % 3 == 0)
-    assert [(row[0], row[3]) for row in serial] == [(row[0], row[3]) for row in rows]
-
-
-@pytest.mark.slow
-@pytest.mark.skipif(importlib.util.find_spec("ray") is None, reason="needs the ray extra")
-def test_ray_executor_gives_the_same_rows():
-    # Not imported here: the executor must import Ray itself, after setting
-    # the environment that keeps a local cluster on the loopback interface.
-    cells = synthetic_cells(SMALL, sequences=2, strategies=("rnd", "smpl"))
-    environment = dict(os.environ)
-    assert run_cells(cells, run_cell, "ray") == run_cells(cells, run_cell, "serial")
-    # The loopback settings were for Ray's start only: the caller's environment is as it was.
-    assert dict(os.environ) == environment
+EXCERPT = Path(__file__).parent / "data" / "pets_s2l1_excerpt"
 
 
 def row(strategy, seed, mota, motp_m, height_px, detections, zoom):
@@ -190,3 +153,86 @@ def test_the_pets_experiment_has_a_column_per_strategy_and_beta(tmp_path, capsys
 def test_the_pets_experiment_refuses_a_detector_it_does_not_have(capsys):
     assert main(["experiment", "pets", "--detector", "realistic"]) == 2
     assert "detector 'realistic' is not available" in capsys.readouterr().err
+
+
+def test_a_priori_is_the_scenario_itself_and_two_fold_scores_each_half_with_the_other_halfs_fit(
+    tmp_path, excerpt_scenario
+):
+    scenario = excerpt_scenario(tmp_path, **{"recording.video": str(EXCERPT / "View_001.avi")})
+    (assert_single,) = protocol_folds(scenario, "a-priori")
+    assert assert_single.scenario is scenario and assert_single.fitted == {} and assert_single.index is None
+    first, second = halves(scenario)
+    # The excerpt's 30 frames, cut on the experiment's frame step of 2.
+    assert first == (0, 16) and second == (16, 30)
+    folds = protocol_folds(scenario, "two-fold")
+    assert [fold.scenario.recording.frame_range for fold in folds] == [second, first]
+    for fold, fitted_on in zip(folds, (first, second), strict=True):
+        assert fold.fitted == fit_detector(scenario, fitted_on)
+        assert fold.scenario.detector.pixel_noise_px == fold.fitted["pixel_noise_px"]
+    with pytest.raises(ValueError, match="unknown protocol 'leave-one-out'"):
+        protocol_folds(scenario, "leave-one-out")
+
+
+def test_the_fitted_pixel_noise_and_width_are_the_annotations_own(tmp_path, excerpt_scenario):
+    """The annotated feet lie a median 2.2 px from the calibrated ones in the 768 px frame (the data's
+    README): about half a pixel at 160 px; the annotated boxes are about 0.36 times as wide as tall."""
+    scenario = excerpt_scenario(tmp_path)
+    fitted = fit_detector(scenario, halves(scenario)[0])
+    assert set(fitted) == {"pixel_noise_px", "width_m"}
+    assert 0.3 < fitted["pixel_noise_px"] < 1.0
+    assert 0.30 * 1.75 < fitted["width_m"] < 0.42 * 1.75
+
+
+def test_the_walkable_area_comes_from_the_calibrated_view_not_the_annotations(tmp_path, excerpt_scenario):
+    scenario = excerpt_scenario(tmp_path)
+    scene = build_scene(scenario, np.random.default_rng(0))
+    assert inside(scene.area_polygon_m, scene.recording.annotations.ground_m).mean() > 0.95
+    # Half the annotated people, the same area.
+    rows = (EXCERPT / "gt_mot15.txt").read_text().splitlines()
+    fewer = tmp_path / "fewer.txt"
+    fewer.write_text("\n".join(row for row in rows if int(row.split(",")[1]) % 2) + "\n")
+    fewer_scene = build_scene(
+        excerpt_scenario(tmp_path, **{"recording.ground_truth": str(fewer)}), np.random.default_rng(0)
+    )
+    assert len(fewer_scene.recording.annotations.frame) < len(scene.recording.annotations.frame)
+    np.testing.assert_array_equal(fewer_scene.area_polygon_m, scene.area_polygon_m)
+    given = excerpt_scenario(tmp_path, **{"recording.area_m": [[0, 0], [10, 0], [10, 10]]})
+    np.testing.assert_array_equal(
+        build_scene(given, np.random.default_rng(0)).area_polygon_m, [[0, 0], [10, 0], [10, 10]]
+    )
+
+
+def test_only_runs_that_depend_on_their_seed_run_several_seeds(tmp_path, excerpt_scenario):
+    hog = excerpt_scenario(tmp_path, **{"detector.kind": "hog", "recording.video": str(EXCERPT / "View_001.avi")})
+    # With the online detector model, intg plans with draws of it, so it depends on its seed too.
+    cells = recording_cells(hog, [1.0], ["fix", "rnd", "intg", "smpl"], seeds=3)
+    assert sorted((cell.column, cell.seed) for cell in cells) == [
+        ("fix", 0), ("intg b1", 0), ("intg b1", 1), ("intg b1", 2), ("rnd", 0), ("rnd", 1), ("rnd", 2),
+        ("smpl b1", 0), ("smpl b1", 1), ("smpl b1", 2),
+    ]  # fmt: skip
+    kept = recording_cells(hog.model_copy(update={"detector": hog.detector.model_copy(update={"model": "a-priori"})}),
+                           [1.0], ["fix", "rnd", "intg", "smpl"], seeds=3)  # fmt: skip
+    assert sorted((cell.column, cell.seed) for cell in kept) == [
+        ("fix", 0), ("intg b1", 0), ("rnd", 0), ("rnd", 1), ("rnd", 2), ("smpl b1", 0), ("smpl b1", 1), ("smpl b1", 2)
+    ]  # fmt: skip
+    ideal = recording_cells(excerpt_scenario(tmp_path), [1.0], ["fix"], seeds=3)
+    assert [cell.seed for cell in ideal] == [0, 1, 2]
+
+
+def test_the_information_gain_runs_of_one_fold_and_beta_share_their_views_and_no_other_runs_do(
+    tmp_path, excerpt_scenario
+):
+    hog = excerpt_scenario(tmp_path, **{"detector.kind": "hog", "recording.video": str(EXCERPT / "View_001.avi")})
+    cells = [
+        cell for fold in (0, 1) for cell in recording_cells(hog, [9.0, 1.0], ["fix", "rnd", "intg", "smpl"], 3, fold)
+    ]
+    groups: dict = {}
+    for cell in cells:
+        groups.setdefault(shared_views_key(cell), []).append((cell.fold, cell.column, cell.seed))
+    shared = sorted(group for group in groups.values() if len(group) > 1)
+    assert shared == [
+        [(fold, f"{strategy} b{beta}", seed) for strategy in ("intg", "smpl") for seed in range(3)]
+        for fold in (0, 1)
+        for beta in (1, 9)
+    ]
+    assert sum(map(len, groups.values())) == len(cells) == 2 * (1 + 3 + 2 * 6)
