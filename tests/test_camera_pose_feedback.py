@@ -9,8 +9,7 @@ from ptztrack.builders.world import action_grid, landing_error
 from ptztrack.camera import pose_feedback
 from ptztrack.config import LiveView, PoseError, ScenarioError, pets_scenario, scenario_from_dict
 from ptztrack.evaluate.metrics import episode_metrics
-from ptztrack.evaluate.registration import summarise_registration
-from ptztrack.experiments.registration import live_view_settings, registration_views
+from ptztrack.experiments.registration import live_view_settings, registration_views, summarise_registration
 from ptztrack.geometry.registration import register
 from ptztrack.types import Detections
 

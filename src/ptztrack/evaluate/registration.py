@@ -1,4 +1,4 @@
-"""How well live PTZ views are registered (scale-invariant tracking paper): errors per view, and their summary.
+"""How well live PTZ views are registered (scale-invariant tracking paper): the errors of each view.
 
 The truth is the view's real pose (pan, tilt, zoom) and focal length, and,
 for live views as a real camera takes them (:mod:`ptztrack.camera.live_view`),
@@ -16,7 +16,7 @@ how far the view's pixels of those points land from them when mapped back
 """
 
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable
 
 import numpy as np
 
@@ -93,31 +93,3 @@ def registration_errors(
         if progress is not None:
             progress(number, views)
     return rows
-
-
-def summarise_registration(rows: Sequence[dict]) -> dict:
-    """Medians and 90th percentiles of the errors over the views.
-
-    A view that was not registered counts as an error larger than any, so it raises the percentiles
-    rather than vanishing from them; percentiles are order statistics (no interpolation with such
-    views), None when they fall on such a view. A view that sees none of the walkable area has no
-    ground errors and is left out of their statistics only.
-    """
-    registered = np.array([row["registered"] for row in rows])
-
-    def percentile(values, q):
-        value = float(np.percentile(values, q, method="inverted_cdf")) if len(values) else np.inf
-        return value if np.isfinite(value) else None
-
-    summary: dict[str, float | None] = {"views": len(rows), "registered": int(registered.sum())}
-    for key, needs_registration in {"focal_err_pct": True, **GROUND_ERRORS}.items():
-        # None: a view that sees nothing (NaN, left out), or one not registered (inf, when that counts).
-        values = np.array([row[key] if row["registered"] or not needs_registration else np.inf for row in rows], float)
-        values = values[~np.isnan(values)]
-        name, unit = key.rsplit("_", 1)
-        summary[f"{name}_median_{unit}"] = percentile(values, 50)
-        summary[f"{name}_p90_{unit}"] = percentile(values, 90)
-    roll_err_deg = [abs(row["roll_err_deg"]) for row in rows if row["registered"]]
-    summary["roll_err_median_deg"] = float(np.median(roll_err_deg)) if roll_err_deg else None
-    summary["register_ms_median"] = float(1e3 * np.median([row["seconds"] for row in rows]))
-    return summary

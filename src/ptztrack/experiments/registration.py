@@ -2,8 +2,10 @@
 registered against its reference views, and the closed loop on the poses a pose source gives.
 
 The views: :func:`registration_views` (errors per view by
-:func:`ptztrack.evaluate.registration.registration_errors`). The closed loop: one cell per pose
-source (:func:`closed_loop_cells`), the camera landing off its commands.
+:func:`ptztrack.evaluate.registration.registration_errors`), their summary
+(:func:`summarise_registration`) and table (:func:`format_registration`). The closed loop: one cell
+per pose source (:func:`closed_loop_cells`), the camera landing off its commands, and its table
+(:func:`format_closed_loop`).
 """
 
 from collections.abc import Callable, Sequence
@@ -22,7 +24,7 @@ from ptztrack.builders.registration import (
 from ptztrack.builders.world import action_grid
 from ptztrack.config import PoseError, Scenario, ScenarioError
 from ptztrack.evaluate.metrics import episode_metrics
-from ptztrack.evaluate.registration import registration_errors
+from ptztrack.evaluate.registration import GROUND_ERRORS, registration_errors
 from ptztrack.experiments.cells import Cell, cell_policy
 from ptztrack.geometry.registration import ReferenceIndex
 from ptztrack.names import POSE_SOURCES
@@ -123,3 +125,95 @@ def run_closed_loop_cell(cell: Cell) -> dict:
         "tracker_zoom_err_pct": float(100 * np.median(error[:, 2] / episode.poses[:, 2])),
         "pose_known": float(episode.pose_known.mean()),
     }
+
+
+def summarise_registration(rows: Sequence[dict]) -> dict:
+    """Medians and 90th percentiles of the errors over the views.
+
+    A view that was not registered counts as an error larger than any, so it raises the percentiles
+    rather than vanishing from them; percentiles are order statistics (no interpolation with such
+    views), None when they fall on such a view. A view that sees none of the walkable area has no
+    ground errors and is left out of their statistics only.
+    """
+    registered = np.array([row["registered"] for row in rows])
+
+    def percentile(values, q):
+        value = float(np.percentile(values, q, method="inverted_cdf")) if len(values) else np.inf
+        return value if np.isfinite(value) else None
+
+    summary: dict[str, float | None] = {"views": len(rows), "registered": int(registered.sum())}
+    for key, needs_registration in {"focal_err_pct": True, **GROUND_ERRORS}.items():
+        # None: a view that sees nothing (NaN, left out), or one not registered (inf, when that counts).
+        values = np.array([row[key] if row["registered"] or not needs_registration else np.inf for row in rows], float)
+        values = values[~np.isnan(values)]
+        name, unit = key.rsplit("_", 1)
+        summary[f"{name}_median_{unit}"] = percentile(values, 50)
+        summary[f"{name}_p90_{unit}"] = percentile(values, 90)
+    roll_err_deg = [abs(row["roll_err_deg"]) for row in rows if row["registered"]]
+    summary["roll_err_median_deg"] = float(np.median(roll_err_deg)) if roll_err_deg else None
+    summary["register_ms_median"] = float(1e3 * np.median([row["seconds"] for row in rows]))
+    return summary
+
+
+def format_registration(summary: dict, settings: dict, reference_views: int, image_size_px) -> str:
+    """The registration's table: how many of the views registered against ``reference_views`` at
+    ``image_size_px`` (width, height), the live views (:func:`describe_live_views` of ``settings``),
+    then the median and 90th percentile of each error of ``summary`` (:func:`summarise_registration`)
+    and the median time per view."""
+    lines = [
+        f"Registration of {summary['views']} live views at random reachable poses, "
+        f"{image_size_px[0]} x {image_size_px[1]} px, "
+        f"against {reference_views} reference views: {summary['registered']} registered",
+        f"  {describe_live_views(settings)}",
+    ]
+    for name, key, unit in (
+        ("focal length error", "focal_err", "pct"),
+        ("ground error", "ground_err", "m"),
+        ("  with true pose", "oracle_ground_err", "m"),
+        ("  with lens", "lens_ground_err", "m"),
+    ):
+        median, p90 = (_unless_failed(summary[f"{key}_{which}_{unit}"]) for which in ("median", "p90"))
+        symbol = "%" if unit == "pct" else unit
+        lines.append(f"  {name:<19} median {median} {symbol}   p90 {p90} {symbol}")
+    lines.append(f"  time per view       median {summary['register_ms_median']:.0f} ms")
+    return "\n".join(lines)
+
+
+def format_closed_loop(rows: Sequence[dict], policy: str, scenario: Scenario, pose_error: PoseError) -> str:
+    """The closed loop's table: a line per pose source (:func:`run_closed_loop_cell`'s rows) of
+    ``policy`` in ``scenario``, the camera landing off its commands by ``pose_error``."""
+    lines = [
+        f"Closed loop: {policy}, {scenario.detector.kind} detector, {scenario.tracker.association} association, "
+        f"camera off its commands by {pose_error.pan_tilt_sigma_deg:g} deg and {100 * pose_error.zoom_sigma:g} % "
+        "zoom (1 sigma)"
+    ]
+    width = max(len(name) for name in POSE_SOURCES)
+    lines.append(f"  {'pose source':<{width + 2}} MOTA     MOTP [m]  pose known  tracker pose error (pan, tilt, zoom)")
+    for row in rows:
+        lines.append(
+            f"  {row['pose_source']:<{width + 2}} {row['mota']:6.1%}   {row['motp_m']:.3f}     {row['pose_known']:6.1%}"
+            f"      {row['tracker_pan_err_deg']:.3f} deg, {row['tracker_tilt_err_deg']:.3f} deg, "
+            f"{row['tracker_zoom_err_pct']:.2f} %"
+        )
+    return "\n".join(lines)
+
+
+def describe_live_views(settings: dict) -> str:
+    """One line on the registration experiment's live views (see ``live_view_settings``)."""
+    frames = (
+        f"reference views of frames {settings['reference_frames'][0]}-{settings['reference_frames'][1]}, "
+        f"live views of frames {settings['first_live_frame']} on"
+    )
+    if settings["exact"]:
+        return f"exact pinhole live views; {frames}"
+    k1 = f"k1 {settings['k1_wide']:g} at zoom 1 to {settings['k1_tele']:g} at zoom {settings['tele_zoom']:g}"
+    return (
+        f"live views rolled up to {settings['roll_max_deg']:g} deg, principal point up to "
+        f"{settings['principal_offset_max_px']:g} px off, {k1}, gain {settings['gain'][0]:g}-{settings['gain'][1]:g}, "
+        f"brightness +-{settings['brightness_max']:g}, JPEG quality {settings['jpeg_quality']}; {frames}"
+    )
+
+
+def _unless_failed(error: float | None) -> str:
+    """An error statistic, or what it means when it fell on views that were not registered."""
+    return "(unregistered views)" if error is None else f"{error:.3f}"
