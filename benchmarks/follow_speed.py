@@ -30,8 +30,8 @@ import cv2  # noqa: E402
 import numpy as np  # noqa: E402
 
 from ptztrack.builders.follow import initial_box, target_scenario, target_source  # noqa: E402
-from ptztrack.builders.follow_experiment import FollowCell, follow_run  # noqa: E402
 from ptztrack.config import pets_follow_scenario  # noqa: E402
+from ptztrack.experiments.follow import FollowCell, follow_run  # noqa: E402
 from ptztrack.files import write_json  # noqa: E402
 from ptztrack.follow.target import box_corners_carried  # noqa: E402
 from ptztrack.geometry.ptz import rotation_homography, standing_height_px  # noqa: E402

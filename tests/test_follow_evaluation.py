@@ -3,15 +3,7 @@
 import numpy as np
 import pytest
 
-from ptztrack.follow.evaluation import (
-    FOLLOW_FIGURES,
-    box_iou,
-    follow_metrics,
-    format_follow_people,
-    format_follow_table,
-    one_pass_scores,
-    summarise_follow,
-)
+from ptztrack.follow.evaluation import box_iou, follow_metrics, one_pass_scores
 
 
 def test_follow_metrics_of_a_short_run_computed_by_hand():
@@ -46,38 +38,3 @@ def test_one_pass_scores_of_perfect_shifted_and_absent_boxes():
     assert shifted["precision_20px"] == 1.0
     far = one_pass_scores(truth + [100.0, 0.0, 0.0, 0.0], truth)
     assert far["success_auc"] == 0.0 and far["precision_20px"] == 0.0
-
-
-def test_the_summary_is_a_mean_per_tracker_over_the_people_where_a_figure_is_defined():
-    rows = [
-        {
-            "tracker": "a",
-            "target_id": 1,
-            "steps": 5,
-            **dict.fromkeys(FOLLOW_FIGURES, 1.0),
-            "losses": 1,
-            "recoveries": 0,
-        },
-        {
-            "tracker": "a",
-            "target_id": 2,
-            "steps": 7,
-            **dict.fromkeys(FOLLOW_FIGURES, 3.0),
-            "losses": 2,
-            "recoveries": 2,
-        },
-        {
-            "tracker": "b",
-            "target_id": 1,
-            "steps": 5,
-            **dict.fromkeys(FOLLOW_FIGURES, 0.5),
-            "losses": 0,
-            "recoveries": 0,
-        },
-    ]
-    rows[1]["ground_error_m"] = float("nan")
-    summary = summarise_follow(rows, FOLLOW_FIGURES)
-    assert [row["tracker"] for row in summary] == ["a", "b"] and summary[0]["people"] == 2
-    assert summary[0]["in_view_fraction"] == 2.0 and summary[0]["ground_error_m"] == 1.0
-    assert "in_view_fraction" in format_follow_table(summary, FOLLOW_FIGURES)
-    assert len(format_follow_people(rows).splitlines()) == 3  # a header and two people

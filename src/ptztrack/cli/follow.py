@@ -4,15 +4,6 @@ import argparse
 import sys
 from pathlib import Path
 
-from ptztrack.builders.follow_experiment import (
-    FollowCell,
-    follow_cells,
-    follow_row,
-    follow_run,
-    otb_cells,
-    run_follow_cell,
-    run_otb_cell,
-)
 from ptztrack.cli.arguments import RUN_FOLDER_FILES
 from ptztrack.cli.scenario import recording_overrides, recording_paths
 from ptztrack.cli.watch import Watch
@@ -22,14 +13,20 @@ from ptztrack.evaluate.report import write_outputs
 from ptztrack.evaluate.video import view_renderer
 from ptztrack.evaluate.view_state import ViewState
 from ptztrack.experiments.cells import Execution, run_experiment_cells
-from ptztrack.files import check_output_folder, run_folder, write_json
-from ptztrack.follow.evaluation import (
+from ptztrack.experiments.follow import (
     FOLLOW_FIGURES,
-    OTB_FIGURES,
-    format_follow_people,
+    FollowCell,
+    follow_cells,
+    follow_row,
+    follow_run,
+    format_follow_experiment,
     format_follow_table,
-    summarise_follow,
+    otb_cells,
+    run_follow_cell,
+    run_otb_cell,
+    summarise_follow_experiment,
 )
+from ptztrack.files import check_output_folder, run_folder, write_json
 
 
 def _follow_scenario(args: argparse.Namespace, tracker: str = "particle") -> Scenario:
@@ -81,17 +78,9 @@ def follow_experiment_command(args: argparse.Namespace) -> int:
     otb_runs = otb_cells(scenario, args.trackers, args.otb_tracks, args.seed)
     print(f"{len(otb_runs)} one-pass runs on the still recording", file=sys.stderr)
     otb_people = run_experiment_cells(otb_runs, run_otb_cell, execution, "run")
-    closed_loop, otb = summarise_follow(people, FOLLOW_FIGURES), summarise_follow(otb_people, OTB_FIGURES)
-    print(
-        f"Follow camera, {scenario.camera.image_size_px[0]} x {scenario.camera.image_size_px[1]} view, "
-        f"person {scenario.follow.target_height_px:g} px tall wanted; per person:"
-    )
-    print(format_follow_people(people))
-    print(format_follow_table(closed_loop, FOLLOW_FIGURES, "\nMeans over the people:"))
-    tracks = ", ".join(str(row["target_id"]) for row in otb_people[: len(otb_people) // len(args.trackers)])
-    print(format_follow_table(otb, OTB_FIGURES, f"\nOne-pass (OTB) on the still recording, people {tracks}:"))
+    summary = summarise_follow_experiment(people, otb_people)
+    print(format_follow_experiment(scenario, summary, args.trackers))
     if args.json is not None:
-        document = {"closed_loop": closed_loop, "otb": otb, "people": people, "otb_people": otb_people}
-        write_json(args.json, document)
+        write_json(args.json, summary)
         print(f"wrote {args.json}")
     return 0

@@ -23,7 +23,7 @@ is steered to frame them:
 
 Nothing here reads the configuration. The scenario's ``follow`` section is
 :mod:`ptztrack.config.follow`; :mod:`ptztrack.builders.follow` turns it into
-these objects and :mod:`ptztrack.builders.follow_experiment` into the
-experiment's cells; the commands ``ptztrack follow`` and ``ptztrack
-experiment follow`` are :mod:`ptztrack.cli.follow`.
+these objects; the experiment (its cells, their run, its summary and tables)
+is :mod:`ptztrack.experiments.follow`; the commands ``ptztrack follow`` and
+``ptztrack experiment follow`` are :mod:`ptztrack.cli.follow`.
 """

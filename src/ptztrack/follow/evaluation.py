@@ -32,18 +32,6 @@ from ptztrack.camera.virtual import VirtualPTZ
 
 SUCCESS_THRESHOLDS = np.linspace(0.0, 1.0, 21)
 PRECISION_PX = 20.0
-FOLLOW_FIGURES = (
-    "in_view_fraction",
-    "target_point_error",
-    "losses",
-    "recoveries",
-    "lost_steps",
-    "jitter_deg",
-    "height_sd_ratio",
-    "ground_error_m",
-    "zoom",
-)
-OTB_FIGURES = ("success_auc", "precision_20px", "fps")
 
 
 def target_in_views(virtual: VirtualPTZ, boxes_px, poses) -> tuple[np.ndarray, np.ndarray]:
@@ -117,53 +105,3 @@ def one_pass_scores(tracked_px, annotated_px) -> dict:
         "precision_20px": float(np.mean(centre_error_px <= PRECISION_PX)),
         "frames": len(overlap),
     }
-
-
-def summarise_follow(rows: list[dict], figures) -> list[dict]:
-    """One row per tracker (in the order they first appear): the mean over people of each figure (of those
-    where it is defined: a person never tracked has no ground error), and ``people``."""
-    trackers = list(dict.fromkeys(row["tracker"] for row in rows))
-    summary = []
-    for tracker in trackers:
-        mine = [row for row in rows if row["tracker"] == tracker]
-        means = {name: _mean([row[name] for row in mine]) for name in figures}
-        summary.append({"tracker": tracker, **means, "people": len(mine)})
-    return summary
-
-
-def _mean(values) -> float:
-    values = np.asarray(values, dtype=float)
-    return float(np.mean(values[np.isfinite(values)])) if np.isfinite(values).any() else float("nan")
-
-
-def format_follow_table(summary: list[dict], figures, title: str = "") -> str:
-    """A plain-text table: one column per tracker, one row per figure."""
-    width = max(len(name) for name in figures) + 2
-    lines = [title] if title else []
-    lines.append(" " * width + "".join(f"{row['tracker']:>12}" for row in summary))
-    for figure in figures:
-        lines.append(f"{figure:<{width}}" + "".join(f"{row[figure]:>12.3f}" for row in summary))
-    return "\n".join(lines)
-
-
-def format_follow_people(rows: list[dict]) -> str:
-    """One line per person: steps, then per tracker the in-view fraction, the target point error and the
-    losses declared / recoveries."""
-    trackers = list(dict.fromkeys(row["tracker"] for row in rows))
-    by_person: dict[int, dict] = {}
-    for row in rows:
-        by_person.setdefault(row["target_id"], {})[row["tracker"]] = row
-    header = "person  steps" + "".join(f"   {name + ': in view, TPE, losses/rec.':<32}" for name in trackers)
-    lines = [header]
-    for person, mine in sorted(by_person.items()):
-        steps = next(iter(mine.values()))["steps"]
-        cells = []
-        for name in trackers:
-            found = mine.get(name)
-            cell = ""
-            if found is not None:
-                losses = f"{found['losses']:3d}/{found['recoveries']}"
-                cell = f"{found['in_view_fraction']:6.1%}  {found['target_point_error']:.3f}  {losses}"
-            cells.append(f"   {cell:<32}")
-        lines.append(f"{person:>6}  {steps:>5}" + "".join(cells))
-    return "\n".join(lines)

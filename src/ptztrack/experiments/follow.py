@@ -1,5 +1,6 @@
-"""The follow experiment as cells: every person followed by every tracker in the closed loop, and the
-trackers alone on the still recording (the OTB one-pass protocol).
+"""The robot-cameraman paper's follow experiment: every person followed by every tracker in the closed
+loop, and the trackers alone on the still recording (the OTB one-pass protocol); per tracker, the
+means over the people of their figures, and the tables.
 
 Each cell is a function of its inputs (the seed fixes the particle filter's
 draws), so every executor gives the same rows; but not MIL's: OpenCV's MIL
@@ -24,6 +25,21 @@ from ptztrack.loop import Episode, StepObserver, World, episode_seeds
 from ptztrack.names import OTB_TRACKS
 from ptztrack.roles import Policy
 from ptztrack.scene.pets import Annotations, RecordedVideo, load_mot_ground_truth
+
+# The tables' rows: the closed loop's figures (follow_metrics', with follow_row's ground error and zoom),
+# and the one-pass scores with the tracker's frames per second.
+FOLLOW_FIGURES = (
+    "in_view_fraction",
+    "target_point_error",
+    "losses",
+    "recoveries",
+    "lost_steps",
+    "jitter_deg",
+    "height_sd_ratio",
+    "ground_error_m",
+    "zoom",
+)
+OTB_FIGURES = ("success_auc", "precision_20px", "fps")
 
 
 @dataclass(frozen=True)
@@ -166,3 +182,79 @@ def run_otb_cell(cell: OnePassCell) -> dict:
     annotated = np.all(np.isfinite(boxes), axis=1)
     scores = one_pass_scores(tracked[annotated], boxes[annotated])
     return {"tracker": cell.tracker, "target_id": cell.target_id, **scores, "fps": len(frames) / elapsed_s}
+
+
+def summarise_follow(rows: list[dict], figures) -> list[dict]:
+    """One row per tracker (in the order they first appear): the mean over people of each figure (of those
+    where it is defined: a person never tracked has no ground error), and ``people``."""
+    trackers = list(dict.fromkeys(row["tracker"] for row in rows))
+    summary = []
+    for tracker in trackers:
+        mine = [row for row in rows if row["tracker"] == tracker]
+        means = {name: _mean([row[name] for row in mine]) for name in figures}
+        summary.append({"tracker": tracker, **means, "people": len(mine)})
+    return summary
+
+
+def _mean(values) -> float:
+    values = np.asarray(values, dtype=float)
+    return float(np.mean(values[np.isfinite(values)])) if np.isfinite(values).any() else float("nan")
+
+
+def format_follow_table(summary: list[dict], figures, title: str = "") -> str:
+    """A plain-text table: one column per tracker, one row per figure."""
+    width = max(len(name) for name in figures) + 2
+    lines = [title] if title else []
+    lines.append(" " * width + "".join(f"{row['tracker']:>12}" for row in summary))
+    for figure in figures:
+        lines.append(f"{figure:<{width}}" + "".join(f"{row[figure]:>12.3f}" for row in summary))
+    return "\n".join(lines)
+
+
+def format_follow_people(rows: list[dict]) -> str:
+    """One line per person: steps, then per tracker the in-view fraction, the target point error and the
+    losses declared / recoveries."""
+    trackers = list(dict.fromkeys(row["tracker"] for row in rows))
+    by_person: dict[int, dict] = {}
+    for row in rows:
+        by_person.setdefault(row["target_id"], {})[row["tracker"]] = row
+    header = "person  steps" + "".join(f"   {name + ': in view, TPE, losses/rec.':<32}" for name in trackers)
+    lines = [header]
+    for person, mine in sorted(by_person.items()):
+        steps = next(iter(mine.values()))["steps"]
+        cells = []
+        for name in trackers:
+            found = mine.get(name)
+            cell = ""
+            if found is not None:
+                losses = f"{found['losses']:3d}/{found['recoveries']}"
+                cell = f"{found['in_view_fraction']:6.1%}  {found['target_point_error']:.3f}  {losses}"
+            cells.append(f"   {cell:<32}")
+        lines.append(f"{person:>6}  {steps:>5}" + "".join(cells))
+    return "\n".join(lines)
+
+
+def summarise_follow_experiment(people: list[dict], otb_people: list[dict]) -> dict:
+    """The experiment's figures: per tracker the means over the people of the closed loop's
+    (``closed_loop``, of ``people``: :func:`run_follow_cell`'s rows) and of the one-pass scores
+    (``otb``, of ``otb_people``: :func:`run_otb_cell`'s rows), and those rows (``people``, ``otb_people``)."""
+    closed_loop, otb = summarise_follow(people, FOLLOW_FIGURES), summarise_follow(otb_people, OTB_FIGURES)
+    return {"closed_loop": closed_loop, "otb": otb, "people": people, "otb_people": otb_people}
+
+
+def format_follow_experiment(scenario: Scenario, summary: dict, trackers) -> str:
+    """The experiment's tables (``summary``: :func:`summarise_follow_experiment`'s, of ``trackers`` in
+    ``scenario``): a line per person, the closed loop's means over the people, and the one-pass scores."""
+    people, otb_people = summary["people"], summary["otb_people"]
+    tracks = ", ".join(str(row["target_id"]) for row in otb_people[: len(otb_people) // len(trackers)])
+    return "\n".join(
+        [
+            f"Follow camera, {scenario.camera.image_size_px[0]} x {scenario.camera.image_size_px[1]} view, "
+            f"person {scenario.follow.target_height_px:g} px tall wanted; per person:",
+            format_follow_people(people),
+            format_follow_table(summary["closed_loop"], FOLLOW_FIGURES, "\nMeans over the people:"),
+            format_follow_table(
+                summary["otb"], OTB_FIGURES, f"\nOne-pass (OTB) on the still recording, people {tracks}:"
+            ),
+        ]
+    )
