@@ -8,28 +8,17 @@ from pathlib import Path
 import numpy as np
 import psutil
 
-from ptztrack.builders.factories import TRACKER_FIELDS
-from ptztrack.config import (
-    MAX_DATASET_FRAMES,
-    DatasetView,
-    MultiViewDataset,
-    Occupancy,
-    OccupancyTracker,
-    Tracker,
-)
+from ptztrack.config import MAX_DATASET_FRAMES, DatasetView, MultiViewDataset, Occupancy
 from ptztrack.geometry.calibration import PinholeCalibration, load_pinhole, load_tsai, pinhole_from_tsai
-from ptztrack.occupancy.detectors import ClusteringDetector, LpomDetector, LpomParameters
-from ptztrack.occupancy.evaluation import OccupancyRun, detect_frames, score_recording
+from ptztrack.occupancy.detectors import LpomParameters
 from ptztrack.occupancy.locus import PERSON, ConeModel
 from ptztrack.occupancy.lpom import LocusSampling, sampled_heights
 from ptztrack.occupancy.motion_edges import MotionEdgeParameters
 from ptztrack.occupancy.multiview import CameraView, ImageFolder, MultiViewRecording, load_mot_detections, mot_truth
 from ptztrack.occupancy.room import RoomLayout, RoomRenderer, room_truth
 from ptztrack.scene.pets import DatasetError, RecordedVideo
-from ptztrack.track.tracker import TrackerParameters
 
 ROOM_AREA_M = ((0.0, 0.0), (5.0, 6.0))
-ROOM_PEOPLE = (1, 3)
 # 20 s at 15 Hz per sequence (the paper's were 3.5 and 7 minutes long).
 ROOM = RoomLayout()
 
@@ -176,42 +165,3 @@ def room_recording(people: int, frames: int, seed: int, layout: RoomLayout = ROO
 def _view_frames(renderer: RoomRenderer, view: int) -> Callable[[int], np.ndarray]:
     """The view's frames, the last two kept: both detectors ask for each frame, LPOM for the one before too."""
     return functools.lru_cache(maxsize=2)(functools.partial(renderer.image, view))
-
-
-def run_recording(
-    recording: MultiViewRecording,
-    occupancy: Occupancy,
-    tracker: Tracker,
-    label: dict | None = None,
-    progress: Callable[[int, int], None] | None = None,
-) -> OccupancyRun:
-    """Both detectors over every frame of ``recording``, scored (the recording needs ground truth)."""
-    if recording.truth is None:
-        raise DatasetError(f"{recording.name}: the experiment needs ground truth (ground_truth)")
-    parameters = lpom_parameters(occupancy)
-    refuse_if_tables_too_large(recording, parameters)
-    lpom = LpomDetector(recording, parameters)
-    clustering = ClusteringDetector(recording, occupancy.linkage_m, occupancy.min_box_score, occupancy.blob_min_area_px)
-    frames = detect_frames(recording, lpom, clustering, progress)
-    # People leave a dataset's area (and never the room's, whose tracks stay well localised).
-    tracking = TrackerParameters(
-        **{name: getattr(tracker, name) for name in TRACKER_FIELDS}, max_position_sigma_m=tracker.max_position_sigma_m
-    )
-    return score_recording(
-        recording, lpom.grid, frames, tracker.acceleration_sigma_m_s2, tracking, occupancy.separation_m, label
-    )
-
-
-def dataset_runs(dataset: MultiViewDataset, frames: int | None, progress=None) -> list[OccupancyRun]:
-    recording = recording_from_dataset(dataset, frames)
-    return [run_recording(recording, dataset.occupancy, dataset.tracker, None, progress)]
-
-
-def room_runs(frames: int, seed: int, progress=None) -> list[OccupancyRun]:
-    """The synthetic room with 1 and with 3 people (seeds ``seed`` and ``seed + 1``), default parameters."""
-    return [
-        run_recording(
-            room_recording(people, frames, seed + index), Occupancy(), OccupancyTracker(), {"people": people}, progress
-        )
-        for index, people in enumerate(ROOM_PEOPLE)
-    ]

@@ -19,7 +19,8 @@ the "detector and clustering" baseline of the multi-view literature.
 
 The modules take plain parameters. The dataset file's models live in
 :mod:`ptztrack.config.dataset`, the recordings and parameters are built from
-them in :mod:`ptztrack.builders.occupancy`, and ``ptztrack experiment
+them in :mod:`ptztrack.builders.occupancy`, the experiment (its runs and
+table) is :mod:`ptztrack.experiments.occupancy`, and ``ptztrack experiment
 occupancy`` is :mod:`ptztrack.cli.occupancy`. The ground-plane tracker the
 modes feed is :func:`ptztrack.track.tracker.update_tracks_on_ground`.
 """
