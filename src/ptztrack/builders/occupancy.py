@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import psutil
 
-from ptztrack.builders.factories import TRACKER_FIELDS
+from ptztrack.builders.factories import parameters_from
 from ptztrack.config import (
     MAX_DATASET_FRAMES,
     DatasetView,
@@ -26,7 +26,7 @@ from ptztrack.occupancy.motion_edges import MotionEdgeParameters
 from ptztrack.occupancy.multiview import CameraView, ImageFolder, MultiViewRecording, load_mot_detections, mot_truth
 from ptztrack.occupancy.room import RoomLayout, RoomRenderer, room_truth
 from ptztrack.scene.pets import DatasetError, RecordedVideo
-from ptztrack.track.tracker import TrackerParameters
+from ptztrack.track.parameters import TrackerParameters
 
 ROOM_AREA_M = ((0.0, 0.0), (5.0, 6.0))
 ROOM_PEOPLE = (1, 3)
@@ -194,12 +194,8 @@ def run_recording(
     clustering = ClusteringDetector(recording, occupancy.linkage_m, occupancy.min_box_score, occupancy.blob_min_area_px)
     frames = detect_frames(recording, lpom, clustering, progress)
     # People leave a dataset's area (and never the room's, whose tracks stay well localised).
-    tracking = TrackerParameters(
-        **{name: getattr(tracker, name) for name in TRACKER_FIELDS}, max_position_sigma_m=tracker.max_position_sigma_m
-    )
-    return score_recording(
-        recording, lpom.grid, frames, tracker.acceleration_sigma_m_s2, tracking, occupancy.separation_m, label
-    )
+    tracking = parameters_from(tracker, TrackerParameters)
+    return score_recording(recording, lpom.grid, frames, tracking, occupancy.separation_m, label)
 
 
 def dataset_runs(dataset: MultiViewDataset, frames: int | None, progress=None) -> list[OccupancyRun]:

@@ -27,6 +27,7 @@ from ptztrack.config.fields import (
 )
 from ptztrack.config.follow import Follow
 from ptztrack.config.reading import ScenarioError, _first_error_line, read_yaml
+from ptztrack.track.parameters import TrackerParameters
 
 _Speed = Annotated[PositiveFloat, at_most(15, "metres per second: faster than anyone runs")]
 _Height = Annotated[PositiveFloat, at_most(3, "metres: taller than anyone")]
@@ -123,6 +124,8 @@ class Detector(_Strict):
 class Tracker(_Strict):
     """The ground-plane tracker: by default (``kind`` 'ekf') one EKF per person, and its data association.
 
+    The fields shared with :class:`~ptztrack.track.parameters.TrackerParameters` take its defaults.
+
     association : 'hungarian' (one detection per track, assigned on the
     Mahalanobis distance) or 'cjpdaf' (Fitzgerald's Cheap JPDAF, equation 6
     of Lisanti et al.: every track is updated with all detections in its
@@ -154,19 +157,27 @@ class Tracker(_Strict):
 
     kind: Annotated[str, _registered("trackers")] = "ekf"
     options: Options = Field(default_factory=dict)
-    acceleration_sigma_m_s2: Annotated[PositiveFloat, at_most(100, "metres per second squared")] = 1.5
-    initial_speed_sigma_m_s: Annotated[PositiveFloat, at_most(100, "metres per second")] = 0.9
-    gate_probability: float = Field(0.99, gt=0, lt=1)
-    existence_at_birth: float = Field(0.5, gt=0, lt=1)
-    existence_when_detected: float = Field(0.99, gt=0, lt=1)
-    existence_to_delete: float = Field(0.1, gt=0, lt=1)
-    max_position_sigma_m: Annotated[PositiveFloat, at_most(10_000, "metres")] = 2.0
-    confirmation_hits: Annotated[int, Field(ge=1), at_most(_MAX_FRAMES, "steps")] = 1
-    report_position_sigma_m: Annotated[PositiveFloat, at_most(10_000, "metres")] = 1.0
-    existence_update: Literal["bayes", "fixed"] = "bayes"
-    existence_to_report: float = Field(0.5, gt=0, lt=1)
-    association: Literal["hungarian", "cjpdaf"] = "hungarian"
-    clutter_density_per_px2: Annotated[NonNegativeFloat, at_most(1, "detections per pixel")] = 0.0
+    acceleration_sigma_m_s2: Annotated[PositiveFloat, at_most(100, "metres per second squared")] = (
+        TrackerParameters.acceleration_sigma_m_s2
+    )
+    initial_speed_sigma_m_s: Annotated[PositiveFloat, at_most(100, "metres per second")] = (
+        TrackerParameters.initial_speed_sigma_m_s
+    )
+    gate_probability: float = Field(TrackerParameters.gate_probability, gt=0, lt=1)
+    existence_at_birth: float = Field(TrackerParameters.existence_at_birth, gt=0, lt=1)
+    existence_when_detected: float = Field(TrackerParameters.existence_when_detected, gt=0, lt=1)
+    existence_to_delete: float = Field(TrackerParameters.existence_to_delete, gt=0, lt=1)
+    max_position_sigma_m: Annotated[PositiveFloat, at_most(10_000, "metres")] = TrackerParameters.max_position_sigma_m
+    confirmation_hits: Annotated[int, Field(ge=1), at_most(_MAX_FRAMES, "steps")] = TrackerParameters.confirmation_hits
+    report_position_sigma_m: Annotated[PositiveFloat, at_most(10_000, "metres")] = (
+        TrackerParameters.report_position_sigma_m
+    )
+    existence_update: Literal["bayes", "fixed"] = TrackerParameters.existence_update
+    existence_to_report: float = Field(TrackerParameters.existence_to_report, gt=0, lt=1)
+    association: Literal["hungarian", "cjpdaf"] = TrackerParameters.association
+    clutter_density_per_px2: Annotated[NonNegativeFloat, at_most(1, "detections per pixel")] = (
+        TrackerParameters.clutter_density_per_px2
+    )
     measurement_source: Literal["detector", "spatiogram"] = "detector"
     detector_every_steps: Annotated[int, Field(ge=1), at_most(_MAX_FRAMES, "steps")] = 5
 
