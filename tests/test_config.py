@@ -3,7 +3,7 @@ from pathlib import Path
 import pytest
 
 from ptztrack.builders.world import action_grid
-from ptztrack.config import Scenario, ScenarioError, load_scenario, scenario_from_dict
+from ptztrack.config import Scenario, ScenarioError, load_scenario, pets_scenario, scenario_from_dict
 
 EXAMPLE = Path(__file__).parent.parent / "examples" / "scenario.yaml"
 
@@ -66,3 +66,17 @@ def test_an_unknown_association_is_refused_naming_the_field():
     assert "tracker.association: Input should be 'hungarian' or 'cjpdaf' (got 'jpda')" in str(error.value)
     with pytest.raises(ScenarioError, match="tracker.clutter_density_per_px2: Input should be greater than or equal"):
         scenario_from_dict({"tracker": {"clutter_density_per_px2": -1e-6}})
+
+
+def test_hog_needs_a_recording_with_video():
+    with pytest.raises(ScenarioError, match="'hog' needs a recording with a video"):
+        scenario_from_dict({"detector": {"kind": "hog"}})
+
+
+def test_the_scenario_chooses_the_search_and_refuses_a_falling_height_range():
+    scenario = pets_scenario("hog")
+    assert scenario.detector.hog_search == "ground" and scenario.detector.hog_person_height_m == (1.5, 2.0)
+    with pytest.raises(ScenarioError, match="hog_person_height_m must be"):
+        pets_scenario("hog", **{"detector.hog_person_height_m": (2.0, 1.5)})
+    with pytest.raises(ScenarioError, match="hog_search"):
+        pets_scenario("hog", **{"detector.hog_search": "sky"})

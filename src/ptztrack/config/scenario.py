@@ -27,6 +27,7 @@ from ptztrack.config.fields import (
 )
 from ptztrack.config.follow import Follow
 from ptztrack.config.reading import ScenarioError, _first_error_line, read_yaml
+from ptztrack.detect.parameters import DetectorPrior, HogParameters
 from ptztrack.track.parameters import TrackerParameters
 
 _Speed = Annotated[PositiveFloat, at_most(15, "metres per second: faster than anyone runs")]
@@ -78,6 +79,9 @@ class Detector(_Strict):
     (:mod:`ptztrack.detect.detector_model`); 'a-priori' keeps the prior, 'true' plans with the
     simulation's own curve, and a file path starts from what an earlier run learned.
 
+    The recall curve's, the noise's and the HOG fields' defaults are those of
+    :class:`~ptztrack.detect.parameters.DetectorPrior` and :class:`~ptztrack.detect.parameters.HogParameters`.
+
     hog_search : 'ground' scans only the windows where a standing person ``hog_person_height_m``
     (shortest, tallest) tall could be seen on the walkable area, at their sizes; 'image' scans every
     window of the pyramid, as OpenCV's ``detectMultiScale`` (:mod:`ptztrack.detect.hog`).
@@ -85,17 +89,19 @@ class Detector(_Strict):
 
     kind: Annotated[str, _registered("detectors")] = "realistic"
     options: Options = Field(default_factory=dict)
-    recall_kd: Annotated[PositiveFloat, at_most(100, "per pixel")] = 0.0098
-    recall_r0_px: Annotated[NonNegativeFloat, at_most(10_000, "pixels")] = 21.29
-    pixel_noise_px: Annotated[NonNegativeFloat, at_most(10_000, "pixels")] = 2.0
+    recall_kd: Annotated[PositiveFloat, at_most(100, "per pixel")] = DetectorPrior.recall_kd
+    recall_r0_px: Annotated[NonNegativeFloat, at_most(10_000, "pixels")] = DetectorPrior.recall_r0_px
+    pixel_noise_px: Annotated[NonNegativeFloat, at_most(10_000, "pixels")] = DetectorPrior.pixel_noise_px
     false_positives_per_frame: Annotated[
         NonNegativeFloat, at_most(1000, "time and memory: every detection is kept and associated")
-    ] = 0.0
-    hog_upsample: Annotated[PositiveFloat, at_most(16, "memory: the view is upsampled this much each way")] = 6.0
-    hog_hit_threshold: float = 0.0
-    hog_nms_iou: float = Field(0.4, gt=0, le=1)
+    ] = DetectorPrior.false_positives_per_frame
+    hog_upsample: Annotated[PositiveFloat, at_most(16, "memory: the view is upsampled this much each way")] = (
+        HogParameters.upsample
+    )
+    hog_hit_threshold: float = HogParameters.hit_threshold
+    hog_nms_iou: float = Field(HogParameters.nms_iou, gt=0, le=1)
     hog_search: Literal["ground", "image"] = "ground"
-    hog_person_height_m: tuple[_Height, _Height] = (1.5, 2.0)
+    hog_person_height_m: tuple[_Height, _Height] = HogParameters.person_heights_m
     model: str = "online"
     prior_shift_px: Annotated[float, Field(ge=-1000, le=1000)] = 0.0
 
