@@ -27,6 +27,7 @@ from ptztrack.config.fields import (
 )
 from ptztrack.config.follow import Follow
 from ptztrack.config.reading import ScenarioError, _first_error_line, read_yaml
+from ptztrack.control.parameters import ControlParameters
 from ptztrack.detect.parameters import DetectorPrior, HogParameters
 from ptztrack.track.parameters import TrackerParameters
 
@@ -189,14 +190,21 @@ class Tracker(_Strict):
 
 
 class Control(_Strict):
-    """Parameters of the information-gain policies (paper sections 4 and 4.4)."""
+    """Parameters of the information-gain policies (paper sections 4 and 4.4); the defaults are those of
+    :class:`~ptztrack.control.parameters.ControlParameters`."""
 
-    samples: Annotated[int, Field(ge=1), at_most(10_000, "time: smpl scores every sample under every action")] = 100
-    beta: Annotated[NonNegativeFloat, at_most(1e6, "a weight")] = 0.0
-    person_height_m: _Height = 1.75
-    exploration_cell_m: Annotated[float, Field(ge=0.05), at_most(1000, "metres")] = 1.0
-    prior_untracked_people: Annotated[NonNegativeFloat, at_most(10_000, "people")] = 1.0
-    arrival_rate_per_s: Annotated[NonNegativeFloat, at_most(1000, "people per second")] = 0.1
+    samples: Annotated[int, Field(ge=1), at_most(10_000, "time: smpl scores every sample under every action")] = (
+        ControlParameters.samples
+    )
+    beta: Annotated[NonNegativeFloat, at_most(1e6, "a weight")] = ControlParameters.beta
+    person_height_m: _Height = ControlParameters.person_height_m
+    exploration_cell_m: Annotated[float, Field(ge=0.05), at_most(1000, "metres")] = ControlParameters.exploration_cell_m
+    prior_untracked_people: Annotated[NonNegativeFloat, at_most(10_000, "people")] = (
+        ControlParameters.prior_untracked_people
+    )
+    arrival_rate_per_s: Annotated[NonNegativeFloat, at_most(1000, "people per second")] = (
+        ControlParameters.arrival_rate_per_s
+    )
 
 
 _VideoFrame = Annotated[int, Field(ge=0), at_most(10_000_000, "video frames: 4 days at 30 Hz")]
