@@ -5,12 +5,10 @@ camera backends and detectors from a scenario and its :class:`~ptztrack.builders
 """
 
 import math
-from dataclasses import fields
 from functools import partial
-from typing import Literal, TypeVar
+from typing import Literal
 
-from pydantic import BaseModel
-
+from ptztrack.builders.parameters import parameters_from
 from ptztrack.builders.registration import live_view_model
 from ptztrack.builders.world import recall_model
 from ptztrack.camera.recorded import RecordedPTZ
@@ -27,15 +25,6 @@ from ptztrack.scene.pets import RecordedVideo
 from ptztrack.track.parameters import TrackerParameters
 from ptztrack.track.templates import TemplateTracker
 from ptztrack.track.tracker import DetectionModel, EkfTracker, pixel_noise_covariance
-
-P = TypeVar("P")
-
-
-def parameters_from(section: BaseModel, parameters_type: type[P], **overrides) -> P:
-    """``parameters_type`` (a dataclass of the maths) with the values of the fields that the configuration
-    ``section`` shares with it, then ``overrides``: the section's defaults are the dataclass's own."""
-    shared = {field.name for field in fields(parameters_type)} & set(type(section).model_fields)
-    return parameters_type(**{name: getattr(section, name) for name in shared} | overrides)
 
 
 def expected_model(scenario: Scenario, world: World) -> RecallCurve:

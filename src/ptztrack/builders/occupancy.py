@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import psutil
 
-from ptztrack.builders.factories import parameters_from
+from ptztrack.builders.parameters import parameters_from
 from ptztrack.config import (
     MAX_DATASET_FRAMES,
     DatasetView,

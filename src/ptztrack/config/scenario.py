@@ -29,6 +29,7 @@ from ptztrack.config.follow import Follow
 from ptztrack.config.reading import ScenarioError, _first_error_line, read_yaml
 from ptztrack.control.parameters import ControlParameters
 from ptztrack.detect.parameters import DetectorPrior, HogParameters
+from ptztrack.scene.parameters import Crowd
 from ptztrack.track.parameters import TrackerParameters
 
 _Speed = Annotated[PositiveFloat, at_most(15, "metres per second: faster than anyone runs")]
@@ -37,19 +38,25 @@ _Stay = Annotated[PositiveFloat, at_most(86_400, "seconds: a day")]
 
 
 class People(_Strict):
-    """The synthetic crowd (:mod:`ptztrack.scene.synthetic`). paired_fraction : the share of the
-    ``count`` people who walk in pairs, side by side ``pair_spacing_m`` apart (pairs: the fraction
-    of count / 2, rounded)."""
+    """The synthetic crowd (:class:`~ptztrack.scene.parameters.Crowd`, whose defaults it takes).
+    paired_fraction : the share of the ``count`` people who walk in pairs, side by side
+    ``pair_spacing_m`` apart (pairs: the fraction of count / 2, rounded)."""
 
-    count: Annotated[int, Field(ge=0), at_most(1000, "time: the policies score every person under every action")] = 7
-    speed_m_s: tuple[_Speed, _Speed] = (1.0, 1.5)
-    height_m: tuple[_Height, _Height] = (1.6, 1.9)
-    width_m: Annotated[PositiveFloat, at_most(3, "metres: a person's width")] = 0.62
-    turn_rate_sigma_deg_s: Annotated[NonNegativeFloat, at_most(3600, "degrees per second")] = 40.0
-    enter_leave: bool = False
-    stay_s: tuple[_Stay, _Stay] = (8.0, 20.0)
-    paired_fraction: float = Field(0.85, ge=0, le=1)
-    pair_spacing_m: Annotated[PositiveFloat, at_most(10, "metres between two people walking together")] = 0.75
+    count: Annotated[int, Field(ge=0), at_most(1000, "time: the policies score every person under every action")] = (
+        Crowd.count
+    )
+    speed_m_s: tuple[_Speed, _Speed] = Crowd.speed_m_s
+    height_m: tuple[_Height, _Height] = Crowd.height_m
+    width_m: Annotated[PositiveFloat, at_most(3, "metres: a person's width")] = Crowd.width_m
+    turn_rate_sigma_deg_s: Annotated[NonNegativeFloat, at_most(3600, "degrees per second")] = (
+        Crowd.turn_rate_sigma_deg_s
+    )
+    enter_leave: bool = Crowd.enter_leave
+    stay_s: tuple[_Stay, _Stay] = Crowd.stay_s
+    paired_fraction: float = Field(Crowd.paired_fraction, ge=0, le=1)
+    pair_spacing_m: Annotated[PositiveFloat, at_most(10, "metres between two people walking together")] = (
+        Crowd.pair_spacing_m
+    )
 
     @model_validator(mode="after")
     def _intervals_ordered(self):
@@ -58,11 +65,6 @@ class People(_Strict):
             if high < low:
                 raise ValueError(f"{name} must be [low, high] with low <= high (got {[low, high]})")
         return self
-
-    @property
-    def pairs(self) -> int:
-        """How many pairs walk side by side (never more than there are people for)."""
-        return min(round(self.paired_fraction * self.count / 2), self.count // 2)
 
 
 # How the policies and the tracker know the detector: its prior curve fixed, learned from the run, or the
