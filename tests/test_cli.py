@@ -13,6 +13,7 @@ from pathlib import Path
 import pytest
 
 from ptztrack.cli import main
+from ptztrack.cli.scenario import build_scenario
 
 
 def test_run_writes_metrics_tracks_and_picture(tmp_path, capsys):
@@ -189,3 +190,13 @@ def test_a_progress_bar_in_a_terminal_and_none_with_quiet(monkeypatch):
     assert "episodes:" not in quiet and "%|" not in quiet and "4 episodes, serial executor" in quiet
     run = _stderr(["run", "--frames", "6", "--policy", "fix"], monkeypatch)
     assert re.search(r"steps: 100%\|.*\| 6/6 \[\d\d:\d\d<00:00, +[\d.]+step/s\]", run), run
+
+
+def test_the_command_line_selects_the_cjpdaf_association(capsys):
+    assert build_scenario("pets", "hog", association="cjpdaf").tracker.association == "cjpdaf"
+    assert build_scenario("synthetic", association="cjpdaf").tracker.association == "cjpdaf"
+    assert main(["run", "--scenario", "pets", "--policy", "fix", "--association", "cjpdaf", "--frames", "5"]) == 0
+    assert "MOTA" in capsys.readouterr().out
+    with pytest.raises(SystemExit) as error:
+        main(["run", "--association", "greedy"])
+    assert error.value.code == 2

@@ -3,7 +3,7 @@ from pathlib import Path
 import pytest
 
 from ptztrack.builders.world import action_grid
-from ptztrack.config import Scenario, ScenarioError, load_scenario
+from ptztrack.config import Scenario, ScenarioError, load_scenario, pets_scenario, scenario_from_dict
 
 EXAMPLE = Path(__file__).parent.parent / "examples" / "scenario.yaml"
 
@@ -58,3 +58,25 @@ def test_overrides_apply_on_top_of_the_file(tmp_path):
     assert scenario.frames == 10
     assert scenario.detector.kind == "ideal"
     assert scenario.detector.pixel_noise_px == 1.0
+
+
+def test_an_unknown_association_is_refused_naming_the_field():
+    with pytest.raises(ScenarioError) as error:
+        scenario_from_dict({"tracker": {"association": "jpda"}})
+    assert "tracker.association: Input should be 'hungarian' or 'cjpdaf' (got 'jpda')" in str(error.value)
+    with pytest.raises(ScenarioError, match="tracker.clutter_density_per_px2: Input should be greater than or equal"):
+        scenario_from_dict({"tracker": {"clutter_density_per_px2": -1e-6}})
+
+
+def test_hog_needs_a_recording_with_video():
+    with pytest.raises(ScenarioError, match="'hog' needs a recording with a video"):
+        scenario_from_dict({"detector": {"kind": "hog"}})
+
+
+def test_the_scenario_chooses_the_search_and_refuses_a_falling_height_range():
+    scenario = pets_scenario("hog")
+    assert scenario.detector.hog_search == "ground" and scenario.detector.hog_person_height_m == (1.5, 2.0)
+    with pytest.raises(ScenarioError, match="hog_person_height_m must be"):
+        pets_scenario("hog", **{"detector.hog_person_height_m": (2.0, 1.5)})
+    with pytest.raises(ScenarioError, match="hog_search"):
+        pets_scenario("hog", **{"detector.hog_search": "sky"})

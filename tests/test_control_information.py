@@ -9,7 +9,6 @@ from overhead import overhead_scenario
 from ptztrack.builders.episode import make_policy
 from ptztrack.builders.factories import recall_model
 from ptztrack.builders.world import action_grid, build_world, ptz_camera
-from ptztrack.config import Control
 from ptztrack.control.gaussian_rectangle import bivariate_normal_cdf, gaussian_rectangle_probability
 from ptztrack.control.information_gain import (
     action_geometry,
@@ -17,6 +16,7 @@ from ptztrack.control.information_gain import (
     detection_weight_sampled,
     information_if_detected_nats,
 )
+from ptztrack.control.parameters import ControlParameters
 from ptztrack.geometry.occlusion import occluded_fraction, occlusion_in_centred_views
 from ptztrack.geometry.ptz import (
     apply_homography,
@@ -346,5 +346,5 @@ def test_without_tracks_the_patrolling_term_moves_the_camera_and_without_it_the_
 
 def test_control_defaults_are_the_papers_synthetic_protocol():
     """M = 100 samples, and no patrolling term: in section 5.1 "the targets are always in the scene"."""
-    assert Control().samples == 100
-    assert Control().beta == 0.0
+    assert ControlParameters().samples == 100
+    assert ControlParameters().beta == 0.0

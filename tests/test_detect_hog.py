@@ -6,7 +6,6 @@ import pytest
 
 from ptztrack.builders.world import build_world
 from ptztrack.camera.virtual import virtual_ptz
-from ptztrack.config import ScenarioError, pets_scenario, scenario_from_dict
 from ptztrack.detect.hog import (
     SCALE_TOLERANCE,
     GroundSearch,
@@ -62,11 +61,6 @@ def test_recorded_video_reads_forwards_and_reopens_to_go_back(excerpt_frames):
         video.frame(40)
     with pytest.raises(DatasetError, match="frames are 768x576 px, expected 640x480"):
         RecordedVideo(EXCERPT / "View_001.avi", (640, 480)).frame(0)
-
-
-def test_hog_needs_a_recording_with_video():
-    with pytest.raises(ScenarioError, match="'hog' needs a recording with a video"):
-        scenario_from_dict({"detector": {"kind": "hog"}})
 
 
 @pytest.fixture(scope="module")
@@ -228,15 +222,6 @@ def test_a_ground_search_refuses_what_it_cannot_use(hog_world):
         detector.boxes(view)
     with pytest.raises(ValueError, match="the image is 320x240 px, the search's camera 160x120 px"):
         detector.boxes(np.zeros((240, 320, 3), np.uint8), whole_frame_at_zoom(hog_world, 0))
-
-
-def test_the_scenario_chooses_the_search_and_refuses_a_falling_height_range():
-    scenario = pets_scenario("hog")
-    assert scenario.detector.hog_search == "ground" and scenario.detector.hog_person_height_m == (1.5, 2.0)
-    with pytest.raises(ScenarioError, match="hog_person_height_m must be"):
-        pets_scenario("hog", **{"detector.hog_person_height_m": (2.0, 1.5)})
-    with pytest.raises(ScenarioError, match="hog_search"):
-        pets_scenario("hog", **{"detector.hog_search": "sky"})
 
 
 class CountingDetector(HogPeopleDetector):

@@ -7,8 +7,7 @@ from hypothesis import strategies as st
 
 from information_gain_reference import occluded_fraction_by_cells
 from overhead import CAMERA as OVERHEAD_CAMERA
-from ptztrack.builders.factories import recall_model
-from ptztrack.config import Scenario
+from ptztrack.detect.parameters import DetectorPrior
 from ptztrack.detect.simulated import RecallDetector, RecallModel, detection_probability
 from ptztrack.geometry.occlusion import occluded_fraction, occlusion_in_centred_views
 from ptztrack.geometry.ptz import (
@@ -25,8 +24,10 @@ from ptztrack.types import PeopleInView
 CAMERA = OVERHEAD_CAMERA
 SIZE = (CAMERA.image_width_px, CAMERA.image_height_px)
 # The scenario's default detectors: the paper's realistic curve, and the ideal one.
-REALISTIC = RecallDetector(recall_model(Scenario()), 2.0, 0.0, SIZE)
-IDEAL = RecallDetector(recall_model(Scenario(detector={"kind": "ideal"})), 2.0, 0.0, SIZE)
+# The paper's recall curve (its Caltech fit of HOG), and the ideal detector's recall of 1.
+CALTECH = RecallModel(DetectorPrior.recall_kd, DetectorPrior.recall_r0_px)
+REALISTIC = RecallDetector(CALTECH, 2.0, 0.0, SIZE)
+IDEAL = RecallDetector(RecallModel(CALTECH.kd_per_px, CALTECH.r0_px, perfect=True), 2.0, 0.0, SIZE)
 PROPERTY = settings(deadline=None, max_examples=100)
 
 

@@ -6,23 +6,21 @@ import cv2
 import numpy as np
 import pytest
 
-from ptztrack.builders.follow import particle_filter_parameters
-from ptztrack.config import scenario_from_dict
+from ptztrack.follow.parameters import FollowSettings
 from ptztrack.follow.particle_filter import (
     MAX_HEIGHT_Z,
     carry_states,
     height_log_prior,
+    particle_filter_parameters,
     predict_states,
     start_filter,
     step_filter,
     systematic_resample,
 )
 
-PARAMETERS = particle_filter_parameters(scenario_from_dict({"frame_rate_hz": 10.0}))
+PARAMETERS = particle_filter_parameters(FollowSettings(), 10.0)
 # The particles move by the estimate's velocity (the prediction before the particles had their own).
-SHARED_VELOCITY = particle_filter_parameters(
-    scenario_from_dict({"frame_rate_hz": 10.0, "follow": {"prediction": "constant_velocity"}})
-)
+SHARED_VELOCITY = particle_filter_parameters(FollowSettings(prediction="constant_velocity"), 10.0)
 RANDOM_WALK = replace(SHARED_VELOCITY, velocity_gain=0.0)  # the paper's prediction
 HEIGHT_PX = 120
 WIDTH_PX = 48

@@ -1,4 +1,5 @@
 import json
+from dataclasses import replace
 from pathlib import Path
 
 import cv2
@@ -223,5 +224,5 @@ def test_a_track_beside_another_keeps_its_existence_through_misses_that_a_lone_t
     seen = Modes(people_m, covariance, np.ones(3))
     first = Modes(people_m[:1], covariance[:1], np.ones(1))
     frames = [seen, seen, first, first, first]
-    reported = track_on_ground(frames, np.full(5, 0.9), 0.5, 10.0, 0.5, GROUND_TRACKER)
+    reported = track_on_ground(frames, np.full(5, 0.9), 0.5, 10.0, replace(GROUND_TRACKER, acceleration_sigma_m_s2=0.5))
     assert [sorted(tracks.ids.tolist()) for tracks in reported] == [[0, 1, 2]] * 4 + [[0, 1]]

@@ -2,16 +2,15 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from ptztrack.config import People
-from ptztrack.scene.synthetic import Crowd, walk_people
+from ptztrack.scene.parameters import Crowd
+from ptztrack.scene.synthetic import walk_people
 
 AREA = (15.0, 15.0)
 
 
 def walk(seed, frames=200, **people):
     """Walkers alone unless ``pairs`` is given."""
-    people = People(**{"paired_fraction": 0.0, **people})
-    crowd = Crowd(**people.model_dump(exclude={"paired_fraction"}), pairs=people.pairs)
+    crowd = Crowd(**{"paired_fraction": 0.0, **people})
     return walk_people(crowd, AREA, frames, 5.0, np.random.default_rng(seed))
 
 
@@ -77,5 +76,5 @@ def test_a_pair_walks_side_by_side_the_second_on_the_left_of_the_first(seed, ent
 
 
 def test_the_paired_fraction_makes_whole_pairs():
-    assert [People(count=count, paired_fraction=0.85).pairs for count in (0, 1, 3, 7, 20)] == [0, 0, 1, 3, 8]
-    assert People(count=7, paired_fraction=1.0).pairs == 3
+    assert [Crowd(count=count, paired_fraction=0.85).pairs for count in (0, 1, 3, 7, 20)] == [0, 0, 1, 3, 8]
+    assert Crowd(count=7, paired_fraction=1.0).pairs == 3

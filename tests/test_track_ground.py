@@ -4,21 +4,11 @@ import numpy as np
 import pytest
 
 from ptztrack.track.kalman import constant_velocity_model
-from ptztrack.track.tracker import TrackerParameters, predict_tracks, start_ground_tracks, update_tracks_on_ground
+from ptztrack.track.parameters import TrackerParameters
+from ptztrack.track.tracker import predict_tracks, start_ground_tracks, update_tracks_on_ground
 from ptztrack.types import Tracks
 
-PARAMETERS = TrackerParameters(
-    initial_speed_sigma_m_s=0.9,
-    gate_probability=0.99,
-    existence_at_birth=0.5,
-    existence_when_detected=0.99,
-    existence_to_delete=0.1,
-    max_position_sigma_m=2.0,
-    confirmation_hits=1,
-    report_position_sigma_m=2.0,
-    association="hungarian",
-    clutter_density_per_px2=0.0,
-)
+PARAMETERS = TrackerParameters(report_position_sigma_m=2.0)
 R = 0.01 * np.eye(2)
 # The map finds a person who is there half the time: a miss takes existence r to r / (2 - r).
 DETECTABLE = 0.5

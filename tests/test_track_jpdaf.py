@@ -6,9 +6,6 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.stats import chi2, multivariate_normal
 
-from ptztrack.cli import main
-from ptztrack.cli.scenario import build_scenario
-from ptztrack.config import ScenarioError, scenario_from_dict
 from ptztrack.track import jpdaf, kalman
 from ptztrack.track.kalman import constant_velocity_model
 from ptztrack.track.tracker import (
@@ -283,22 +280,3 @@ def test_tracks_follow_two_crossing_walkers_and_keep_their_ids(association):
     start = np.array([[4.5, 3.5], [10.5, 3.5]])
     velocity = np.array([[1.0, 1.0], [-1.0, 1.0]])
     assert_tracks_follow_walkers(start, velocity, 31, parameters(association=association))
-
-
-def test_an_unknown_association_is_refused_naming_the_field():
-    with pytest.raises(ScenarioError) as error:
-        scenario_from_dict({"tracker": {"association": "jpda"}})
-    assert "tracker.association: Input should be 'hungarian' or 'cjpdaf' (got 'jpda')" in str(error.value)
-    with pytest.raises(ScenarioError, match="tracker.clutter_density_per_px2: Input should be greater than or equal"):
-        scenario_from_dict({"tracker": {"clutter_density_per_px2": -1e-6}})
-
-
-def test_the_default_is_hungarian_and_the_command_line_selects_the_cjpdaf(capsys):
-    assert parameters().association == "hungarian"
-    assert build_scenario("pets", "hog", association="cjpdaf").tracker.association == "cjpdaf"
-    assert build_scenario("synthetic", association="cjpdaf").tracker.association == "cjpdaf"
-    assert main(["run", "--scenario", "pets", "--policy", "fix", "--association", "cjpdaf", "--frames", "5"]) == 0
-    assert "MOTA" in capsys.readouterr().out
-    with pytest.raises(SystemExit) as error:
-        main(["run", "--association", "greedy"])
-    assert error.value.code == 2

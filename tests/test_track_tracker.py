@@ -1,16 +1,15 @@
+import math
 from dataclasses import replace
 
 import numpy as np
 import pytest
 
-from ptztrack.builders.factories import tracker_parameters
-from ptztrack.config import Tracker, scenario_from_dict
 from ptztrack.geometry.ptz import PTZCamera, apply_homography, feet_jacobian, ground_to_image, look_at
 from ptztrack.track import kalman
 from ptztrack.track.kalman import constant_velocity_model
+from ptztrack.track.parameters import TrackerParameters
 from ptztrack.track.tracker import (
     EkfTracker,
-    TrackerParameters,
     existence_after_detection,
     existence_after_miss,
     innovation_likelihood,
@@ -25,12 +24,13 @@ from ptztrack.types import Detections, Tracks
 CAMERA = PTZCamera((7.5, -4.0, 7.0), 640, 480, 400.0)
 POSE = look_at(CAMERA, [7.5, 6.0], 1.0)
 V = 4.0 * np.eye(2)
-ACCELERATION_SIGMA_M_S2 = Tracker().acceleration_sigma_m_s2
+ACCELERATION_SIGMA_M_S2 = TrackerParameters.acceleration_sigma_m_s2
 
 
-def parameters(people: dict | None = None, **fields) -> TrackerParameters:
-    """The tracker's parameters of a synthetic scenario with these ``tracker`` fields (and ``people``)."""
-    return tracker_parameters(scenario_from_dict({"tracker": fields, "people": people or {}}))
+def parameters(**fields) -> TrackerParameters:
+    """The defaults with these fields, where people never leave (uncertainty deletes nobody) unless a
+    ``max_position_sigma_m`` is given."""
+    return replace(TrackerParameters(max_position_sigma_m=math.inf), **fields)
 
 
 CONFIG = parameters()
@@ -90,15 +90,15 @@ def test_the_tracker_predicts_by_any_time_and_by_its_step_by_default():
     the time as the constant-velocity model's closed form says."""
     tracks = start_tracks(feet_px([[5.0, 5.0]]), CAMERA, POSE, V, CONFIG.initial_speed_sigma_m_s, first_id=0)
     tracks = replace(tracks, mean=np.array([[5.0, 5.0, 1.0, -0.5]]))
-    halves = EkfTracker(CAMERA, 0.2, ACCELERATION_SIGMA_M_S2, V, CONFIG, lambda *a: np.ones(len(a[0])), tracks)
-    whole = EkfTracker(CAMERA, 0.2, ACCELERATION_SIGMA_M_S2, V, CONFIG, lambda *a: np.ones(len(a[0])), tracks)
+    halves = EkfTracker(CAMERA, 0.2, V, CONFIG, lambda *a: np.ones(len(a[0])), tracks)
+    whole = EkfTracker(CAMERA, 0.2, V, CONFIG, lambda *a: np.ones(len(a[0])), tracks)
     halves.predict(0.1)
     halves.predict(0.1)
     whole.predict()
     np.testing.assert_allclose(halves.tracks.mean, whole.tracks.mean)
     np.testing.assert_allclose(whole.tracks.mean, [[5.2, 4.9, 1.0, -0.5]])
     F, U = constant_velocity_model(0.7, ACCELERATION_SIGMA_M_S2)
-    later = EkfTracker(CAMERA, 0.2, ACCELERATION_SIGMA_M_S2, V, CONFIG, lambda *a: np.ones(len(a[0])), tracks)
+    later = EkfTracker(CAMERA, 0.2, V, CONFIG, lambda *a: np.ones(len(a[0])), tracks)
     np.testing.assert_allclose(later.predict(0.7).covariance[0], F @ tracks.covariance[0] @ F.T + U)
 
 
@@ -148,9 +148,8 @@ def test_a_person_out_of_view_is_never_forgotten_and_one_missed_in_view_soon_is(
     assert lengths == [1, 1, 0]
 
 
-def test_uncertainty_deletes_a_track_only_where_people_can_leave():
-    leaving, staying = parameters({"enter_leave": True}, max_position_sigma_m=1.0), parameters(max_position_sigma_m=1.0)
-    assert staying.max_position_sigma_m == np.inf
+def test_uncertainty_deletes_a_track_only_below_a_finite_bound():
+    leaving, staying = parameters(max_position_sigma_m=1.0), parameters()
     lifetimes = []
     for config in (leaving, staying):
         tracks, F, U = detected_track(config)
@@ -238,13 +237,12 @@ def test_the_tracker_reports_only_tracks_sure_enough_to_exist():
     start = feet_px([[7.5, 6.0]])
     first = update_tracks(Tracks.empty(), start, CAMERA, POSE, V, params, np.zeros(0)).tracks
     assert first.existence[0] == pytest.approx(0.4)
-    tracker = EkfTracker(CAMERA, 0.2, ACCELERATION_SIGMA_M_S2, V, params, lambda *a: np.ones(len(a[0])))
+    tracker = EkfTracker(CAMERA, 0.2, V, params, lambda *a: np.ones(len(a[0])))
     tracker.tracks = first
     assert len(tracker.reported()) == 0
     fixed = EkfTracker(
         CAMERA,
         0.2,
-        ACCELERATION_SIGMA_M_S2,
         V,
         parameters(**fields, existence_update="fixed"),
         lambda *a: np.ones(len(a[0])),

@@ -8,6 +8,7 @@ import math
 from functools import partial
 from typing import Literal
 
+from ptztrack.builders.parameters import parameters_from
 from ptztrack.builders.registration import live_view_model
 from ptztrack.builders.world import recall_model
 from ptztrack.camera.recorded import RecordedPTZ
@@ -21,22 +22,9 @@ from ptztrack.detect.hog import GroundSearch, HogPeopleDetector
 from ptztrack.detect.simulated import AnnotationDetector, RecallCurve, RecallDetector, RecallModel
 from ptztrack.loop import World
 from ptztrack.scene.pets import RecordedVideo
+from ptztrack.track.parameters import TrackerParameters
 from ptztrack.track.templates import TemplateTracker
-from ptztrack.track.tracker import DetectionModel, EkfTracker, TrackerParameters, pixel_noise_covariance
-
-TRACKER_FIELDS = (
-    "initial_speed_sigma_m_s",
-    "gate_probability",
-    "existence_at_birth",
-    "existence_when_detected",
-    "existence_to_delete",
-    "confirmation_hits",
-    "report_position_sigma_m",
-    "association",
-    "clutter_density_per_px2",
-    "existence_update",
-    "existence_to_report",
-)
+from ptztrack.track.tracker import DetectionModel, EkfTracker, pixel_noise_covariance
 
 
 def expected_model(scenario: Scenario, world: World) -> RecallCurve:
@@ -62,11 +50,9 @@ def people_can_leave(scenario: Scenario) -> bool:
 
 def tracker_parameters(scenario: Scenario) -> TrackerParameters:
     """The tracker's parameters; uncertainty deletes a track only where people can leave."""
-    tracker = scenario.tracker
-    max_position_sigma_m = tracker.max_position_sigma_m if people_can_leave(scenario) else math.inf
-    return TrackerParameters(
-        **{name: getattr(tracker, name) for name in TRACKER_FIELDS}, max_position_sigma_m=max_position_sigma_m
-    )
+    if people_can_leave(scenario):
+        return parameters_from(scenario.tracker, TrackerParameters)
+    return parameters_from(scenario.tracker, TrackerParameters, max_position_sigma_m=math.inf)
 
 
 def detection_model(scenario: Scenario, world: World) -> DetectionModel:
@@ -183,7 +169,6 @@ def ekf_tracker(scenario: Scenario, world: World) -> EkfTracker | TemplateTracke
     tracker = EkfTracker(
         world.camera,
         1.0 / scenario.frame_rate_hz,
-        config.acceleration_sigma_m_s2,
         pixel_noise(scenario),
         parameters,
         model,

@@ -9,11 +9,13 @@ first step, moved into the view the camera is at before it.
 
 import numpy as np
 
+from ptztrack.builders.parameters import parameters_from
 from ptztrack.camera.recorded import RecordedPTZ
 from ptztrack.camera.virtual import virtual_ptz
 from ptztrack.config import Actions, Scenario, ScenarioError
 from ptztrack.follow.controller import FollowParameters, FollowPolicy, framing_pose
-from ptztrack.follow.particle_filter import ParticleFilterParameters
+from ptztrack.follow.parameters import FollowSettings
+from ptztrack.follow.particle_filter import particle_filter_parameters, smoothing_pole
 from ptztrack.follow.target import OpenCVSource, ParticleSource, TargetSource, TargetTracker, opencv_tracker_factory
 from ptztrack.geometry.calibration import load_calibration
 from ptztrack.geometry.ptz import PTZCamera, aim_at
@@ -22,42 +24,9 @@ from ptztrack.names import FOLLOW_TRACKERS
 from ptztrack.scene.pets import load_mot_ground_truth
 
 
-def particle_filter_parameters(scenario: Scenario) -> ParticleFilterParameters:
-    """The particle filter's per-step parameters at the scenario's frame rate."""
-    follow, step_s = scenario.follow, 1.0 / scenario.frame_rate_hz
-    return ParticleFilterParameters(
-        particles=follow.particles,
-        search_particles=follow.search_particles,
-        patches=np.asarray(follow.patches, dtype=float),
-        bins=follow.histogram_bins,
-        achromatic=follow.achromatic_bins,
-        samples=follow.samples_per_patch,
-        background_ring_scale=None if follow.background_area_ratio is None else follow.background_area_ratio**0.5,
-        lambda_colour=follow.lambda_colour,
-        lambda_loss=follow.lambda_loss,
-        lambda_motion=follow.lambda_motion,
-        height_log_sigma=follow.height_log_sigma,
-        walk_sigma=follow.walk_heights_per_s * step_s,
-        scale_sigma=follow.scale_change_per_s * step_s,
-        velocity_gain=1.0 - smoothing_pole(scenario) if follow.prediction == "constant_velocity" else 0.0,
-        acceleration_sigma=(
-            follow.acceleration_heights_per_s2 * step_s**2 if follow.prediction == "particle_velocity" else None
-        ),
-        initial_speed_sigma=follow.initial_speed_heights_per_s * step_s,
-        loss_fraction=follow.loss_fraction,
-        adapt_fraction=follow.adapt_fraction,
-        reference_rate=min(1.0, step_s / follow.reference_time_constant_s),
-        search_sigma=follow.search_heights,
-        search_scale_sigma=follow.search_scale,
-        motion_threshold=follow.motion_threshold,
-        motion_decay=min(1.0, step_s / follow.motion_memory_s),
-        motion_scale=follow.motion_scale,
-    )
-
-
-def smoothing_pole(scenario: Scenario) -> float:
-    """The output filter's pole ``exp(-2 pi f_c step)`` for the cut-off ``follow.smoothing_cutoff_hz``."""
-    return float(np.exp(-2 * np.pi * scenario.follow.smoothing_cutoff_hz / scenario.frame_rate_hz))
+def follow_settings(scenario: Scenario) -> FollowSettings:
+    """The scenario's follow section as the follow camera's parameters."""
+    return parameters_from(scenario.follow, FollowSettings)
 
 
 def follow_parameters(scenario: Scenario, camera: PTZCamera) -> FollowParameters:
@@ -116,7 +85,7 @@ def initial_box(scenario: Scenario, world: World) -> tuple[np.ndarray, np.ndarra
 def target_source(scenario: Scenario, tracker: str, rng: np.random.Generator) -> TargetSource:
     """The source of a follow tracker by name: 'particle' (drawing from ``rng``), 'csrt' or 'mil'."""
     if tracker == "particle":
-        return ParticleSource(particle_filter_parameters(scenario), rng)
+        return ParticleSource(particle_filter_parameters(follow_settings(scenario), scenario.frame_rate_hz), rng)
     if tracker in ("csrt", "mil"):
         return OpenCVSource(opencv_tracker_factory(tracker))
     raise ScenarioError(f"no follow tracker {tracker!r}; expected one of {', '.join(FOLLOW_TRACKERS)}")
@@ -132,7 +101,7 @@ def _target_tracker(scenario: Scenario, world: World, tracker: str) -> TargetTra
         box_px,
         start_pose,
         scenario.control.person_height_m,
-        smoothing_pole(scenario),
+        smoothing_pole(scenario.follow.smoothing_cutoff_hz, scenario.frame_rate_hz),
         1.0 / scenario.frame_rate_hz,
     )
 

@@ -7,6 +7,7 @@ from typing import Any
 import numpy as np
 
 from ptztrack import registry
+from ptztrack.builders.parameters import parameters_from
 from ptztrack.builders.registration import registered_pose_source
 from ptztrack.camera.actions import ActionGrid
 from ptztrack.camera.pose_feedback import LandingError, commanded_pose, true_pose
@@ -20,8 +21,9 @@ from ptztrack.geometry.calibration import load_calibration
 from ptztrack.geometry.ptz import PTZCamera, ground_footprint
 from ptztrack.loop import World
 from ptztrack.roles import CameraBackend, Detector, PoseSource
+from ptztrack.scene.parameters import Crowd
 from ptztrack.scene.pets import RecordedScene, load_mot_ground_truth, recorded_scene
-from ptztrack.scene.synthetic import Crowd, walk_people
+from ptztrack.scene.synthetic import walk_people
 from ptztrack.types import GroundTruth
 
 CameraSpec = str | CameraBackend | Callable[[Scenario, "BuiltScene"], CameraBackend]
@@ -65,8 +67,7 @@ def action_grid(scenario: Scenario) -> ActionGrid:
 
 
 def crowd(scenario: Scenario) -> Crowd:
-    people = scenario.people.model_dump(exclude={"paired_fraction"})
-    return Crowd(**people, pairs=scenario.people.pairs)
+    return parameters_from(scenario.people, Crowd)
 
 
 def build_scene(scenario: Scenario, scene_rng: np.random.Generator) -> BuiltScene:

@@ -27,6 +27,10 @@ from ptztrack.config.fields import (
 )
 from ptztrack.config.follow import Follow
 from ptztrack.config.reading import ScenarioError, _first_error_line, read_yaml
+from ptztrack.control.parameters import ControlParameters
+from ptztrack.detect.parameters import DetectorPrior, HogParameters
+from ptztrack.scene.parameters import Crowd
+from ptztrack.track.parameters import TrackerParameters
 
 _Speed = Annotated[PositiveFloat, at_most(15, "metres per second: faster than anyone runs")]
 _Height = Annotated[PositiveFloat, at_most(3, "metres: taller than anyone")]
@@ -34,19 +38,25 @@ _Stay = Annotated[PositiveFloat, at_most(86_400, "seconds: a day")]
 
 
 class People(_Strict):
-    """The synthetic crowd (:mod:`ptztrack.scene.synthetic`). paired_fraction : the share of the
-    ``count`` people who walk in pairs, side by side ``pair_spacing_m`` apart (pairs: the fraction
-    of count / 2, rounded)."""
+    """The synthetic crowd (:class:`~ptztrack.scene.parameters.Crowd`, whose defaults it takes).
+    paired_fraction : the share of the ``count`` people who walk in pairs, side by side
+    ``pair_spacing_m`` apart (pairs: the fraction of count / 2, rounded)."""
 
-    count: Annotated[int, Field(ge=0), at_most(1000, "time: the policies score every person under every action")] = 7
-    speed_m_s: tuple[_Speed, _Speed] = (1.0, 1.5)
-    height_m: tuple[_Height, _Height] = (1.6, 1.9)
-    width_m: Annotated[PositiveFloat, at_most(3, "metres: a person's width")] = 0.62
-    turn_rate_sigma_deg_s: Annotated[NonNegativeFloat, at_most(3600, "degrees per second")] = 40.0
-    enter_leave: bool = False
-    stay_s: tuple[_Stay, _Stay] = (8.0, 20.0)
-    paired_fraction: float = Field(0.85, ge=0, le=1)
-    pair_spacing_m: Annotated[PositiveFloat, at_most(10, "metres between two people walking together")] = 0.75
+    count: Annotated[int, Field(ge=0), at_most(1000, "time: the policies score every person under every action")] = (
+        Crowd.count
+    )
+    speed_m_s: tuple[_Speed, _Speed] = Crowd.speed_m_s
+    height_m: tuple[_Height, _Height] = Crowd.height_m
+    width_m: Annotated[PositiveFloat, at_most(3, "metres: a person's width")] = Crowd.width_m
+    turn_rate_sigma_deg_s: Annotated[NonNegativeFloat, at_most(3600, "degrees per second")] = (
+        Crowd.turn_rate_sigma_deg_s
+    )
+    enter_leave: bool = Crowd.enter_leave
+    stay_s: tuple[_Stay, _Stay] = Crowd.stay_s
+    paired_fraction: float = Field(Crowd.paired_fraction, ge=0, le=1)
+    pair_spacing_m: Annotated[PositiveFloat, at_most(10, "metres between two people walking together")] = (
+        Crowd.pair_spacing_m
+    )
 
     @model_validator(mode="after")
     def _intervals_ordered(self):
@@ -55,11 +65,6 @@ class People(_Strict):
             if high < low:
                 raise ValueError(f"{name} must be [low, high] with low <= high (got {[low, high]})")
         return self
-
-    @property
-    def pairs(self) -> int:
-        """How many pairs walk side by side (never more than there are people for)."""
-        return min(round(self.paired_fraction * self.count / 2), self.count // 2)
 
 
 # How the policies and the tracker know the detector: its prior curve fixed, learned from the run, or the
@@ -77,6 +82,9 @@ class Detector(_Strict):
     (:mod:`ptztrack.detect.detector_model`); 'a-priori' keeps the prior, 'true' plans with the
     simulation's own curve, and a file path starts from what an earlier run learned.
 
+    The recall curve's, the noise's and the HOG fields' defaults are those of
+    :class:`~ptztrack.detect.parameters.DetectorPrior` and :class:`~ptztrack.detect.parameters.HogParameters`.
+
     hog_search : 'ground' scans only the windows where a standing person ``hog_person_height_m``
     (shortest, tallest) tall could be seen on the walkable area, at their sizes; 'image' scans every
     window of the pyramid, as OpenCV's ``detectMultiScale`` (:mod:`ptztrack.detect.hog`).
@@ -84,17 +92,19 @@ class Detector(_Strict):
 
     kind: Annotated[str, _registered("detectors")] = "realistic"
     options: Options = Field(default_factory=dict)
-    recall_kd: Annotated[PositiveFloat, at_most(100, "per pixel")] = 0.0098
-    recall_r0_px: Annotated[NonNegativeFloat, at_most(10_000, "pixels")] = 21.29
-    pixel_noise_px: Annotated[NonNegativeFloat, at_most(10_000, "pixels")] = 2.0
+    recall_kd: Annotated[PositiveFloat, at_most(100, "per pixel")] = DetectorPrior.recall_kd
+    recall_r0_px: Annotated[NonNegativeFloat, at_most(10_000, "pixels")] = DetectorPrior.recall_r0_px
+    pixel_noise_px: Annotated[NonNegativeFloat, at_most(10_000, "pixels")] = DetectorPrior.pixel_noise_px
     false_positives_per_frame: Annotated[
         NonNegativeFloat, at_most(1000, "time and memory: every detection is kept and associated")
-    ] = 0.0
-    hog_upsample: Annotated[PositiveFloat, at_most(16, "memory: the view is upsampled this much each way")] = 6.0
-    hog_hit_threshold: float = 0.0
-    hog_nms_iou: float = Field(0.4, gt=0, le=1)
+    ] = DetectorPrior.false_positives_per_frame
+    hog_upsample: Annotated[PositiveFloat, at_most(16, "memory: the view is upsampled this much each way")] = (
+        HogParameters.upsample
+    )
+    hog_hit_threshold: float = HogParameters.hit_threshold
+    hog_nms_iou: float = Field(HogParameters.nms_iou, gt=0, le=1)
     hog_search: Literal["ground", "image"] = "ground"
-    hog_person_height_m: tuple[_Height, _Height] = (1.5, 2.0)
+    hog_person_height_m: tuple[_Height, _Height] = HogParameters.person_heights_m
     model: str = "online"
     prior_shift_px: Annotated[float, Field(ge=-1000, le=1000)] = 0.0
 
@@ -122,6 +132,8 @@ class Detector(_Strict):
 
 class Tracker(_Strict):
     """The ground-plane tracker: by default (``kind`` 'ekf') one EKF per person, and its data association.
+
+    The fields shared with :class:`~ptztrack.track.parameters.TrackerParameters` take its defaults.
 
     association : 'hungarian' (one detection per track, assigned on the
     Mahalanobis distance) or 'cjpdaf' (Fitzgerald's Cheap JPDAF, equation 6
@@ -154,32 +166,47 @@ class Tracker(_Strict):
 
     kind: Annotated[str, _registered("trackers")] = "ekf"
     options: Options = Field(default_factory=dict)
-    acceleration_sigma_m_s2: Annotated[PositiveFloat, at_most(100, "metres per second squared")] = 1.5
-    initial_speed_sigma_m_s: Annotated[PositiveFloat, at_most(100, "metres per second")] = 0.9
-    gate_probability: float = Field(0.99, gt=0, lt=1)
-    existence_at_birth: float = Field(0.5, gt=0, lt=1)
-    existence_when_detected: float = Field(0.99, gt=0, lt=1)
-    existence_to_delete: float = Field(0.1, gt=0, lt=1)
-    max_position_sigma_m: Annotated[PositiveFloat, at_most(10_000, "metres")] = 2.0
-    confirmation_hits: Annotated[int, Field(ge=1), at_most(_MAX_FRAMES, "steps")] = 1
-    report_position_sigma_m: Annotated[PositiveFloat, at_most(10_000, "metres")] = 1.0
-    existence_update: Literal["bayes", "fixed"] = "bayes"
-    existence_to_report: float = Field(0.5, gt=0, lt=1)
-    association: Literal["hungarian", "cjpdaf"] = "hungarian"
-    clutter_density_per_px2: Annotated[NonNegativeFloat, at_most(1, "detections per pixel")] = 0.0
+    acceleration_sigma_m_s2: Annotated[PositiveFloat, at_most(100, "metres per second squared")] = (
+        TrackerParameters.acceleration_sigma_m_s2
+    )
+    initial_speed_sigma_m_s: Annotated[PositiveFloat, at_most(100, "metres per second")] = (
+        TrackerParameters.initial_speed_sigma_m_s
+    )
+    gate_probability: float = Field(TrackerParameters.gate_probability, gt=0, lt=1)
+    existence_at_birth: float = Field(TrackerParameters.existence_at_birth, gt=0, lt=1)
+    existence_when_detected: float = Field(TrackerParameters.existence_when_detected, gt=0, lt=1)
+    existence_to_delete: float = Field(TrackerParameters.existence_to_delete, gt=0, lt=1)
+    max_position_sigma_m: Annotated[PositiveFloat, at_most(10_000, "metres")] = TrackerParameters.max_position_sigma_m
+    confirmation_hits: Annotated[int, Field(ge=1), at_most(_MAX_FRAMES, "steps")] = TrackerParameters.confirmation_hits
+    report_position_sigma_m: Annotated[PositiveFloat, at_most(10_000, "metres")] = (
+        TrackerParameters.report_position_sigma_m
+    )
+    existence_update: Literal["bayes", "fixed"] = TrackerParameters.existence_update
+    existence_to_report: float = Field(TrackerParameters.existence_to_report, gt=0, lt=1)
+    association: Literal["hungarian", "cjpdaf"] = TrackerParameters.association
+    clutter_density_per_px2: Annotated[NonNegativeFloat, at_most(1, "detections per pixel")] = (
+        TrackerParameters.clutter_density_per_px2
+    )
     measurement_source: Literal["detector", "spatiogram"] = "detector"
     detector_every_steps: Annotated[int, Field(ge=1), at_most(_MAX_FRAMES, "steps")] = 5
 
 
 class Control(_Strict):
-    """Parameters of the information-gain policies (paper sections 4 and 4.4)."""
+    """Parameters of the information-gain policies (paper sections 4 and 4.4); the defaults are those of
+    :class:`~ptztrack.control.parameters.ControlParameters`."""
 
-    samples: Annotated[int, Field(ge=1), at_most(10_000, "time: smpl scores every sample under every action")] = 100
-    beta: Annotated[NonNegativeFloat, at_most(1e6, "a weight")] = 0.0
-    person_height_m: _Height = 1.75
-    exploration_cell_m: Annotated[float, Field(ge=0.05), at_most(1000, "metres")] = 1.0
-    prior_untracked_people: Annotated[NonNegativeFloat, at_most(10_000, "people")] = 1.0
-    arrival_rate_per_s: Annotated[NonNegativeFloat, at_most(1000, "people per second")] = 0.1
+    samples: Annotated[int, Field(ge=1), at_most(10_000, "time: smpl scores every sample under every action")] = (
+        ControlParameters.samples
+    )
+    beta: Annotated[NonNegativeFloat, at_most(1e6, "a weight")] = ControlParameters.beta
+    person_height_m: _Height = ControlParameters.person_height_m
+    exploration_cell_m: Annotated[float, Field(ge=0.05), at_most(1000, "metres")] = ControlParameters.exploration_cell_m
+    prior_untracked_people: Annotated[NonNegativeFloat, at_most(10_000, "people")] = (
+        ControlParameters.prior_untracked_people
+    )
+    arrival_rate_per_s: Annotated[NonNegativeFloat, at_most(1000, "people per second")] = (
+        ControlParameters.arrival_rate_per_s
+    )
 
 
 _VideoFrame = Annotated[int, Field(ge=0), at_most(10_000_000, "video frames: 4 days at 30 Hz")]

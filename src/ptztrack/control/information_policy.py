@@ -30,6 +30,7 @@ from ptztrack.control.information_gain import (
     detection_weight_sampled,
     information_if_detected_nats,
 )
+from ptztrack.control.parameters import ControlParameters
 from ptztrack.detect.simulated import RecallCurve
 from ptztrack.geometry.ptz import PTZCamera, look_at
 from ptztrack.types import DecisionContext, Tracks
@@ -77,8 +78,8 @@ class InformationGainPolicy:
     person_height_m: float
     person_width_m: float
     method: Literal["intg", "smpl"]
-    samples: int
-    beta: float = 0.0
+    samples: int = ControlParameters.samples
+    beta: float = ControlParameters.beta
     exploration: ExplorationMap | None = None
     move_seconds: Callable[[np.ndarray, np.ndarray], np.ndarray] | None = None
     step_s: float = 1.0

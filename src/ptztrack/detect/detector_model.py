@@ -46,6 +46,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ptztrack.detect.parameters import DetectorPrior
 from ptztrack.detect.simulated import RecallModel
 from ptztrack.files import InputError, read_json, write_json
 from ptztrack.geometry.occlusion import occluded_fraction
@@ -101,8 +102,8 @@ class OnlineDetectorModel:
     person_width_m: float
     prior: RecallModel
     learning: bool = True
-    false_positives_per_view: float = 0.0
-    pixel_noise_px: float = 2.0
+    false_positives_per_view: float = DetectorPrior.false_positives_per_frame
+    pixel_noise_px: float = DetectorPrior.pixel_noise_px
     prior_successes: np.ndarray | None = None
     prior_trials: np.ndarray | None = None
     prior_views: float = PRIOR_VIEWS

@@ -60,6 +60,7 @@ import cv2
 import numpy as np
 from scipy.sparse.csgraph import connected_components
 
+from ptztrack.detect.parameters import HogParameters
 from ptztrack.geometry.area import inside
 from ptztrack.geometry.ptz import PTZCamera, apply_homography, head_from_feet_homology, pixels_to_ground
 from ptztrack.roles import CameraBackend
@@ -113,7 +114,7 @@ class GroundSearch:
 
     camera: PTZCamera
     area_polygon_m: np.ndarray
-    person_heights_m: tuple[float, float] = (1.5, 2.0)
+    person_heights_m: tuple[float, float] = HogParameters.person_heights_m
     tolerance: float = SCALE_TOLERANCE
 
     def __post_init__(self):
@@ -157,9 +158,9 @@ class HogPeopleDetector:
         (OpenCV's ``detectMultiScale``).
     """
 
-    upsample: float = 6.0
-    hit_threshold: float = 0.0
-    nms_iou: float = 0.4
+    upsample: float = HogParameters.upsample
+    hit_threshold: float = HogParameters.hit_threshold
+    nms_iou: float = HogParameters.nms_iou
     search: GroundSearch | None = None
     _hog: cv2.HOGDescriptor = field(init=False, repr=False)
 

@@ -9,19 +9,19 @@ per method, are tabled by :func:`format_occupancy_table`.
 
 from collections.abc import Callable
 
-from ptztrack.builders.factories import TRACKER_FIELDS
 from ptztrack.builders.occupancy import (
     lpom_parameters,
     recording_from_dataset,
     refuse_if_tables_too_large,
     room_recording,
 )
+from ptztrack.builders.parameters import parameters_from
 from ptztrack.config import MultiViewDataset, Occupancy, OccupancyTracker, Tracker
 from ptztrack.occupancy.detectors import ClusteringDetector, LpomDetector
 from ptztrack.occupancy.evaluation import OccupancyRun, detect_frames, score_recording
 from ptztrack.occupancy.multiview import MultiViewRecording
 from ptztrack.scene.pets import DatasetError
-from ptztrack.track.tracker import TrackerParameters
+from ptztrack.track.parameters import TrackerParameters
 
 ROOM_PEOPLE = (1, 3)
 # The table's columns (a row's key) and their formats.
@@ -55,12 +55,8 @@ def run_recording(
     clustering = ClusteringDetector(recording, occupancy.linkage_m, occupancy.min_box_score, occupancy.blob_min_area_px)
     frames = detect_frames(recording, lpom, clustering, progress)
     # People leave a dataset's area (and never the room's, whose tracks stay well localised).
-    tracking = TrackerParameters(
-        **{name: getattr(tracker, name) for name in TRACKER_FIELDS}, max_position_sigma_m=tracker.max_position_sigma_m
-    )
-    return score_recording(
-        recording, lpom.grid, frames, tracker.acceleration_sigma_m_s2, tracking, occupancy.separation_m, label
-    )
+    tracking = parameters_from(tracker, TrackerParameters)
+    return score_recording(recording, lpom.grid, frames, tracking, occupancy.separation_m, label)
 
 
 def dataset_runs(dataset: MultiViewDataset, frames: int | None, progress=None) -> list[OccupancyRun]:

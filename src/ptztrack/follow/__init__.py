@@ -6,6 +6,8 @@ in virtual reality TV studio" (IROS 2008), on a camera that turns and zooms
 instead of driving. One person is tracked in the image and the camera
 is steered to frame them:
 
+- :mod:`.parameters`: the follow camera's parameters and their defaults
+  (rates per second), which the configuration maps onto;
 - :mod:`.colour_model`: the target model, multi-patch hue-saturation
   histograms compared by the Bhattacharyya distance (section III-B,
   equations 2-3);

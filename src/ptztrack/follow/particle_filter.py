@@ -82,6 +82,7 @@ import numpy as np
 
 from ptztrack.follow import colour_model
 from ptztrack.follow.motion_image import MotionImage, first_motion_image, next_motion_image, non_motion_fraction
+from ptztrack.follow.parameters import FollowSettings
 from ptztrack.geometry.ptz import apply_homography
 
 # A box is never smaller than this many pixels high: the random walk would otherwise shrink one
@@ -104,8 +105,8 @@ class ParticleFilterParameters:
 
     particles, search_particles : while tracking, and while lost.
     patches : (K, 4) (left, top, width, height) in box units (:mod:`ptztrack.follow.colour_model`).
-    bins : N of the N x N hue-saturation histograms; achromatic : N more bins by value for greys
-    (:func:`ptztrack.follow.colour_model.colour_bins`); samples : grid points per patch axis.
+    histogram_bins : N of the N x N hue-saturation histograms; achromatic_bins : N more bins by value for
+    greys (:func:`ptztrack.follow.colour_model.colour_bins`); samples_per_patch : grid points per patch axis.
     background_ring_scale : the background-weighted histograms' ring, the box scaled by this much
     (:func:`ptztrack.follow.colour_model.background_weights`); None: unweighted, the paper's.
     lambda_colour, lambda_motion : equations 3 and 4.
@@ -126,9 +127,9 @@ class ParticleFilterParameters:
     particles: int
     search_particles: int
     patches: np.ndarray
-    bins: int
-    achromatic: bool
-    samples: int
+    histogram_bins: int
+    achromatic_bins: bool
+    samples_per_patch: int
     background_ring_scale: float | None
     lambda_colour: float
     lambda_motion: float
@@ -147,6 +148,48 @@ class ParticleFilterParameters:
     motion_threshold: float
     motion_decay: float
     motion_scale: float
+
+
+def smoothing_pole(cutoff_hz: float, frame_rate_hz: float) -> float:
+    """The output filter's pole ``exp(-2 pi f_c / frame_rate)`` for the cut-off ``f_c`` (Hz)."""
+    return float(np.exp(-2 * np.pi * cutoff_hz / frame_rate_hz))
+
+
+def particle_filter_parameters(settings: FollowSettings, frame_rate_hz: float) -> ParticleFilterParameters:
+    """The filter's per-step parameters from the follow camera's (rates per second) at ``frame_rate_hz``."""
+    step_s = 1.0 / frame_rate_hz
+    return ParticleFilterParameters(
+        particles=settings.particles,
+        search_particles=settings.search_particles,
+        patches=np.asarray(settings.patches, dtype=float),
+        histogram_bins=settings.histogram_bins,
+        achromatic_bins=settings.achromatic_bins,
+        samples_per_patch=settings.samples_per_patch,
+        background_ring_scale=None if settings.background_area_ratio is None else settings.background_area_ratio**0.5,
+        lambda_colour=settings.lambda_colour,
+        lambda_loss=settings.lambda_loss,
+        lambda_motion=settings.lambda_motion,
+        height_log_sigma=settings.height_log_sigma,
+        walk_sigma=settings.walk_heights_per_s * step_s,
+        scale_sigma=settings.scale_change_per_s * step_s,
+        velocity_gain=(
+            1.0 - smoothing_pole(settings.smoothing_cutoff_hz, frame_rate_hz)
+            if settings.prediction == "constant_velocity"
+            else 0.0
+        ),
+        acceleration_sigma=(
+            settings.acceleration_heights_per_s2 * step_s**2 if settings.prediction == "particle_velocity" else None
+        ),
+        initial_speed_sigma=settings.initial_speed_heights_per_s * step_s,
+        loss_fraction=settings.loss_fraction,
+        adapt_fraction=settings.adapt_fraction,
+        reference_rate=min(1.0, step_s / settings.reference_time_constant_s),
+        search_sigma=settings.search_heights,
+        search_scale_sigma=settings.search_scale,
+        motion_threshold=settings.motion_threshold,
+        motion_decay=min(1.0, step_s / settings.motion_memory_s),
+        motion_scale=settings.motion_scale,
+    )
 
 
 @dataclass(frozen=True)
@@ -221,10 +264,12 @@ def start_filter(image_bgr, box_px, parameters: ParticleFilterParameters) -> Par
     """
     left, top, width, height = (float(value) for value in box_px)
     state = np.array([left + width / 2, top + height / 2, height])
-    bins = colour_model.colour_bins(image_bgr, parameters.bins, parameters.achromatic)
+    bins = colour_model.colour_bins(image_bgr, parameters.histogram_bins, parameters.achromatic_bins)
     patches = colour_model.patch_boxes(np.asarray(box_px, dtype=float), parameters.patches)
-    total_bins = colour_model.bin_count(parameters.bins, parameters.achromatic)
-    reference = colour_model.patch_histograms(bins, patches, total_bins, REFERENCE_OVERSAMPLING * parameters.samples)
+    total_bins = colour_model.bin_count(parameters.histogram_bins, parameters.achromatic_bins)
+    reference = colour_model.patch_histograms(
+        bins, patches, total_bins, REFERENCE_OVERSAMPLING * parameters.samples_per_patch
+    )
     bin_weights = (
         np.ones(total_bins)
         if parameters.background_ring_scale is None
@@ -389,7 +434,7 @@ class _ColourRegion(NamedTuple):
         (col0, row0), (col1, row1) = (np.clip(c, 0, [image_width, image_height]).astype(int) for c in (low, high))
         region = image_bgr[row0 : max(row0, row1), col0 : max(col0, col1)]
         bins = (
-            colour_model.colour_bins(region, parameters.bins, parameters.achromatic)
+            colour_model.colour_bins(region, parameters.histogram_bins, parameters.achromatic_bins)
             if region.size
             else np.zeros((0, 0), int)
         )
@@ -400,9 +445,9 @@ class _ColourRegion(NamedTuple):
         target's reference histograms."""
         boxes = colour_model.box_of_states(states, target.aspect)
         boxes = colour_model.patch_boxes(boxes, parameters.patches) - [*self.origin, 0, 0]
-        total_bins = colour_model.bin_count(parameters.bins, parameters.achromatic)
+        total_bins = colour_model.bin_count(parameters.histogram_bins, parameters.achromatic_bins)
         if self.bins.size:
-            histograms = colour_model.patch_histograms(self.bins, boxes, total_bins, parameters.samples)
+            histograms = colour_model.patch_histograms(self.bins, boxes, total_bins, parameters.samples_per_patch)
         else:
             histograms = np.zeros(boxes.shape[:-1] + (total_bins,))
         histograms = colour_model.weigh_histograms(histograms, target.bin_weights)

@@ -35,7 +35,8 @@ from ptztrack.occupancy.detectors import ClusteringDetector, LpomDetector
 from ptztrack.occupancy.lpom import GroundGrid, Modes
 from ptztrack.occupancy.multiview import MultiViewRecording
 from ptztrack.track.kalman import constant_velocity_model
-from ptztrack.track.tracker import TrackerParameters, predict_tracks, update_tracks_on_ground
+from ptztrack.track.parameters import TrackerParameters
+from ptztrack.track.tracker import predict_tracks, update_tracks_on_ground
 from ptztrack.types import Tracks
 
 MATCH_RADIUS_M = 0.5
@@ -156,7 +157,6 @@ def track_on_ground(
     recall,
     separation_m: float,
     frame_rate_hz: float,
-    acceleration_sigma_m_s2: float,
     parameters: TrackerParameters,
 ) -> list[Tracks]:
     """The ground-plane EKF tracker fed by each frame's modes; the reported tracks per frame.
@@ -166,7 +166,7 @@ def track_on_ground(
     mode of its own, so its miss says nothing (detection probability 0); any other's is ``recall``
     (an undetected track's loss of existence; :func:`ptztrack.track.tracker.update_tracks_on_ground`).
     """
-    F, U = constant_velocity_model(1.0 / frame_rate_hz, acceleration_sigma_m_s2)
+    F, U = constant_velocity_model(1.0 / frame_rate_hz, parameters.acceleration_sigma_m_s2)
     tracks, reported = Tracks.empty(), []
     for found, recall_now in zip(modes, recall, strict=True):
         tracks = predict_tracks(tracks, F, U)
@@ -198,7 +198,6 @@ def score_recording(
     recording: MultiViewRecording,
     grid: GroundGrid,
     frames: Frames,
-    acceleration_sigma_m_s2: float,
     tracker: TrackerParameters,
     separation_m: float,
     label: dict | None = None,
@@ -217,7 +216,7 @@ def score_recording(
         truth_m, [c.views for c in frames.clusters], [c.position_m for c in frames.clusters], views
     )
     clustering = [found.select(keep) for found, keep in zip(frames.clusters, kept_clusters, strict=True)]
-    tracks = track_on_ground(lpom, recall, separation_m, recording.frame_rate_hz, acceleration_sigma_m_s2, tracker)
+    tracks = track_on_ground(lpom, recall, separation_m, recording.frame_rate_hz, tracker)
     tracking = clear_metrics(truth_m, [t.ids for t in tracks], [t.mean[:, :2] for t in tracks])
     common = {"dataset": recording.name, **(label or {}), "frames": recording.frames, "views": len(recording.views)}
     rows = [

@@ -18,7 +18,8 @@ import cv2
 import numpy as np
 
 from ptztrack.geometry.calibration import PinholeCalibration, pixel_rays, project_pinhole
-from ptztrack.scene.synthetic import Crowd, walk_people
+from ptztrack.scene.parameters import Crowd
+from ptztrack.scene.synthetic import walk_people
 from ptztrack.types import GroundTruth
 
 FACETS = 16  # facets around each cone
@@ -291,7 +292,7 @@ def room_truth(layout: RoomLayout, people: int, frames: int, seed: int) -> Groun
     0.5 m wide, present throughout."""
     crowd = Crowd(
         count=people,
-        pairs=0,
+        paired_fraction=0.0,
         pair_spacing_m=0.0,
         speed_m_s=(0.5, 1.2),
         height_m=(1.6, 1.9),

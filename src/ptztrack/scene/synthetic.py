@@ -16,39 +16,15 @@ area with head and feet in the image, and a person looks 50 px tall on
 average, close to the 49 px the paper reports for its 'fix' strategy.
 """
 
-from dataclasses import dataclass
-
 import numpy as np
 
+from ptztrack.scene.parameters import Crowd
 from ptztrack.types import GroundTruth
 
 TURN_TIME_CONSTANT_S = 2.0
 LOOKAHEAD_S = 2.0
 MAX_STEERING_RATE_DEG_S = 60.0
 BORDER_MARGIN_M = 0.5
-
-
-@dataclass(frozen=True)
-class Crowd:
-    """Who walks in the synthetic scene.
-
-    count : people; speed_m_s, height_m : [low, high] of the uniform draws per person;
-    width_m : everybody's width; turn_rate_sigma_deg_s : stationary spread of the turn rate;
-    enter_leave : people enter through the border and leave after ``stay_s`` [low, high] seconds;
-    else they are there from the first frame to the last.
-    pairs : how many of them walk in pairs, side by side (persons 0 and 1, 2 and 3, ...): the
-    second of a pair keeps ``pair_spacing_m`` to the left of the first, who leads.
-    """
-
-    count: int
-    pairs: int
-    pair_spacing_m: float
-    speed_m_s: tuple[float, float]
-    height_m: tuple[float, float]
-    width_m: float
-    turn_rate_sigma_deg_s: float
-    enter_leave: bool
-    stay_s: tuple[float, float]
 
 
 def _wrap_angle(angle_rad):

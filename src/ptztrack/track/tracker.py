@@ -38,7 +38,6 @@ track is more often a false positive and a miss at once than a match).
 
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
-from typing import Literal
 
 import numpy as np
 from scipy.stats import chi2
@@ -55,6 +54,7 @@ from ptztrack.geometry.ptz import (
 from ptztrack.roles import ImageSource
 from ptztrack.track import jpdaf, kalman
 from ptztrack.track.association import assign_gated, associate, gated_innovations
+from ptztrack.track.parameters import TrackerParameters
 from ptztrack.types import Detections, TrackerEvidence, Tracks, TrackUpdate
 
 # Feet are found on a pixel grid: the tracker trusts them to half a pixel at
@@ -66,36 +66,6 @@ MIN_PIXEL_NOISE_PX = 0.5
 def pixel_noise_covariance(pixel_noise_px: float) -> np.ndarray:
     """``V`` (2, 2) px^2: the feet-pixel noise the tracker and the policies assume."""
     return max(pixel_noise_px, MIN_PIXEL_NOISE_PX) ** 2 * np.eye(2)
-
-
-@dataclass(frozen=True)
-class TrackerParameters:
-    """The ground-plane tracker's parameters (see :func:`update_tracks`).
-
-    initial_speed_sigma_m_s : spread of a new track's velocity per axis.
-    gate_probability : the chi-square gate (2 degrees of freedom) of the association.
-    existence_at_birth, existence_when_detected, existence_to_delete : the existence probability
-        of a new track, of a track just detected, and below which a track is deleted.
-    max_position_sigma_m : a track more uncertain than this is deleted (inf where people never leave).
-    confirmation_hits, report_position_sigma_m : what the tracker reports (see the module's docstring).
-    association : 'hungarian' or 'cjpdaf' (:mod:`ptztrack.track.jpdaf`).
-    clutter_density_per_px2 : the CJPDAF's C, and the false detections' density ``kappa`` of the existence
-        update (a tracker given a learned clutter rate uses that instead).
-    existence_update : 'bayes' (the module's docstring) or 'fixed'; existence_to_report : see there.
-    """
-
-    initial_speed_sigma_m_s: float
-    gate_probability: float
-    existence_at_birth: float
-    existence_when_detected: float
-    existence_to_delete: float
-    max_position_sigma_m: float
-    confirmation_hits: int
-    report_position_sigma_m: float
-    association: Literal["hungarian", "cjpdaf"]
-    clutter_density_per_px2: float
-    existence_update: Literal["bayes", "fixed"] = "bayes"
-    existence_to_report: float = 0.5
 
 
 DetectionModel = Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray]
@@ -423,9 +393,9 @@ def tracker_evidence(
 class EkfTracker:
     """The ground-plane tracker as a role of the loop (:class:`ptztrack.roles.Tracker`).
 
-    camera : the camera model; step_s, acceleration_sigma_m_s2 : the motion model's step and its white
-    acceleration (:func:`ptztrack.track.kalman.constant_velocity_model`); V : (2, 2) px^2 the detections'
-    noise; parameters : see :func:`update_tracks`;
+    camera : the camera model; step_s : the motion model's step (s) when :meth:`predict` is given none;
+    V : (2, 2) px^2 the detections' noise; parameters : see :class:`TrackerParameters` (its
+    ``acceleration_sigma_m_s2`` that of :func:`ptztrack.track.kalman.constant_velocity_model`);
     detection_model : what the detector would find (see :data:`DetectionModel`);
     learner : given every step's :class:`~ptztrack.types.TrackerEvidence` (a detector model that
         learns from it, say; None: nobody).
@@ -435,7 +405,6 @@ class EkfTracker:
 
     camera: PTZCamera
     step_s: float
-    acceleration_sigma_m_s2: float
     V: np.ndarray
     parameters: TrackerParameters
     detection_model: DetectionModel
@@ -444,7 +413,8 @@ class EkfTracker:
     clutter_per_view: Callable[[], float] | None = None
 
     def predict(self, dt_s: float | None = None) -> Tracks:
-        F, U = kalman.constant_velocity_model(self.step_s if dt_s is None else dt_s, self.acceleration_sigma_m_s2)
+        dt_s = self.step_s if dt_s is None else dt_s
+        F, U = kalman.constant_velocity_model(dt_s, self.parameters.acceleration_sigma_m_s2)
         self.tracks = predict_tracks(self.tracks, F, U)
         return self.tracks
 
