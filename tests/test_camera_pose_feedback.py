@@ -7,6 +7,7 @@ from ptztrack.builders.episode import run_episode
 from ptztrack.builders.registration import live_view_model, reference_index, registration_camera
 from ptztrack.builders.world import action_grid, landing_error
 from ptztrack.camera import pose_feedback
+from ptztrack.camera.parameters import LandingError
 from ptztrack.config import LiveView, PoseError, ScenarioError, pets_scenario, scenario_from_dict
 from ptztrack.evaluate.metrics import episode_metrics
 from ptztrack.experiments.registration import live_view_settings, registration_views, summarise_registration
@@ -29,9 +30,7 @@ def test_a_perfect_camera_lands_exactly_where_it_is_sent():
 
 
 def test_bias_and_noise_of_the_landing_pose_have_the_configured_size():
-    error = pose_feedback.LandingError(
-        pan_tilt_sigma_deg=2.0, pan_tilt_bias_deg=(1.0, -0.5), zoom_sigma=0.03, zoom_bias=1.1
-    )
+    error = LandingError(pan_tilt_sigma_deg=2.0, pan_tilt_bias_deg=(1.0, -0.5), zoom_sigma=0.03, zoom_bias=1.1)
     rng = np.random.default_rng(1)
     commanded = np.array([10.0, 20.0, 2.0])
     landed = np.array([pose_feedback.landed_pose(commanded, error, rng) for _ in range(20000)])

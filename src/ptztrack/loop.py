@@ -19,7 +19,8 @@ from functools import partial
 import numpy as np
 
 from ptztrack.camera.actions import ActionGrid
-from ptztrack.camera.pose_feedback import LandingError, landed_pose
+from ptztrack.camera.parameters import LandingError
+from ptztrack.camera.pose_feedback import landed_pose
 from ptztrack.detect.detector_model import OnlineDetectorModel
 from ptztrack.geometry.ptz import PTZCamera
 from ptztrack.roles import CameraBackend, Detector, ImageSource, Policy, PoseSource, Tracker

@@ -4,7 +4,9 @@ its views depart from the pinhole model, its reference index and the registered 
 
 import numpy as np
 
-from ptztrack.camera.live_view import LiveViewModel, k1_at_zoom
+from ptztrack.builders.parameters import parameters_from
+from ptztrack.camera.live_view import k1_at_zoom
+from ptztrack.camera.parameters import LiveViewModel
 from ptztrack.camera.pose_feedback import RegisteredPose, build_reference_index, cached_reference_index, reference_poses
 from ptztrack.camera.virtual import VirtualPTZ, virtual_ptz
 from ptztrack.config import Scenario, ScenarioError
@@ -39,9 +41,7 @@ def live_view_model(scenario: Scenario) -> LiveViewModel | None:
     live_view = scenario.camera.live_view
     if live_view is None:
         return None
-    model = LiveViewModel(
-        offset_image_width_px=scenario.pose_feedback.image_size_px[0], **live_view.model_dump(mode="python")
-    )
+    model = parameters_from(live_view, LiveViewModel, offset_image_width_px=scenario.pose_feedback.image_size_px[0])
     camera = registration_camera(scenario)[0].camera
     for zoom in np.linspace(1.0, max(max(scenario.actions.zoom), model.tele_zoom), 50):
         if not distortion_invertible(k1_at_zoom(model, zoom), corner_radius2(camera, zoom)):

@@ -10,7 +10,8 @@ from ptztrack import registry
 from ptztrack.builders.parameters import parameters_from
 from ptztrack.builders.registration import registered_pose_source
 from ptztrack.camera.actions import ActionGrid
-from ptztrack.camera.pose_feedback import LandingError, commanded_pose, true_pose
+from ptztrack.camera.parameters import LandingError
+from ptztrack.camera.pose_feedback import commanded_pose, true_pose
 from ptztrack.camera.virtual import VirtualPTZ, virtual_ptz
 from ptztrack.config import Scenario, ScenarioError
 from ptztrack.control.baselines import widest_view_action
@@ -133,7 +134,7 @@ def pose_source(scenario: Scenario, scene: BuiltScene) -> PoseSource:
 
 
 def landing_error(scenario: Scenario) -> LandingError:
-    return LandingError(**scenario.camera.pose_error.model_dump())
+    return parameters_from(scenario.camera.pose_error, LandingError)
 
 
 def recall_model(scenario: Scenario) -> RecallModel:

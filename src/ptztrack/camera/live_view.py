@@ -22,35 +22,9 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
+from ptztrack.camera.parameters import LiveViewModel
 from ptztrack.camera.virtual import VirtualPTZ, resample
 from ptztrack.geometry.lens import Lens, pixel_directions, project_directions
-
-
-@dataclass(frozen=True)
-class LiveViewModel:
-    """The departures of a real PTZ camera's views from the pinhole model, and their ranges.
-
-    roll_max_deg : roll about the optical axis, uniform in [-roll_max_deg, roll_max_deg].
-    principal_offset_max_px : principal point offset, uniform over the disc of this radius, in
-        pixels of an image ``offset_image_width_px`` wide (other image sizes scale it).
-    k1_wide, k1_tele, tele_zoom : radial distortion (normalised coordinates), k1_wide at zoom 1
-        falling linearly to k1_tele at ``tele_zoom`` and held beyond.
-    gain : (low, high) contrast factor, uniform; brightness_max : brightness offset in grey
-        levels, uniform in [-brightness_max, brightness_max].
-    jpeg_quality : JPEG quality (1-100) each image is compressed at.
-    seed : the camera unit: its views' values at a pose are fixed by the seed and the pose.
-    """
-
-    roll_max_deg: float
-    principal_offset_max_px: float
-    offset_image_width_px: int
-    k1_wide: float
-    k1_tele: float
-    tele_zoom: float
-    gain: tuple[float, float]
-    brightness_max: float
-    jpeg_quality: int
-    seed: int
 
 
 @dataclass(frozen=True)

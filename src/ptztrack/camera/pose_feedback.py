@@ -18,22 +18,11 @@ from pathlib import Path
 
 import numpy as np
 
-from ptztrack.camera.live_view import LiveViewModel, render_view
+from ptztrack.camera.live_view import render_view
+from ptztrack.camera.parameters import LandingError, LiveViewModel
 from ptztrack.camera.virtual import VirtualPTZ
 from ptztrack.geometry.registration import ReferenceIndex, build_index, load_index, register, save_index
 from ptztrack.scene.pets import RecordedVideo
-
-
-@dataclass(frozen=True)
-class LandingError:
-    """How far a camera lands from the pose it is sent to: pan and tilt off by ``pan_tilt_bias_deg``
-    plus Gaussian errors of ``pan_tilt_sigma_deg``, zoom times ``zoom_bias`` times (1 + a Gaussian
-    error of ``zoom_sigma``)."""
-
-    pan_tilt_sigma_deg: float
-    pan_tilt_bias_deg: tuple[float, float]
-    zoom_sigma: float
-    zoom_bias: float
 
 
 def landed_pose(commanded, error: LandingError, rng: np.random.Generator) -> np.ndarray:

@@ -12,7 +12,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ptztrack.camera.live_view import LiveViewModel, recorded_to_live, render_view
+from ptztrack.camera.live_view import recorded_to_live, render_view
+from ptztrack.camera.parameters import LiveViewModel
 from ptztrack.camera.virtual import VirtualPTZ
 from ptztrack.geometry.occlusion import occluded_fraction
 from ptztrack.scene.pets import RecordedScene, RecordedVideo

@@ -6,6 +6,7 @@ from typing import Annotated, Literal
 import numpy as np
 from pydantic import Field, model_validator
 
+from ptztrack.camera.parameters import LandingError, LiveViewModel
 from ptztrack.config.fields import (
     Degrees,
     NonNegativeFloat,
@@ -27,13 +28,14 @@ class PoseError(_Strict):
     Each time the command changes, the camera lands at the commanded pan and tilt plus
     ``pan_tilt_bias_deg`` plus independent Gaussian errors of ``pan_tilt_sigma_deg``, and at the
     commanded zoom times ``zoom_bias`` times (1 + a Gaussian error of ``zoom_sigma``); it stays there
-    while the command does not change. The defaults are a perfect camera.
+    while the command does not change. The defaults are
+    :class:`~ptztrack.camera.parameters.LandingError`'s: a perfect camera.
     """
 
-    pan_tilt_sigma_deg: Annotated[NonNegativeFloat, at_most(90, "degrees")] = 0.0
-    pan_tilt_bias_deg: tuple[Degrees, Degrees] = (0.0, 0.0)
-    zoom_sigma: Annotated[float, Field(ge=0, lt=0.5)] = 0.0
-    zoom_bias: Annotated[PositiveFloat, at_most(10, "a factor on the zoom")] = 1.0
+    pan_tilt_sigma_deg: Annotated[NonNegativeFloat, at_most(90, "degrees")] = LandingError.pan_tilt_sigma_deg
+    pan_tilt_bias_deg: tuple[Degrees, Degrees] = LandingError.pan_tilt_bias_deg
+    zoom_sigma: Annotated[float, Field(ge=0, lt=0.5)] = LandingError.zoom_sigma
+    zoom_bias: Annotated[PositiveFloat, at_most(10, "a factor on the zoom")] = LandingError.zoom_bias
 
 
 _Gain = Annotated[PositiveFloat, at_most(100, "a factor on the contrast")]
@@ -41,7 +43,8 @@ _Gain = Annotated[PositiveFloat, at_most(100, "a factor on the contrast")]
 
 class LiveView(_Strict):
     """How a real PTZ camera's views depart from the pinhole model (:mod:`ptztrack.camera.live_view`);
-    the defaults are the realistic model of the registration experiment.
+    the defaults (:class:`~ptztrack.camera.parameters.LiveViewModel`'s) are the realistic model of the
+    registration experiment.
 
     Each view is rolled by up to ``roll_max_deg`` (uniform), its principal point is off the centre
     by up to ``principal_offset_max_px`` (uniform over the disc; pixels of the registered image,
@@ -52,16 +55,19 @@ class LiveView(_Strict):
     view's values are fixed by ``seed`` (the camera unit) and its pose.
     """
 
-    roll_max_deg: Annotated[NonNegativeFloat, at_most(45, "degrees: a mount rolled further is not level")] = 2.0
-    principal_offset_max_px: Annotated[NonNegativeFloat, at_most(1000, "pixels")] = 10.0
-    # The PETS camera's own lens over the field of our zoom-1 view (its calibration's k1).
-    k1_wide: Annotated[float, Field(gt=-1, lt=1)] = -0.15
-    k1_tele: Annotated[float, Field(gt=-1, lt=1)] = 0.0
-    tele_zoom: Annotated[float, Field(gt=1), at_most(100, "a PTZ camera's optical zoom")] = 4.0
-    gain: tuple[_Gain, _Gain] = (0.7, 1.3)
-    brightness_max: Annotated[NonNegativeFloat, at_most(255, "grey levels")] = 20.0
-    jpeg_quality: int = Field(75, ge=1, le=100)
-    seed: int = Field(0, ge=0, lt=2**63)
+    roll_max_deg: Annotated[NonNegativeFloat, at_most(45, "degrees: a mount rolled further is not level")] = (
+        LiveViewModel.roll_max_deg
+    )
+    principal_offset_max_px: Annotated[NonNegativeFloat, at_most(1000, "pixels")] = (
+        LiveViewModel.principal_offset_max_px
+    )
+    k1_wide: Annotated[float, Field(gt=-1, lt=1)] = LiveViewModel.k1_wide
+    k1_tele: Annotated[float, Field(gt=-1, lt=1)] = LiveViewModel.k1_tele
+    tele_zoom: Annotated[float, Field(gt=1), at_most(100, "a PTZ camera's optical zoom")] = LiveViewModel.tele_zoom
+    gain: tuple[_Gain, _Gain] = LiveViewModel.gain
+    brightness_max: Annotated[NonNegativeFloat, at_most(255, "grey levels")] = LiveViewModel.brightness_max
+    jpeg_quality: int = Field(LiveViewModel.jpeg_quality, ge=1, le=100)
+    seed: int = Field(LiveViewModel.seed, ge=0, lt=2**63)
 
     @model_validator(mode="after")
     def _gain_ordered(self):

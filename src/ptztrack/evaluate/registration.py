@@ -20,7 +20,8 @@ from collections.abc import Callable
 
 import numpy as np
 
-from ptztrack.camera.live_view import LiveViewModel, render_view, view_lens
+from ptztrack.camera.live_view import render_view, view_lens
+from ptztrack.camera.parameters import LiveViewModel
 from ptztrack.camera.virtual import VirtualPTZ
 from ptztrack.geometry.lens import Lens, pixel_directions, project_directions
 from ptztrack.geometry.ptz import PTZCamera, apply_homography, image_to_ground, inside_image
