@@ -22,13 +22,13 @@ from pathlib import Path  # noqa: E402
 import cv2  # noqa: E402
 import numpy as np  # noqa: E402
 
-from ptztrack.builders.occupancy import lpom_parameters, room_recording  # noqa: E402
-from ptztrack.config import Occupancy  # noqa: E402
+from ptztrack.builders.occupancy import room_recording  # noqa: E402
 from ptztrack.files import write_atomically  # noqa: E402
-from ptztrack.occupancy.detectors import LpomDetector  # noqa: E402
+from ptztrack.occupancy.detectors import LpomDetector, lpom_parameters  # noqa: E402
 from ptztrack.occupancy.lpom import map_modes, occupancy_map, table_map  # noqa: E402
 from ptztrack.occupancy.motion_edges import motion_edges  # noqa: E402
 from ptztrack.occupancy.multiview import CameraView  # noqa: E402
+from ptztrack.occupancy.parameters import OccupancyParameters  # noqa: E402
 
 
 def main() -> None:
@@ -47,7 +47,7 @@ def main() -> None:
     recording = type(recording)(
         recording.name, views, recording.frames, recording.frame_rate_hz, recording.area_m, None
     )
-    parameters = lpom_parameters(Occupancy())
+    parameters = lpom_parameters(OccupancyParameters())
     start = time.perf_counter()
     detector = LpomDetector(recording, parameters)
     build_s = time.perf_counter() - start

@@ -2,9 +2,8 @@ import numpy as np
 import pytest
 from scipy.stats import multivariate_normal
 
-from ptztrack.builders.occupancy import lpom_parameters, room_recording
-from ptztrack.config import Occupancy
-from ptztrack.occupancy.detectors import LpomDetector
+from ptztrack.builders.occupancy import room_recording
+from ptztrack.occupancy.detectors import LpomDetector, lpom_parameters
 from ptztrack.occupancy.locus import PERSON
 from ptztrack.occupancy.lpom import (
     GroundGrid,
@@ -18,12 +17,13 @@ from ptztrack.occupancy.lpom import (
     table_map,
 )
 from ptztrack.occupancy.motion_edges import box_outline_points
+from ptztrack.occupancy.parameters import OccupancyParameters
 from ptztrack.occupancy.room import RoomLayout, room_cameras
 
 
 def test_a_single_person_in_the_synthetic_room_gives_one_mode_near_the_truth():
     recording = room_recording(people=1, frames=6, seed=3)
-    detector = LpomDetector(recording, lpom_parameters(Occupancy()))
+    detector = LpomDetector(recording, lpom_parameters(OccupancyParameters()))
     for frame in range(recording.frames):
         pom, modes = detector.detect(frame)
         if frame == 0:

@@ -8,12 +8,9 @@ from pathlib import Path
 import numpy as np
 import psutil
 
-from ptztrack.config import MAX_DATASET_FRAMES, DatasetView, MultiViewDataset, Occupancy
+from ptztrack.config import MAX_DATASET_FRAMES, DatasetView, MultiViewDataset
 from ptztrack.geometry.calibration import PinholeCalibration, load_pinhole, load_tsai, pinhole_from_tsai
 from ptztrack.occupancy.detectors import LpomParameters
-from ptztrack.occupancy.locus import PERSON, ConeModel
-from ptztrack.occupancy.lpom import LocusSampling, sampled_heights
-from ptztrack.occupancy.motion_edges import MotionEdgeParameters
 from ptztrack.occupancy.multiview import CameraView, ImageFolder, MultiViewRecording, load_mot_detections, mot_truth
 from ptztrack.occupancy.room import RoomLayout, RoomRenderer, room_truth
 from ptztrack.scene.pets import DatasetError, RecordedVideo
@@ -21,26 +18,6 @@ from ptztrack.scene.pets import DatasetError, RecordedVideo
 ROOM_AREA_M = ((0.0, 0.0), (5.0, 6.0))
 # 20 s at 15 Hz per sequence (the paper's were 3.5 and 7 minutes long).
 ROOM = RoomLayout()
-
-
-def lpom_parameters(config: Occupancy) -> LpomParameters:
-    model = ConeModel(PERSON.height_fraction, PERSON.radius_fraction, config.width_m)
-    heights = sampled_heights(config.min_height_m, config.max_height_m, config.height_step_m)
-    return LpomParameters(
-        sampling=LocusSampling(model, heights, config.samples_per_height),
-        cell_m=config.cell_m,
-        kernel_sigma_m=config.kernel_sigma_m,
-        separation_m=config.separation_m,
-        window_m=config.window_m,
-        # Candidates well below any threshold the fit may choose (its smallest is 0.05).
-        candidate_strength=0.02,
-        block_px=config.block_px,
-        edges=MotionEdgeParameters(
-            config.canny_low, config.canny_high, config.difference_threshold, config.dilation_px
-        ),
-        outline_points_per_box=config.outline_points_per_box,
-        min_box_score=config.min_box_score,
-    )
 
 
 def locus_table_bytes(recording: MultiViewRecording, parameters: LpomParameters) -> float:

@@ -11,6 +11,7 @@ from pydantic import Field, model_validator
 from ptztrack.config.fields import _MAX_FRAMES, NonNegativeFloat, Pixels, PositiveFloat, _Strict, at_most, at_most_items
 from ptztrack.config.reading import ScenarioError, _first_error_line, read_yaml
 from ptztrack.config.scenario import Tracker
+from ptztrack.occupancy.parameters import OccupancyParameters
 
 
 class DatasetView(_Strict):
@@ -52,36 +53,37 @@ MAX_DATASET_FRAMES = _MAX_FRAMES
 
 
 class Occupancy(_Strict):
-    """The occupancy-map detector, its baseline and where their parameters come from (docs: the occupancy map).
-
-    Person model (equation 4, Algorithm 1): heights from min_height_m up to max_height_m in steps of
-    height_step_m (at the steps' midpoints), width_m, samples_per_height tangent points per height.
-    Map: cell_m, kernel_sigma_m (the Gaussian kernel), block_px (locus tables per block of pixels).
-    Modes: separation_m (closest two people), window_m (their mean and covariance), min_strength
-    (fraction of the frame's strongest mode; None: fitted on the other half of the frames).
-    Motion edges: canny_low, canny_high, difference_threshold (grey levels), dilation_px.
-    Boxes: outline_points_per_box, min_box_score. Baseline: linkage_m (complete-linkage cut),
-    min_views (None: fitted like min_strength), blob_min_area_px (blob boxes of views without detections).
+    """The occupancy-map detector and its baseline (docs: the occupancy map): the fields of
+    :class:`~ptztrack.occupancy.parameters.OccupancyParameters`, whose defaults it takes and where
+    their meaning is given.
     """
 
-    min_height_m: _PersonHeight = 1.6
-    max_height_m: _PersonHeight = 1.9
-    height_step_m: _PersonHeight = 0.1
-    width_m: Annotated[PositiveFloat, at_most(10, "metres: a person")] = 0.5
-    samples_per_height: Annotated[int, Field(ge=1), at_most(1000, _LOCUS_MEMORY)] = 32
-    cell_m: PositiveFloat = 0.05
-    kernel_sigma_m: _GroundDistance = 0.1
-    block_px: Annotated[int, Field(ge=1), at_most(256, "pixels")] = 4
-    separation_m: _GroundDistance = 0.5
-    window_m: _GroundDistance = 0.25
-    canny_low: Annotated[NonNegativeFloat, at_most(10_000, "a gradient magnitude")] = 50.0
-    canny_high: Annotated[NonNegativeFloat, at_most(10_000, "a gradient magnitude")] = 150.0
-    difference_threshold: Annotated[NonNegativeFloat, at_most(255, "grey levels")] = 15.0
-    dilation_px: Annotated[int, Field(ge=0), at_most(256, "pixels")] = 2
-    outline_points_per_box: Annotated[int, Field(ge=4), at_most(10_000, _LOCUS_MEMORY)] = 64
-    min_box_score: float = Field(0.5, ge=0, le=1)
-    linkage_m: _GroundDistance = 1.0
-    blob_min_area_px: Annotated[int, Field(ge=1), at_most(8192 * 8192, "an image's pixels")] = 400
+    min_height_m: _PersonHeight = OccupancyParameters.min_height_m
+    max_height_m: _PersonHeight = OccupancyParameters.max_height_m
+    height_step_m: _PersonHeight = OccupancyParameters.height_step_m
+    width_m: Annotated[PositiveFloat, at_most(10, "metres: a person")] = OccupancyParameters.width_m
+    samples_per_height: Annotated[int, Field(ge=1), at_most(1000, _LOCUS_MEMORY)] = (
+        OccupancyParameters.samples_per_height
+    )
+    cell_m: PositiveFloat = OccupancyParameters.cell_m
+    kernel_sigma_m: _GroundDistance = OccupancyParameters.kernel_sigma_m
+    block_px: Annotated[int, Field(ge=1), at_most(256, "pixels")] = OccupancyParameters.block_px
+    separation_m: _GroundDistance = OccupancyParameters.separation_m
+    window_m: _GroundDistance = OccupancyParameters.window_m
+    canny_low: Annotated[NonNegativeFloat, at_most(10_000, "a gradient magnitude")] = OccupancyParameters.canny_low
+    canny_high: Annotated[NonNegativeFloat, at_most(10_000, "a gradient magnitude")] = OccupancyParameters.canny_high
+    difference_threshold: Annotated[NonNegativeFloat, at_most(255, "grey levels")] = (
+        OccupancyParameters.difference_threshold
+    )
+    dilation_px: Annotated[int, Field(ge=0), at_most(256, "pixels")] = OccupancyParameters.dilation_px
+    outline_points_per_box: Annotated[int, Field(ge=4), at_most(10_000, _LOCUS_MEMORY)] = (
+        OccupancyParameters.outline_points_per_box
+    )
+    min_box_score: float = Field(OccupancyParameters.min_box_score, ge=0, le=1)
+    linkage_m: _GroundDistance = OccupancyParameters.linkage_m
+    blob_min_area_px: Annotated[int, Field(ge=1), at_most(8192 * 8192, "an image's pixels")] = (
+        OccupancyParameters.blob_min_area_px
+    )
 
     @model_validator(mode="after")
     def _heights_ordered(self):

@@ -10,16 +10,16 @@ per method, are tabled by :func:`format_occupancy_table`.
 from collections.abc import Callable
 
 from ptztrack.builders.occupancy import (
-    lpom_parameters,
     recording_from_dataset,
     refuse_if_tables_too_large,
     room_recording,
 )
 from ptztrack.builders.parameters import parameters_from
 from ptztrack.config import MultiViewDataset, Occupancy, OccupancyTracker, Tracker
-from ptztrack.occupancy.detectors import ClusteringDetector, LpomDetector
+from ptztrack.occupancy.detectors import ClusteringDetector, LpomDetector, lpom_parameters
 from ptztrack.occupancy.evaluation import OccupancyRun, detect_frames, score_recording
 from ptztrack.occupancy.multiview import MultiViewRecording
+from ptztrack.occupancy.parameters import OccupancyParameters
 from ptztrack.scene.pets import DatasetError
 from ptztrack.track.parameters import TrackerParameters
 
@@ -49,10 +49,11 @@ def run_recording(
     """Both detectors over every frame of ``recording``, scored (the recording needs ground truth)."""
     if recording.truth is None:
         raise DatasetError(f"{recording.name}: the experiment needs ground truth (ground_truth)")
-    parameters = lpom_parameters(occupancy)
+    settings = parameters_from(occupancy, OccupancyParameters)
+    parameters = lpom_parameters(settings)
     refuse_if_tables_too_large(recording, parameters)
     lpom = LpomDetector(recording, parameters)
-    clustering = ClusteringDetector(recording, occupancy.linkage_m, occupancy.min_box_score, occupancy.blob_min_area_px)
+    clustering = ClusteringDetector(recording, settings.linkage_m, settings.min_box_score, settings.blob_min_area_px)
     frames = detect_frames(recording, lpom, clustering, progress)
     # People leave a dataset's area (and never the room's, whose tracks stay well localised).
     tracking = parameters_from(tracker, TrackerParameters)

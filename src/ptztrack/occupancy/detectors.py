@@ -14,6 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ptztrack.occupancy.clustering import BlobBoxes, Clusters, cluster_feet, feet_on_ground
+from ptztrack.occupancy.locus import PERSON, ConeModel
 from ptztrack.occupancy.lpom import (
     GroundGrid,
     LocusSampling,
@@ -23,10 +24,12 @@ from ptztrack.occupancy.lpom import (
     map_modes,
     occupancy_map,
     points_map,
+    sampled_heights,
     table_map,
 )
 from ptztrack.occupancy.motion_edges import MotionEdgeParameters, box_outline_points, motion_edges
 from ptztrack.occupancy.multiview import CameraView, MultiViewRecording
+from ptztrack.occupancy.parameters import OccupancyParameters
 
 
 @dataclass(frozen=True)
@@ -49,6 +52,28 @@ class LpomParameters:
     edges: MotionEdgeParameters
     outline_points_per_box: int
     min_box_score: float
+
+
+def lpom_parameters(parameters: OccupancyParameters) -> LpomParameters:
+    """The occupancy map's parameters from the detector's (the person a cone of ``width_m``)."""
+    model = ConeModel(PERSON.height_fraction, PERSON.radius_fraction, parameters.width_m)
+    heights = sampled_heights(parameters.min_height_m, parameters.max_height_m, parameters.height_step_m)
+    edges = MotionEdgeParameters(
+        parameters.canny_low, parameters.canny_high, parameters.difference_threshold, parameters.dilation_px
+    )
+    return LpomParameters(
+        sampling=LocusSampling(model, heights, parameters.samples_per_height),
+        cell_m=parameters.cell_m,
+        kernel_sigma_m=parameters.kernel_sigma_m,
+        separation_m=parameters.separation_m,
+        window_m=parameters.window_m,
+        # Candidates well below any threshold the fit may choose (its smallest is 0.05).
+        candidate_strength=0.02,
+        block_px=parameters.block_px,
+        edges=edges,
+        outline_points_per_box=parameters.outline_points_per_box,
+        min_box_score=parameters.min_box_score,
+    )
 
 
 def scored_boxes(view: CameraView, frame: int, min_score: float) -> np.ndarray:
