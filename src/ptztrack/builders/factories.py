@@ -21,7 +21,6 @@ from ptztrack.control.information_policy import InformationGainPolicy
 from ptztrack.detect.hog import GroundSearch, HogPeopleDetector
 from ptztrack.detect.simulated import AnnotationDetector, RecallCurve, RecallDetector, RecallModel
 from ptztrack.loop import World
-from ptztrack.scene.pets import RecordedVideo
 from ptztrack.track.parameters import TrackerParameters
 from ptztrack.track.templates import TemplateTracker
 from ptztrack.track.tracker import DetectionModel, EkfTracker, pixel_noise_covariance
@@ -152,12 +151,8 @@ def simulated_camera(scenario: Scenario, scene) -> SimulatedPTZ:
 
 def virtual_camera(scenario: Scenario, scene) -> RecordedPTZ:
     """The virtual PTZ camera over the scenario's recording (images only if it names a video)."""
-    recording = scenario.required_recording("camera.backend 'virtual'")
-    frames_needed = int(scene.recording.video_frame.max()) + 1
-    video = (
-        None if recording.video is None else RecordedVideo(recording.video, recording.recorded_size_px, frames_needed)
-    )
-    return RecordedPTZ(scene.virtual, scene.recording, video, live_view_model(scenario))
+    scenario.required_recording("camera.backend 'virtual'")
+    return RecordedPTZ(scene.virtual, scene.recording, scene.video, live_view_model(scenario, scene.calibration))
 
 
 def ekf_tracker(scenario: Scenario, world: World) -> EkfTracker | TemplateTracker:

@@ -10,7 +10,7 @@ from ptztrack.camera.parameters import LiveViewModel
 from ptztrack.camera.pose_feedback import RegisteredPose, build_reference_index, cached_reference_index, reference_poses
 from ptztrack.camera.virtual import VirtualPTZ, virtual_ptz
 from ptztrack.config import Scenario, ScenarioError
-from ptztrack.geometry.calibration import load_calibration
+from ptztrack.geometry.calibration import PinholeCalibration, load_calibration
 from ptztrack.geometry.lens import corner_radius2, distortion_invertible
 from ptztrack.geometry.registration import ReferenceIndex
 from ptztrack.scene.pets import RecordedVideo
@@ -28,21 +28,27 @@ LIVE_GAP_FRAMES = 300
 REFERENCE_SEED = 20091
 
 
-def registration_camera(scenario: Scenario) -> tuple[VirtualPTZ, np.ndarray]:
-    """The recording scenario's virtual camera at ``pose_feedback.image_size_px``, and its whole-frame pose."""
+def registration_camera(
+    scenario: Scenario, calibration: PinholeCalibration | None = None
+) -> tuple[VirtualPTZ, np.ndarray]:
+    """The recording scenario's virtual camera at ``pose_feedback.image_size_px``, and its whole-frame pose.
+
+    calibration : the recording's, when the caller has read it already.
+    """
     recording = scenario.required_recording("registration")
-    calibration = load_calibration(recording.calibration, recording.view)
+    calibration = calibration or load_calibration(recording.calibration, recording.view)
     return virtual_ptz(calibration, recording.recorded_size_px, scenario.pose_feedback.image_size_px)
 
 
-def live_view_model(scenario: Scenario) -> LiveViewModel | None:
+def live_view_model(scenario: Scenario, calibration: PinholeCalibration | None = None) -> LiveViewModel | None:
     """The scenario's ``camera.live_view`` as the camera layer's model; None for exact pinhole views.
-    Its principal point offset is in pixels of the registered image."""
+    Its principal point offset is in pixels of the registered image. calibration : the recording's,
+    when the caller has read it already."""
     live_view = scenario.camera.live_view
     if live_view is None:
         return None
     model = parameters_from(live_view, LiveViewModel, offset_image_width_px=scenario.pose_feedback.image_size_px[0])
-    camera = registration_camera(scenario)[0].camera
+    camera = registration_camera(scenario, calibration)[0].camera
     for zoom in np.linspace(1.0, max(max(scenario.actions.zoom), model.tele_zoom), 50):
         if not distortion_invertible(k1_at_zoom(model, zoom), corner_radius2(camera, zoom)):
             raise ScenarioError(
@@ -71,12 +77,14 @@ def scenario_reference_poses(scenario: Scenario, whole_frame_pose) -> np.ndarray
     )
 
 
-def reference_index(scenario: Scenario, camera: tuple[VirtualPTZ, np.ndarray] | None = None) -> ReferenceIndex:
+def reference_index(
+    scenario: Scenario, camera: tuple[VirtualPTZ, np.ndarray] | None = None, video: RecordedVideo | None = None
+) -> ReferenceIndex:
     """The reference index of a recording scenario: views over its action grid's pan and tilt range,
     rendered from the frames of :func:`reference_frames`. Read from ``pose_feedback.index`` when that
     file exists; built otherwise (about a minute), and written there when a path is given.
 
-    camera : ``registration_camera(scenario)``, when the caller has it already.
+    camera : ``registration_camera(scenario)``, video : the recording's video, when the caller has them.
     """
     recording, feedback = scenario.required_recording("registration"), scenario.pose_feedback
     video_path = scenario.required_video("registration")
@@ -84,8 +92,8 @@ def reference_index(scenario: Scenario, camera: tuple[VirtualPTZ, np.ndarray] | 
     poses = scenario_reference_poses(scenario, whole_frame_pose)
 
     def build():
-        video = RecordedVideo(video_path, recording.recorded_size_px)
-        frames = [video.frame(int(frame)) for frame in reference_frames(len(poses))]
+        source = video or RecordedVideo(video_path, recording.recorded_size_px)
+        frames = [source.frame(int(frame)) for frame in reference_frames(len(poses))]
         rng = np.random.default_rng(REFERENCE_SEED)
         return build_reference_index(
             virtual, frames, poses, feedback.reference_pose_sigma_deg, feedback.reference_zoom_spread, rng
@@ -94,12 +102,11 @@ def reference_index(scenario: Scenario, camera: tuple[VirtualPTZ, np.ndarray] | 
     return cached_reference_index(feedback.index, build)
 
 
-def registered_pose_source(scenario: Scenario, video_frame: np.ndarray) -> RegisteredPose:
-    """The registered pose source of a recording scenario whose step ``t`` shows frame ``video_frame[t]``;
-    it registers the views of ``camera.live_view``."""
-    recording = scenario.required_recording("registration")
-    camera = registration_camera(scenario)
-    video = RecordedVideo(
-        scenario.required_video("registration"), recording.recorded_size_px, int(video_frame.max()) + 1
-    )
-    return RegisteredPose(camera[0], reference_index(scenario, camera), video, video_frame, live_view_model(scenario))
+def registered_pose_source(
+    scenario: Scenario, video_frame: np.ndarray, calibration: PinholeCalibration, video: RecordedVideo
+) -> RegisteredPose:
+    """The registered pose source of a recording scenario whose step ``t`` shows frame ``video_frame[t]``
+    of ``video``; it registers the views of ``camera.live_view``. calibration : the recording's."""
+    camera = registration_camera(scenario, calibration)
+    index = reference_index(scenario, camera, video)
+    return RegisteredPose(camera[0], index, video, video_frame, live_view_model(scenario, calibration))

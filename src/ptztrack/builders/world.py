@@ -18,12 +18,12 @@ from ptztrack.control.baselines import widest_view_action
 from ptztrack.detect.detector_model import OnlineDetectorModel, read_detector_model_file
 from ptztrack.detect.simulated import RecallModel
 from ptztrack.geometry.area import rectangle_m
-from ptztrack.geometry.calibration import load_calibration
+from ptztrack.geometry.calibration import PinholeCalibration, load_calibration
 from ptztrack.geometry.ptz import PTZCamera, ground_footprint
 from ptztrack.loop import World
 from ptztrack.roles import CameraBackend, Detector, PoseSource
 from ptztrack.scene.parameters import Crowd
-from ptztrack.scene.pets import RecordedScene, load_mot_ground_truth, recorded_scene
+from ptztrack.scene.pets import RecordedScene, RecordedVideo, load_mot_ground_truth, recorded_scene
 from ptztrack.scene.synthetic import walk_people
 from ptztrack.types import GroundTruth
 
@@ -39,7 +39,9 @@ class BuiltScene:
 
     camera : the PTZ camera model; grid : its action grid; truth : the people;
     area_polygon_m : (K, 2) the walkable area, a polygon on the ground.
-    recording, virtual : for a recording, its annotated people and the virtual PTZ camera over it.
+    recording, virtual : for a recording, its annotated people and the virtual PTZ camera over it;
+    calibration, video : its calibration and its video (None without one), each read once here for
+    whoever needs them (the camera backend, the pose source).
     """
 
     camera: PTZCamera
@@ -48,6 +50,8 @@ class BuiltScene:
     area_polygon_m: np.ndarray
     recording: RecordedScene | None = None
     virtual: VirtualPTZ | None = None
+    calibration: PinholeCalibration | None = None
+    video: RecordedVideo | None = None
 
 
 def ptz_camera(scenario: Scenario) -> PTZCamera:
@@ -97,7 +101,10 @@ def build_scene(scenario: Scenario, scene_rng: np.random.Generator) -> BuiltScen
         area_polygon_m = np.asarray(recording.area_m, dtype=float)
     else:
         area_polygon_m = visible_ground_m(scenario, virtual.camera, whole_frame_pose, grid)
-    return BuiltScene(virtual.camera, grid, scene.truth, area_polygon_m, scene, virtual)
+    video = None
+    if recording.video is not None:
+        video = RecordedVideo(recording.video, recording.recorded_size_px, int(scene.video_frame.max()) + 1)
+    return BuiltScene(virtual.camera, grid, scene.truth, area_polygon_m, scene, virtual, calibration, video)
 
 
 def visible_ground_m(scenario: Scenario, camera: PTZCamera, whole_frame_pose, grid: ActionGrid) -> np.ndarray:
@@ -129,7 +136,9 @@ def pose_source(scenario: Scenario, scene: BuiltScene) -> PoseSource:
     if source == "registered":
         if scene.recording is None:
             raise ScenarioError("pose_feedback.source 'registered' needs a recording")
-        return registered_pose_source(scenario, scene.recording.video_frame)
+        # The scenario's validation requires a video for 'registered'.
+        assert scene.calibration is not None and scene.video is not None
+        return registered_pose_source(scenario, scene.recording.video_frame, scene.calibration, scene.video)
     return {"commanded": commanded_pose, "oracle": true_pose}[source]
 
 
