@@ -7,11 +7,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from ptztrack.builders.world import action_grid
 from ptztrack.camera.actions import ActionGrid
-from ptztrack.config import Scenario
+from synthetic_scene import GRID
 
-GRID = action_grid(Scenario())
 PROPERTY = settings(deadline=None, max_examples=100)
 
 

@@ -5,10 +5,9 @@ from hypothesis import strategies as st
 from scipy.stats import multivariate_normal
 
 import information_gain_reference
-from overhead import overhead_scenario
-from ptztrack.builders.episode import make_policy
-from ptztrack.builders.factories import recall_model
-from ptztrack.builders.world import action_grid, build_world, ptz_camera
+from overhead import CAMERA
+from ptztrack.camera.actions import ActionGrid
+from ptztrack.control.exploration import exploration_map
 from ptztrack.control.gaussian_rectangle import bivariate_normal_cdf, gaussian_rectangle_probability
 from ptztrack.control.information_gain import (
     action_geometry,
@@ -16,7 +15,11 @@ from ptztrack.control.information_gain import (
     detection_weight_sampled,
     information_if_detected_nats,
 )
+from ptztrack.control.information_policy import InformationGainPolicy
 from ptztrack.control.parameters import ControlParameters
+from ptztrack.detect.parameters import DetectorPrior
+from ptztrack.detect.simulated import RecallModel
+from ptztrack.geometry.area import rectangle_m
 from ptztrack.geometry.occlusion import occluded_fraction, occlusion_in_centred_views
 from ptztrack.geometry.ptz import (
     apply_homography,
@@ -30,21 +33,42 @@ from ptztrack.geometry.ptz import (
 from ptztrack.track import kalman
 from ptztrack.types import DecisionContext, Tracks
 
-SCENARIO = overhead_scenario()
+GRID = ActionGrid(np.linspace(-45.0, 45.0, 7), np.linspace(15.0, 60.0, 10), np.array([1.0, 2.0, 3.0, 4.0]), (2, 2, 1))
+AREA_M = rectangle_m(15.0, 15.0)
+V = 4.0 * np.eye(2)
+HEIGHT_M = 1.75
+WIDTH_M = 0.5
+STEP_S = 0.2
+# The paper's recall curve of HOG (the realistic detector's), and the ideal detector's recall of 1.
+CURVES = {
+    "realistic": RecallModel(DetectorPrior.recall_kd, DetectorPrior.recall_r0_px),
+    "ideal": RecallModel(DetectorPrior.recall_kd, DetectorPrior.recall_r0_px, perfect=True),
+}
 
 
 def detector_model(kind="realistic"):
-    """The recall model the policies plan with for the scenario's detector of ``kind``."""
-    return recall_model(overhead_scenario({"detector": {"kind": kind}}))
+    """The recall model the policies plan with for the detector of ``kind``."""
+    return CURVES[kind]
 
 
-def policy_for(name, scenario):
-    return make_policy(name, scenario, build_world(scenario, np.random.default_rng(0)))
-
-
-CAMERA, GRID = ptz_camera(SCENARIO), action_grid(SCENARIO)
-V = 4.0 * np.eye(2)
-HEIGHT_M = 1.75
+def policy_for(method, kind="realistic", beta=0.0):
+    """The overhead scene's policy ``method`` planning with the ``kind`` detector's curve, with the
+    patrolling term of weight ``beta`` (the default control parameters otherwise)."""
+    recall, control = detector_model(kind), ControlParameters()
+    exploration = None
+    if beta > 0:
+        exploration = exploration_map(
+            CAMERA,
+            GRID.poses,
+            AREA_M,
+            recall,
+            HEIGHT_M,
+            control.exploration_cell_m,
+            control.prior_untracked_people,
+            control.arrival_rate_per_s,
+            STEP_S,
+        )
+    return InformationGainPolicy(CAMERA, GRID, recall, V, HEIGHT_M, WIDTH_M, method, control.samples, beta, exploration)
 
 
 @settings(deadline=None, max_examples=60)
@@ -161,7 +185,6 @@ def single_track(mean_xy, sigma_m):
 def test_with_one_person_and_no_occluders_smpl_and_intg_choose_the_same_action(kind):
     """Same action, up to ties: where both choices are worth the same to intg (within 0.1 %),
     the sampled estimate may pick either."""
-    scenario = overhead_scenario({"detector": {"kind": kind}, "control": {"beta": 0.0}})
     rng = np.random.default_rng(11)
     agreements = 0
     for trial in range(12):
@@ -171,9 +194,9 @@ def test_with_one_person_and_no_occluders_smpl_and_intg_choose_the_same_action(k
         distance = np.abs(GRID.poses[:, :2] - look_at(CAMERA, position)[:2]).sum(axis=1)
         current = int(np.argmin(distance + 100 * (GRID.axis_indices[:, 2] != rng.integers(4))))
         context = DecisionContext(0, current, GRID.reachable(current), tracks, np.random.default_rng(trial))
-        intg_policy = policy_for("intg", scenario)
+        intg_policy = policy_for("intg", kind)
         intg = intg_policy.choose(context)
-        smpl = policy_for("smpl", scenario).choose(context)
+        smpl = policy_for("smpl", kind).choose(context)
         agreements += intg == smpl
         worth = intg_policy.rewards(np.array([intg, smpl]), tracks, context.rng)
         assert worth[1] >= 0.999 * worth[0]
@@ -226,8 +249,7 @@ def test_rewards_of_the_kernels_are_those_of_the_numpy_reference(method, kind):
     """Every action's reward, from the compiled kernels, equals the plain NumPy evaluation of the
     same estimator (equations 7-9 and 19; the same draws for smpl) to rounding, on crowds that
     hide one another, and the best action is the same."""
-    scenario = overhead_scenario({"detector": {"kind": kind}, "control": {"beta": 1.0}})
-    policy = policy_for(method, scenario)
+    policy = policy_for(method, kind, beta=1.0)
     actions = np.arange(GRID.size)
     rng = np.random.default_rng(21)
     hidden = []
@@ -273,9 +295,7 @@ def test_zoom_leaves_occluded_fractions_exactly_unchanged():
 
 
 def test_patrolling_term_grows_while_unobserved_and_clears_where_the_camera_looks():
-    scenario = overhead_scenario({"detector": {"kind": "ideal"}, "control": {"beta": 1.0}})
-    policy = policy_for("intg", scenario)
-    exploration = policy.exploration
+    exploration = policy_for("intg", "ideal", beta=1.0).exploration
     q = exploration.detection_probability(np.arange(len(exploration.height_px)))
     wide = int(np.argmax(q.sum(axis=1)))
     elsewhere = int(np.argmin(q[:, q[wide] > 0.5].sum(axis=1)))
@@ -293,8 +313,7 @@ def test_patrolling_term_grows_while_unobserved_and_clears_where_the_camera_look
 
 def test_the_patrolling_term_grows_by_the_time_unobserved_in_steps_of_any_length():
     """Arrivals are a Poisson process: two half steps unobserved leave the map as one whole step does."""
-    scenario = overhead_scenario({"detector": {"kind": "ideal"}, "control": {"beta": 1.0}})
-    halves, whole = policy_for("intg", scenario).exploration, policy_for("intg", scenario).exploration
+    halves, whole = policy_for("intg", "ideal", beta=1.0).exploration, policy_for("intg", "ideal", beta=1.0).exploration
     q = halves.detection_probability(np.arange(len(halves.height_px)))
     unseen = int(np.argmin(q.sum(axis=1)))
     halves.advance(unseen, halves.step_s / 2)
@@ -307,8 +326,7 @@ def test_the_patrolling_term_grows_by_the_time_unobserved_in_steps_of_any_length
 def test_a_camera_whose_moves_take_time_compares_information_per_second():
     """With move times, an action's reward is divided by a step and the move there: an action twice as
     informative but a step and a half away loses to staying."""
-    scenario = overhead_scenario({"detector": {"kind": "ideal"}})
-    policy = policy_for("intg", scenario)
+    policy = policy_for("intg", "ideal")
     tracks = Tracks(
         np.array([0]),
         np.array([[7.5, 6.0, 0.0, 0.0]]),
@@ -338,8 +356,8 @@ def test_without_tracks_the_patrolling_term_moves_the_camera_and_without_it_the_
     empty = Tracks.empty()
     start = int(GRID.index(3, 4, 1))
     context = DecisionContext(0, start, GRID.reachable(start), empty, np.random.default_rng(0))
-    assert policy_for("intg", overhead_scenario({"control": {"beta": 0.0}})).choose(context) == start
-    explorer = policy_for("intg", overhead_scenario({"control": {"beta": 1.0}}))
+    assert policy_for("intg", beta=0.0).choose(context) == start
+    explorer = policy_for("intg", beta=1.0)
     moves = [explorer.choose(context) for _ in range(3)]
     assert any(move != start for move in moves)
 
