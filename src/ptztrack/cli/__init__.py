@@ -14,6 +14,7 @@ import os
 import sys
 
 from ptztrack.cli.arguments import parser
+from ptztrack.cli.interrupt import catch_interrupts, raise_if_interrupted
 from ptztrack.files import InputError, check_output_file, check_output_folder
 
 __all__ = ["main", "parser", "check_outputs"]
@@ -35,11 +36,14 @@ def main(argv: list[str] | None = None) -> int:
     # Before any library configures the root logger (onvif-zeep-async does at import): warnings only,
     # one line each (a camera lost, back, still unreachable).
     logging.basicConfig(level=logging.WARNING, format="ptztrack: %(message)s")
+    catch_interrupts()
     try:
         args = parser().parse_args(argv)
         check_outputs(args)
         module, _, function = args.handler.partition(":")
-        return getattr(importlib.import_module(module), function)(args)
+        status = getattr(importlib.import_module(module), function)(args)
+        raise_if_interrupted()
+        return status
     except (InputError, RuntimeError) as error:
         print(f"ptztrack: error: {error}", file=sys.stderr)
         return 2

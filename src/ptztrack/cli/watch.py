@@ -2,6 +2,7 @@
 
 from pathlib import Path
 
+from ptztrack.cli.interrupt import raise_if_interrupted
 from ptztrack.evaluate.executors import Progress
 from ptztrack.evaluate.view_state import StepView, ViewState
 from ptztrack.evaluate.web_view import ViewHub, ViewServer
@@ -38,8 +39,8 @@ class Watch:
         if self._server is not None:
             self._server.__exit__(*failure)
 
-    def observe(self, world, policy) -> StepObserver | None:
-        """The run's step observer (None when nothing watches)."""
+    def observe(self, world, policy) -> StepObserver:
+        """The run's step observer: it also stops the run at the step after a Ctrl-C that was lost."""
         view_state = self.view_state = self.view(world, policy)
         watching = None
         if self.hub is not None or self.keep:
@@ -47,13 +48,13 @@ class Watch:
                 None if self.hub is None else self.hub.after_step, self.views if self.keep else None
             )
         progress = self.progress
-        if progress is None:
-            return watching
 
         def observe(step: int, context, record: dict) -> None:
+            raise_if_interrupted()
             if watching is not None:
                 watching(step, context, record)
-            progress(step + 1, view_state.steps)
+            if progress is not None:
+                progress(step + 1, view_state.steps)
 
         return observe
 
