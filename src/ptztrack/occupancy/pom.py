@@ -64,8 +64,10 @@ from ptztrack.occupancy.multiview import CameraView, MultiViewRecording
 from ptztrack.occupancy.parameters import PomParameters
 
 Q_FLOOR = 1e-9
-RIM_POINTS = 32  # points around each of the cylinder's circles
-RIM_LEVELS = 5  # circles from the feet to the top of the head
+RIM_POINTS = (
+    64  # points around each of the cylinder's circles (the bound is short by r (1 - cos(pi / 64)), 0.3 mm at 0.25 m)
+)
+RIM_LEVELS = 5  # circles from the feet to the top of the head (a distorting lens bends the sides)
 MIN_DEPTH_M = 0.01  # a person's point closer to the camera's plane than this: no rectangle
 # The signs of a rectangle's corners (top-left, top-right, bottom-left, bottom-right) in a 2-D
 # difference array (and in an integral image's box sum).
@@ -133,6 +135,7 @@ def person_boxes(
         shape = (height_px // block_px, width_px // block_px)
         box_px = person_box_px(calibration, centres_m, height_m, width_m)
         seen = ~np.isnan(box_px[:, 0])
+        box_px = np.where(seen[:, None], box_px, 0.0)
         left, right = covered_span(box_px[:, 0] / block_px, box_px[:, 2] / block_px)
         top, bottom = covered_span(box_px[:, 1] / block_px, box_px[:, 3] / block_px)
         box = np.stack(
