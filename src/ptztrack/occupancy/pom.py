@@ -1,9 +1,10 @@
 """The probabilistic occupancy map (POM): the posterior probability that each ground cell holds a person.
 
 F. Fleuret, J. Berclaz, R. Lengagne and P. Fua, "Multicamera People Tracking
-with a Probabilistic Occupancy Map", IEEE TPAMI 30(2), 2008, section 4.
-``X_k`` in {0, 1} says whether cell ``k`` is occupied, with independent
-priors ``P(X_k = 1) = epsilon``. A person at cell ``k`` seen by view ``c``
+with a Probabilistic Occupancy Map", IEEE TPAMI 30(2), 2008: each frame on
+its own, from binary foreground masks of calibrated views. ``X_k`` in
+{0, 1} says whether cell ``k`` is occupied, with independent priors
+``P(X_k = 1) = epsilon``. A person at cell ``k`` seen by view ``c``
 covers the rectangle ``A_k^c``; the synthetic image of an occupancy ``X`` is
 the union of its occupied cells' rectangles, ``A^c = 1 - prod_k (1 - X_k A_k^c)``,
 and the foreground mask ``B^c`` of each view depends on ``X`` only through it::
@@ -48,7 +49,8 @@ iterations. Every ``q`` starts at the prior. ``q`` is kept within
 
 Masks are averaged over blocks of pixels (a fraction of foreground per
 block, which the distance above takes as it is) and the rectangles are
-snapped to the blocks: the working resolution.
+snapped to the blocks: the working resolution. A view without video gets
+the union of its detector's boxes as its mask (:func:`boxes_mask`).
 """
 
 from collections.abc import Sequence
@@ -372,7 +374,11 @@ class PomDetector:
 
     def detect(self, frame: int, masks: Sequence[np.ndarray | None] | None = None) -> tuple[np.ndarray, Modes]:
         """The POM (rows, columns) at ``frame`` and its candidates (strength: q), given per view a
-        full-resolution foreground mask (height, width) or None (its boxes, if any, stand in)."""
+        full-resolution foreground mask (height, width) or None (its boxes, if any, stand in).
+
+        The detections are the candidates of at least ``min_probability`` (or of a threshold fitted
+        on other frames); ``last`` keeps the frame's :class:`PomResult` (iterations, convergence).
+        """
         parameters = self.parameters
         self.last = self.solver.posterior(self.view_masks(frame, masks), parameters)
         q_map = self.last.q.reshape(self.grid.shape)
