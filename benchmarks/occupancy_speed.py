@@ -1,10 +1,14 @@
-"""The occupancy-map detector's speed on one core: frames per second for 4 views of 1024 x 768.
+"""The occupancy-map detectors' speed on one core: frames per second for 4 views of 1024 x 768.
 
 Renders the synthetic room (3 people, the paper's lab: 4 corner cameras, 1024 x 768, 15 Hz) ahead
 of time, then times LPOM on each frame, single-threaded: motion edges of the 4 views (Canny and the
 frame difference), the summed loci through the precomputed locus tables, the normalised and
 smoothed map, and its modes. Rendering is not timed (a camera delivers the frames). The tables'
 one-off build time and memory are reported apart.
+
+Then POM (Fleuret et al.) on the same frames with the foreground masks given (each frame against the
+empty room, not timed): the masks reduced to the working resolution, the mean-field iterations and
+the candidates (``pom_frames_per_s``); the rectangles' one-off computation is reported apart.
 
     python benchmarks/occupancy_speed.py [--frames 40] [--json PATH]
 """
@@ -22,13 +26,18 @@ from pathlib import Path  # noqa: E402
 import cv2  # noqa: E402
 import numpy as np  # noqa: E402
 
-from ptztrack.builders.occupancy import room_recording  # noqa: E402
+from ptztrack.builders.occupancy import ROOM, room_recording  # noqa: E402
 from ptztrack.files import write_atomically  # noqa: E402
 from ptztrack.occupancy.detectors import LpomDetector, lpom_parameters  # noqa: E402
 from ptztrack.occupancy.lpom import map_modes, occupancy_map, table_map  # noqa: E402
 from ptztrack.occupancy.motion_edges import motion_edges  # noqa: E402
 from ptztrack.occupancy.multiview import CameraView  # noqa: E402
-from ptztrack.occupancy.parameters import OccupancyParameters  # noqa: E402
+from ptztrack.occupancy.parameters import OccupancyParameters, PomParameters  # noqa: E402
+from ptztrack.occupancy.pom import PomDetector  # noqa: E402
+from ptztrack.occupancy.room import RoomRenderer  # noqa: E402
+
+# Grey levels a pixel must differ from the empty room by to be foreground (the sensor noise's sigma is 2).
+FOREGROUND_LEVELS = 25
 
 
 def main() -> None:
@@ -40,6 +49,9 @@ def main() -> None:
 
     recording = room_recording(people=3, frames=args.frames + 1, seed=0)
     images = [[view.frames(frame) for view in recording.views] for frame in range(recording.frames)]
+    assert recording.truth is not None
+    # The same room's renderer (same seed) for its empty backgrounds.
+    backgrounds = RoomRenderer(ROOM, recording.truth, seed=0).backgrounds
     views = tuple(
         CameraView(view.name, view.calibration, view.image_size_px, images_of(images, index), None)
         for index, view in enumerate(recording.views)
@@ -99,9 +111,51 @@ def main() -> None:
     print("  stages [ms/frame]: " + ", ".join(f"{k} {v:.1f}" for k, v in figures["stages_ms_per_frame"].items()))
     print(f"  motion pixels per view: {figures['motion_pixels_per_view_mean']:.0f} on average")
     print(f"  locus tables: {build_s:.1f} s to build once, {table_mb:.0f} MB for the {len(detector.tables)} views")
+    figures.update(time_pom(recording, images, backgrounds))
+    print(
+        f"POM, the same views and frames, masks given, one thread: {figures['pom_frames_per_s']:.1f} frames/s "
+        f"(median {figures['pom_ms_per_frame_median']:.1f} ms, p90 {figures['pom_ms_per_frame_p90']:.1f} ms per "
+        f"frame; {figures['pom_iterations_mean']:.0f} iterations on average, {figures['pom_unconverged']} frames "
+        f"stopped at the maximum)"
+    )
+    print(
+        f"  {figures['pom_cells']} cells, working images {figures['pom_working_px'][0]} x "
+        f"{figures['pom_working_px'][1]}; rectangles: {figures['pom_rectangles_s']:.1f} s to compute once"
+    )
     if args.json is not None:
         write_atomically(args.json, (json.dumps(figures, indent=2) + "\n").encode())
         print(f"wrote {args.json}")
+
+
+def time_pom(recording, images: list, backgrounds: list) -> dict:
+    """POM's figures on frames 1 onwards (LPOM's frames): per frame, the masks' reduction to the working
+    resolution, the mean-field iterations and the candidates, with the masks computed beforehand."""
+    start = time.perf_counter()
+    detector = PomDetector(recording, PomParameters())
+    rectangles_s = time.perf_counter() - start
+    per_frame_s, iterations, unconverged = [], [], 0
+    for frame in range(1, recording.frames):
+        masks = [
+            cv2.absdiff(image, background).max(axis=2) > FOREGROUND_LEVELS
+            for image, background in zip(images[frame], backgrounds, strict=True)
+        ]
+        start = time.perf_counter()
+        detector.detect(frame, masks)
+        per_frame_s.append(time.perf_counter() - start)
+        assert detector.last is not None
+        iterations.append(detector.last.iterations)
+        unconverged += not detector.last.converged
+    shape = detector.boxes.shapes[0]
+    return {
+        "pom_frames_per_s": len(per_frame_s) / sum(per_frame_s),
+        "pom_ms_per_frame_median": 1000 * float(np.median(per_frame_s)),
+        "pom_ms_per_frame_p90": 1000 * float(np.percentile(per_frame_s, 90)),
+        "pom_iterations_mean": float(np.mean(iterations)),
+        "pom_unconverged": unconverged,
+        "pom_cells": detector.grid.cells,
+        "pom_working_px": [shape[1], shape[0]],
+        "pom_rectangles_s": rectangles_s,
+    }
 
 
 def images_of(images: list, view: int):

@@ -9,6 +9,8 @@ the "detector and clustering" baseline of the multi-view literature.
 
 * :mod:`~ptztrack.occupancy.locus`: the person model (connected cones) and a pixel's locus;
 * :mod:`~ptztrack.occupancy.lpom`: the ground grid, the locus tables, the map and its modes;
+* :mod:`~ptztrack.occupancy.pom`: the probabilistic occupancy map of Fleuret et al. (TPAMI 2008) from
+  foreground masks, by mean field;
 * :mod:`~ptztrack.occupancy.motion_edges`: a view's evidence (motion edges, box outlines);
 * :mod:`~ptztrack.occupancy.clustering`: the baseline (box feet on the ground, clustered, blob boxes);
 * :mod:`~ptztrack.occupancy.detectors`: both detectors run over a recording, frame by frame;

@@ -37,3 +37,50 @@ class OccupancyParameters:
     min_box_score: float = 0.5
     linkage_m: float = 1.0
     blob_min_area_px: int = 400
+
+
+@dataclass(frozen=True)
+class PomParameters:
+    """The probabilistic occupancy map (POM) of Fleuret, Berclaz, Lengagne and Fua (TPAMI 2008),
+    :mod:`ptztrack.occupancy.pom`.
+
+    Model: prior is each cell's prior probability of being occupied (epsilon), 0.01, the default of the
+    authors' POM software (released with the paper); sigma scales the pseudo-distance Psi between a
+    foreground mask and a synthetic image, 0.01, that software's value too (there the spread of a
+    Gaussian on the same normalised distance, here its scale as in the paper's equation). A person at a
+    cell is a vertical cylinder height_m tall and width_m across, whose projection's bounding box is the
+    cell's rectangle: 1.75 m, the middle of OccupancyParameters' heights (1.6-1.9 m, the synthetic
+    room's people), and 0.5 m, OccupancyParameters.width_m (the cone model's widest diameter, the room's
+    person width). Grid: cell_m, 0.25 m, half a person's width; the prior is per cell, so it goes with
+    the cell: 0.01 at 0.25 m is 0.16 people per square metre a priori, a few in a room, whereas at
+    LPOM's 0.05 m it would be 4 per square metre and the expected synthetic image would cover most of
+    every view from the start.
+    Working resolution: the masks are averaged over block_px x block_px pixel blocks and the rectangles
+    snapped to the blocks; 4 makes the room's 1024 x 768 views 256 x 192, near the 360 x 288 video of
+    the paper's sequences.
+    Iterations: all cells are updated together from the same average synthetic images, each new value
+    mixed with the old as ``q <- damping q + (1 - damping) q_new``; damping 0.8, max_iterations 100 and
+    tolerance 1e-4 (the largest change of a q that counts as converged) are the authors' software's
+    defaults (the paper gives the fixed point, not the iteration).
+    Boxes: a detector's boxes with a score of at least min_box_score make a view's mask
+    (OccupancyParameters.min_box_score). Candidates: a cell is a candidate when its q is the largest
+    within separation_m and at least candidate_probability; its position is the q-weighted mean over
+    window_m (separation_m and window_m as OccupancyParameters'; candidate_probability 0.02, below the
+    smallest threshold the experiment's fit tries, 0.05, as LPOM's candidates). min_probability: the
+    detections' q, 0.5 (more likely there than not), where no threshold is fitted.
+    """
+
+    prior: float = 0.01
+    sigma: float = 0.01
+    height_m: float = 1.75
+    width_m: float = 0.5
+    cell_m: float = 0.25
+    block_px: int = 4
+    damping: float = 0.8
+    max_iterations: int = 100
+    tolerance: float = 1e-4
+    min_box_score: float = 0.5
+    separation_m: float = 0.5
+    window_m: float = 0.25
+    candidate_probability: float = 0.02
+    min_probability: float = 0.5

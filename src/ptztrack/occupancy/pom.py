@@ -1,0 +1,393 @@
+"""The probabilistic occupancy map (POM): the posterior probability that each ground cell holds a person.
+
+F. Fleuret, J. Berclaz, R. Lengagne and P. Fua, "Multicamera People Tracking
+with a Probabilistic Occupancy Map", IEEE TPAMI 30(2), 2008: each frame on
+its own, from binary foreground masks of calibrated views. ``X_k`` in
+{0, 1} says whether cell ``k`` is occupied, with independent priors
+``P(X_k = 1) = epsilon``. A person at cell ``k`` seen by view ``c``
+covers the rectangle ``A_k^c``; the synthetic image of an occupancy ``X`` is
+the union of its occupied cells' rectangles, ``A^c = 1 - prod_k (1 - X_k A_k^c)``,
+and the foreground mask ``B^c`` of each view depends on ``X`` only through it::
+
+    P(B^c | X) = exp(-Psi(B^c, A^c)) / Z,
+    Psi(B, A) = |B (1 - A) + (1 - B) A| / (sigma |A|)
+
+with ``|.|`` the sum over the pixels: the pixels where mask and synthetic
+image disagree, counted relative to the synthetic image's area.
+
+The posterior is approximated by the product law ``Q = prod_k q_k`` closest
+to it in Kullback-Leibler divergence (mean field), whose fixed point is::
+
+    q_k = 1 / (1 + exp(lambda + sum_c Psi(B^c, A_{k,1}^c) - Psi(B^c, A_{k,0}^c))),
+    lambda = log((1 - epsilon) / epsilon),
+
+where the expected distance given ``X_k = xi`` is replaced by the distance to
+the average synthetic image given ``X_k = xi``::
+
+    A_{k,xi}^c = 1 - (1 - xi A_k^c) prod_{j != k} (1 - q_j A_j^c).
+
+Both differ from the average synthetic image ``A^c = 1 - prod_j (1 - q_j A_j^c)``
+only inside rectangle ``k``: with ``N = 1 - A^c`` and ``n``, ``bn`` the sums
+of ``N`` and ``B N`` over the rectangle (integral images, so O(1) per cell)::
+
+    |A_{k,1}| = |A| + n,        |B A_{k,1}| = |B A| + bn,
+    |A_{k,0}| = |A| - rho n,    |B A_{k,0}| = |B A| - rho bn,    rho = q_k / (1 - q_k),
+
+and ``|B (1 - A) + (1 - B) A| = |B| + |A| - 2 |B A|``. ``N`` itself is the
+exponential of the sum of ``log(1 - q_j)`` over the rectangles covering each
+pixel, one 2-D prefix sum of their corners.
+
+Where the paper leaves the iteration open we follow the authors' software:
+all cells are updated together from the same average images (one pass of
+integral images per iteration, the point of the O(1) update) and each new
+value is mixed with the old, ``q <- damping q + (1 - damping) q_new``, which
+keeps the joint update from oscillating (all cells that explain the same
+blob would otherwise switch on together and off together); it stops when no
+``q`` changes by more than the tolerance, or after the maximum number of
+iterations. Every ``q`` starts at the prior. ``q`` is kept within
+``[Q_FLOOR, 1 - Q_FLOOR]`` so that ``rho`` stays finite and ``|A| > 0``.
+
+Masks are averaged over blocks of pixels (a fraction of foreground per
+block, which the distance above takes as it is) and the rectangles are
+snapped to the blocks: the working resolution. A view without video gets
+the union of its detector's boxes as its mask (:func:`boxes_mask`).
+"""
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+from scipy.special import expit
+
+from ptztrack.geometry.calibration import PinholeCalibration, project_pinhole
+from ptztrack.occupancy.lpom import GroundGrid, Modes, map_modes
+from ptztrack.occupancy.multiview import CameraView, MultiViewRecording
+from ptztrack.occupancy.parameters import PomParameters
+
+Q_FLOOR = 1e-9
+RIM_POINTS = (
+    64  # points around each of the cylinder's circles (the bound is short by r (1 - cos(pi / 64)), 0.3 mm at 0.25 m)
+)
+RIM_LEVELS = 5  # circles from the feet to the top of the head (a distorting lens bends the sides)
+MIN_DEPTH_M = 0.01  # a person's point closer to the camera's plane than this: no rectangle
+# The signs of a rectangle's corners (top-left, top-right, bottom-left, bottom-right) in a 2-D
+# difference array (and in an integral image's box sum).
+CORNER_SIGNS = np.array([1.0, -1.0, -1.0, 1.0])
+
+
+def person_box_px(calibration: PinholeCalibration, ground_m, height_m: float, width_m: float) -> np.ndarray:
+    """The image bounding box of a person standing at each ground point: (K, 4) (left, top, right, bottom) px.
+
+    The person is a vertical cylinder ``height_m`` tall and ``width_m`` across, standing on the ground
+    point (K, 2) m; the box bounds the projections (through the calibration, lens distortion included)
+    of ``RIM_LEVELS`` circles of ``RIM_POINTS`` points from its base to its top. NaN where a point of the
+    cylinder is not in front of the camera (the projection has no bound).
+    """
+    ground_m = np.asarray(ground_m, dtype=float).reshape(-1, 2)
+    angle = np.linspace(0.0, 2 * np.pi, RIM_POINTS, endpoint=False)
+    ring = 0.5 * width_m * np.stack([np.cos(angle), np.sin(angle), np.zeros_like(angle)], axis=-1)
+    levels = np.linspace(0.0, height_m, RIM_LEVELS)[:, None, None] * np.array([0.0, 0.0, 1.0])
+    offsets_m = (ring[None, :, :] + levels).reshape(-1, 3)  # (RIM_LEVELS * RIM_POINTS, 3)
+    feet_m = np.concatenate([ground_m, np.zeros((len(ground_m), 1))], axis=-1)
+    points_m = feet_m[:, None, :] + offsets_m[None, :, :]
+    depth_m = (points_m @ calibration.R.T + calibration.t / 1000.0)[..., 2]
+    pixels = project_pinhole(calibration, 1000.0 * points_m.reshape(-1, 3)).reshape(len(ground_m), -1, 2)
+    box = np.concatenate([pixels.min(axis=1), pixels.max(axis=1)], axis=-1)
+    return np.where(np.all(depth_m > MIN_DEPTH_M, axis=1)[:, None], box, np.nan)
+
+
+def covered_span(low, high) -> tuple[np.ndarray, np.ndarray]:
+    """The pixels (or blocks) ``[first, stop)`` whose centres ``i + 0.5`` lie in ``[low, high)`` (unit-sized)."""
+    return np.ceil(np.asarray(low) - 0.5).astype(np.int64), np.ceil(np.asarray(high) - 0.5).astype(np.int64)
+
+
+@dataclass(frozen=True)
+class PersonBoxes:
+    """Each cell's person rectangle in each view, at the working resolution.
+
+    boxes : (views, cells, 4) int32 (left, top, right, bottom) in blocks, the rectangle covering blocks
+    ``[left, right) x [top, bottom)``; visible : (views, cells) bool, whether the cell has a rectangle in
+    the view (not behind the camera, not wholly outside its image); shapes : per view, the working image's
+    (rows, columns); block_px : pixels per block side.
+    """
+
+    boxes: np.ndarray
+    visible: np.ndarray
+    shapes: tuple[tuple[int, int], ...]
+    block_px: int
+
+
+def person_boxes(
+    views: Sequence[tuple[PinholeCalibration, tuple[int, int]]],
+    grid: GroundGrid,
+    height_m: float,
+    width_m: float,
+    block_px: int,
+) -> PersonBoxes:
+    """:class:`PersonBoxes` of the grid's cells in views given as (calibration, image size (width, height) px).
+
+    A rectangle covers the blocks whose centres lie in the person's box (:func:`person_box_px`), clipped
+    to the working image of ``(height // block_px, width // block_px)`` blocks.
+    """
+    rows, columns = np.mgrid[0 : grid.shape[0], 0 : grid.shape[1]]
+    centres_m = grid.centre_of(rows.ravel(), columns.ravel())
+    boxes, visible, shapes = [], [], []
+    for calibration, (width_px, height_px) in views:
+        shape = (height_px // block_px, width_px // block_px)
+        box_px = person_box_px(calibration, centres_m, height_m, width_m)
+        seen = ~np.isnan(box_px[:, 0])
+        box_px = np.where(seen[:, None], box_px, 0.0)
+        left, right = covered_span(box_px[:, 0] / block_px, box_px[:, 2] / block_px)
+        top, bottom = covered_span(box_px[:, 1] / block_px, box_px[:, 3] / block_px)
+        box = np.stack(
+            [
+                np.clip(left, 0, shape[1]),
+                np.clip(top, 0, shape[0]),
+                np.clip(right, 0, shape[1]),
+                np.clip(bottom, 0, shape[0]),
+            ],
+            axis=-1,
+        )
+        seen &= (box[:, 2] > box[:, 0]) & (box[:, 3] > box[:, 1])
+        boxes.append(np.where(seen[:, None], box, 0).astype(np.int32))
+        visible.append(seen)
+        shapes.append(shape)
+    return PersonBoxes(np.stack(boxes), np.stack(visible), tuple(shapes), block_px)
+
+
+def boxes_mask(boxes, image_size_px, min_score: float) -> np.ndarray:
+    """The union of a detector's boxes (K, 5) (left, top, width, height, score) px whose score is at least
+    ``min_score``, as a (height, width) bool mask of the pixels whose centres they hold."""
+    width_px, height_px = image_size_px
+    mask = np.zeros((height_px, width_px), bool)
+    boxes = np.asarray(boxes, dtype=float).reshape(-1, 5)
+    boxes = boxes[boxes[:, 4] >= min_score]
+    left, right = covered_span(boxes[:, 0], boxes[:, 0] + boxes[:, 2])
+    top, bottom = covered_span(boxes[:, 1], boxes[:, 1] + boxes[:, 3])
+    for x0, y0, x1, y1 in zip(left, top, right, bottom, strict=True):
+        mask[max(y0, 0) : max(y1, 0), max(x0, 0) : max(x1, 0)] = True
+    return mask
+
+
+def working_mask(mask, block_px: int) -> np.ndarray:
+    """The fraction of foreground (rows // block_px, columns // block_px) float32 in each block of a
+    (rows, columns) mask (bool or 0/1; the last partial blocks are dropped)."""
+    rows, columns = mask.shape[0] // block_px, mask.shape[1] // block_px
+    cropped = np.asarray(mask[: rows * block_px, : columns * block_px], dtype=np.float32)
+    # Area interpolation by a whole factor is the blocks' mean (OpenCV's is some ten times NumPy's speed).
+    return cv2.resize(cropped, (columns, rows), interpolation=cv2.INTER_AREA)
+
+
+def integral_image(image, out: np.ndarray | None = None) -> np.ndarray:
+    """(rows + 1, columns + 1) float64: entry (y, x) is the sum of ``image[:y, :x]`` (a zero first row and
+    column), written into ``out`` when given (OpenCV's integral, which is some twenty times NumPy's cumsum)."""
+    image = np.asarray(image)
+    if image.dtype not in (np.uint8, np.float32, np.float64):
+        image = image.astype(np.float64)
+    return cv2.integral(np.ascontiguousarray(image), out, sdepth=cv2.CV_64F)
+
+
+def flat_corners(boxes, columns: int) -> np.ndarray:
+    """(4, K) flat indices into a (rows + 1, columns + 1) integral image of the corners (top-left, top-right,
+    bottom-left, bottom-right) of boxes (K, 4) (left, top, right, bottom)."""
+    left, top, right, bottom = np.asarray(boxes, dtype=np.int64).reshape(-1, 4).T
+    stride = columns + 1
+    return np.stack([top * stride + left, top * stride + right, bottom * stride + left, bottom * stride + right])
+
+
+def corner_sums(flat_integral: np.ndarray, corners: np.ndarray) -> np.ndarray:
+    """The sums (K,) over boxes given by their :func:`flat_corners` of the image whose integral image,
+    flattened, is ``flat_integral``."""
+    return flat_integral[corners[3]] - flat_integral[corners[1]] - flat_integral[corners[2]] + flat_integral[corners[0]]
+
+
+def box_sums(integral, boxes) -> np.ndarray:
+    """The sums (K,) of the image whose :func:`integral_image` is ``integral`` over boxes (K, 4)
+    (left, top, right, bottom), each covering ``[left, right) x [top, bottom)``."""
+    return corner_sums(np.ravel(integral), flat_corners(boxes, np.shape(integral)[1] - 1))
+
+
+class _ViewSolver:
+    """One view's part of the iterations: its visible cells' rectangles and work buffers.
+
+    cells : (M,) the visible cells; corners : (4, M) flat indices of their rectangles' corners
+    (top-left, top-right, bottom-left, bottom-right) into a (rows + 1, columns + 1) integral image.
+    The difference array of ``log N`` needs only the corners inside the (rows, columns) image (the
+    others change no pixel of it): ``inside`` (4M,) marks them among ``corners.ravel()``, ``unique``
+    their distinct flat indices into the image and ``slot`` where each adds. The buffers are kept
+    from one iteration to the next (fresh large arrays would cost a page fault per page).
+    """
+
+    def __init__(self, boxes: PersonBoxes, index: int):
+        rows, columns = self.shape = boxes.shapes[index]
+        self.cells = np.flatnonzero(boxes.visible[index])
+        view_boxes = boxes.boxes[index, self.cells]
+        self.corners = flat_corners(view_boxes, columns)
+        left, top, right, bottom = view_boxes.T.astype(np.int64)
+        corner_rows = np.stack([top, top, bottom, bottom]).ravel()
+        corner_columns = np.stack([left, right, left, right]).ravel()
+        self.inside = (corner_rows < rows) & (corner_columns < columns)
+        self.unique, self.slot = np.unique(
+            corner_rows[self.inside] * columns + corner_columns[self.inside], return_inverse=True
+        )
+        self.delta = np.zeros((rows, columns))
+        self.log_absent = np.zeros((rows + 1, columns + 1))
+        self.absent = np.zeros((rows, columns), np.float32)
+        self.masked = np.zeros((rows, columns), np.float32)
+        self.absent_integral = np.zeros((rows + 1, columns + 1))
+        self.masked_integral = np.zeros((rows + 1, columns + 1))
+
+    def distance_change(self, mask: np.ndarray, total_mask: float, q: np.ndarray, sigma: float) -> np.ndarray:
+        """``Psi(B, A_{k,1}) - Psi(B, A_{k,0})`` (M,) for the visible cells, given all cells' q and the
+        view's mask (rows, columns) float32 of ``total_mask`` foreground."""
+        rows, columns = self.shape
+        q_view = q[self.cells]
+        # log N = sum of log(1 - q) over the rectangles covering a pixel: a difference array's 2-D prefix sum.
+        weights = (CORNER_SIGNS[:, None] * np.log1p(-q_view)[None, :]).ravel()[self.inside]
+        self.delta.fill(0.0)
+        self.delta.ravel()[self.unique] = np.bincount(self.slot, weights, minlength=len(self.unique))
+        integral_image(self.delta, self.log_absent)
+        np.exp(self.log_absent[1:, 1:], out=self.absent, casting="same_kind")  # N = 1 - A
+        np.multiply(mask, self.absent, out=self.masked)
+        integral_image(self.absent, self.absent_integral)
+        integral_image(self.masked, self.masked_integral)
+        absent_flat, masked_flat = self.absent_integral.ravel(), self.masked_integral.ravel()
+        total_a = rows * columns - absent_flat[-1]  # |A|
+        total_ba = total_mask - masked_flat[-1]  # |B A|
+        n = corner_sums(absent_flat, self.corners)
+        bn = corner_sums(masked_flat, self.corners)
+        rho = q_view / (1.0 - q_view)
+        area_1, overlap_1 = total_a + n, total_ba + bn
+        # |A_{k,0}| > 0 whenever another visible cell has q > 0; the floor guards its rounding.
+        area_0, overlap_0 = np.maximum(total_a - rho * n, Q_FLOOR), total_ba - rho * bn
+        psi_1 = (total_mask + area_1 - 2 * overlap_1) / (sigma * area_1)
+        psi_0 = (total_mask + area_0 - 2 * overlap_0) / (sigma * area_0)
+        return psi_1 - psi_0
+
+
+@dataclass(frozen=True)
+class PomResult:
+    """The mean-field posterior: q (cells,) the probability that each cell is occupied; iterations run;
+    converged, whether the last iteration changed no q by more than the tolerance; change, that largest change."""
+
+    q: np.ndarray
+    iterations: int
+    converged: bool
+    change: float
+
+
+class PomSolver:
+    """The mean-field iterations of the POM (module docstring) over fixed rectangles (``posterior(masks)``).
+
+    Each view's corners, index tables and work buffers are prepared once, for every frame.
+    """
+
+    def __init__(self, boxes: PersonBoxes):
+        self.boxes = boxes
+        self.views = [_ViewSolver(boxes, index) for index in range(len(boxes.shapes))]
+
+    def posterior(self, masks: Sequence[np.ndarray | None], parameters: PomParameters) -> PomResult:
+        """Iterate the fixed point from the prior.
+
+        masks : per view, its working mask (:func:`working_mask`, rows x columns of ``boxes.shapes``,
+        values in [0, 1]) or None where the view has nothing this frame (it is left out). Uses
+        ``prior``, ``sigma``, ``damping``, ``max_iterations`` and ``tolerance``.
+        """
+        used = []
+        for view, mask in zip(self.views, masks, strict=True):
+            if mask is None or len(view.cells) == 0:
+                continue
+            mask = np.asarray(mask, dtype=np.float32)
+            if mask.shape != view.shape:
+                raise ValueError(f"a mask is {mask.shape[0]} x {mask.shape[1]}, its view's working image {view.shape}")
+            used.append((view, mask, float(mask.sum(dtype=np.float64))))
+        cells = self.boxes.visible.shape[1]
+        q = np.full(cells, float(np.clip(parameters.prior, Q_FLOOR, 1 - Q_FLOOR)))
+        log_prior_ratio = np.log((1 - parameters.prior) / parameters.prior)
+        change, iterations = np.inf, 0
+        while iterations < parameters.max_iterations and change >= parameters.tolerance:
+            evidence = np.zeros(cells)
+            for view, mask, total_mask in used:
+                evidence[view.cells] += view.distance_change(mask, total_mask, q, parameters.sigma)
+            updated = parameters.damping * q + (1 - parameters.damping) * expit(-(log_prior_ratio + evidence))
+            updated = np.clip(updated, Q_FLOOR, 1 - Q_FLOOR)
+            change = float(np.max(np.abs(updated - q), initial=0.0))
+            q, iterations = updated, iterations + 1
+        return PomResult(q, iterations, change < parameters.tolerance, change)
+
+
+def pom_posterior(boxes: PersonBoxes, masks: Sequence[np.ndarray | None], parameters: PomParameters) -> PomResult:
+    """:meth:`PomSolver.posterior` of one frame (a solver of its own: for many frames keep a :class:`PomSolver`)."""
+    return PomSolver(boxes).posterior(masks, parameters)
+
+
+def pom_modes(q_map, grid: GroundGrid, separation_m: float, window_m: float, min_probability: float) -> Modes:
+    """The candidates of a POM ``q_map`` (rows, columns): cells whose q is the largest within
+    ``separation_m`` and at least ``min_probability``, strongest first.
+
+    Positions and covariances as :func:`ptztrack.occupancy.lpom.map_modes` (the q-weighted mean and
+    spread over the disc of ``window_m``); the strength is the cell's q itself (a probability, not
+    relative to the frame's largest).
+    """
+    peak = float(np.max(q_map, initial=0.0))
+    if peak < min_probability or peak <= 0:
+        return Modes.empty()
+    modes = map_modes(q_map, grid, separation_m, window_m, min_probability / peak)
+    return Modes(modes.position_m, modes.covariance_m2, modes.strength * peak)
+
+
+class PomDetector:
+    """The POM and its candidates for frames of ``recording`` (``detect(frame, masks)``).
+
+    The cells' rectangles (:func:`person_boxes`) are computed on construction, for every view; each
+    view needs its image size. A view's mask at a frame is the one given, else the union of its
+    detector's boxes (:func:`boxes_mask`); a view with neither is left out of that frame.
+    """
+
+    def __init__(self, recording: MultiViewRecording, parameters: PomParameters):
+        self.recording, self.parameters = recording, parameters
+        self.grid = GroundGrid.covering(recording.area_m, parameters.cell_m)
+        for view in recording.views:
+            if view.image_size_px is None:
+                raise ValueError(f"{view.name}: POM needs the view's image size (its rectangles and masks)")
+        self.boxes = person_boxes(
+            [(view.calibration, _size(view)) for view in recording.views],
+            self.grid,
+            parameters.height_m,
+            parameters.width_m,
+            parameters.block_px,
+        )
+        self.solver = PomSolver(self.boxes)
+        self.last: PomResult | None = None
+
+    def view_masks(self, frame: int, masks: Sequence[np.ndarray | None] | None = None) -> list[np.ndarray | None]:
+        """Per view, its working mask at ``frame``: from ``masks`` (full-resolution, per view, None where
+        not given) or from its boxes; None where it has neither."""
+        given = list(masks) if masks is not None else [None] * len(self.recording.views)
+        working: list[np.ndarray | None] = []
+        for view, mask in zip(self.recording.views, given, strict=True):
+            if mask is None and view.boxes is not None:
+                mask = boxes_mask(view.boxes[frame], _size(view), self.parameters.min_box_score)
+            working.append(None if mask is None else working_mask(mask, self.parameters.block_px))
+        return working
+
+    def detect(self, frame: int, masks: Sequence[np.ndarray | None] | None = None) -> tuple[np.ndarray, Modes]:
+        """The POM (rows, columns) at ``frame`` and its candidates (strength: q), given per view a
+        full-resolution foreground mask (height, width) or None (its boxes, if any, stand in).
+
+        The detections are the candidates of at least ``min_probability`` (or of a threshold fitted
+        on other frames); ``last`` keeps the frame's :class:`PomResult` (iterations, convergence).
+        """
+        parameters = self.parameters
+        self.last = self.solver.posterior(self.view_masks(frame, masks), parameters)
+        q_map = self.last.q.reshape(self.grid.shape)
+        modes = pom_modes(
+            q_map, self.grid, parameters.separation_m, parameters.window_m, parameters.candidate_probability
+        )
+        return q_map, modes
+
+
+def _size(view: CameraView) -> tuple[int, int]:
+    assert view.image_size_px is not None
+    return view.image_size_px
