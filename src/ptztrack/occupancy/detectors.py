@@ -109,12 +109,22 @@ class LpomDetector:
                 scored_boxes(view, frame, parameters.min_box_score)[:, :4], parameters.outline_points_per_box
             )
             return points_map(view.calibration, outline, self.grid, parameters.sampling)
-        image = view.frames(frame)
+        pixels = self.motion_pixels(index, frame)
+        if pixels is None:
+            return np.zeros(self.grid.cells)
+        return table_map(self.tables[index], pixels)
+
+    def motion_pixels(self, index: int, frame: int) -> np.ndarray | None:
+        """The motion edges (height, width) bool of view ``index`` (one with video) at ``frame``, against
+        the frame before; None on the first frame or after a jump (no motion to see)."""
+        frames = self.recording.views[index].frames
+        assert frames is not None
+        image = frames(frame)
         previous_frame, previous = self._previous.get(index, (-1, image))
         self._previous[index] = (frame, image)
         if previous_frame != frame - 1:
-            return np.zeros(self.grid.cells)  # the first frame, or after a jump: no motion to see
-        return table_map(self.tables[index], motion_edges(previous, image, parameters.edges))
+            return None
+        return motion_edges(previous, image, self.parameters.edges)
 
     def detect(self, frame: int) -> tuple[np.ndarray, Modes]:
         """The occupancy map (rows, columns) at ``frame`` and its candidate modes."""
