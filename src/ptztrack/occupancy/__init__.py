@@ -10,6 +10,7 @@ the "detector and clustering" baseline of the multi-view literature.
 * :mod:`~ptztrack.occupancy.locus`: the person model (connected cones) and a pixel's locus;
 * :mod:`~ptztrack.occupancy.lpom`: the ground grid, the locus tables, the map and its modes;
 * :mod:`~ptztrack.occupancy.motion_edges`: a view's evidence (motion edges, box outlines);
+* :mod:`~ptztrack.occupancy.foreground`: a view's evidence from a background model (silhouettes, their edges);
 * :mod:`~ptztrack.occupancy.clustering`: the baseline (box feet on the ground, clustered, blob boxes);
 * :mod:`~ptztrack.occupancy.detectors`: both detectors run over a recording, frame by frame;
 * :mod:`~ptztrack.occupancy.multiview`: multi-view recordings and their files;
