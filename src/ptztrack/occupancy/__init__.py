@@ -12,6 +12,7 @@ the "detector and clustering" baseline of the multi-view literature.
 * :mod:`~ptztrack.occupancy.pom`: the probabilistic occupancy map of Fleuret et al. (TPAMI 2008) from
   foreground masks, by mean field;
 * :mod:`~ptztrack.occupancy.motion_edges`: a view's evidence (motion edges, box outlines);
+* :mod:`~ptztrack.occupancy.foreground`: a view's evidence from a background model (silhouettes, their edges);
 * :mod:`~ptztrack.occupancy.clustering`: the baseline (box feet on the ground, clustered, blob boxes);
 * :mod:`~ptztrack.occupancy.detectors`: both detectors run over a recording, frame by frame;
 * :mod:`~ptztrack.occupancy.multiview`: multi-view recordings and their files;

@@ -4,6 +4,8 @@
 (:mod:`ptztrack.occupancy.lpom`) from every view's motion pixels: motion
 edges where the view has video (:func:`ptztrack.occupancy.motion_edges.motion_edges`,
 against the previous frame), else the outlines of its detector's boxes.
+:class:`LpomForegroundDetector` takes instead the edges of a background
+model's foreground silhouettes (:mod:`ptztrack.occupancy.foreground`).
 :class:`ClusteringDetector` clusters the views' box feet on the ground
 (:mod:`ptztrack.occupancy.clustering`), with blob boxes for views that have
 only video. Both are fed the frames in order.
@@ -14,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ptztrack.occupancy.clustering import BlobBoxes, Clusters, cluster_feet, feet_on_ground
+from ptztrack.occupancy.foreground import ViewForeground
 from ptztrack.occupancy.locus import PERSON, ConeModel
 from ptztrack.occupancy.lpom import (
     GroundGrid,
@@ -29,7 +32,7 @@ from ptztrack.occupancy.lpom import (
 )
 from ptztrack.occupancy.motion_edges import MotionEdgeParameters, box_outline_points, motion_edges
 from ptztrack.occupancy.multiview import CameraView, MultiViewRecording
-from ptztrack.occupancy.parameters import OccupancyParameters
+from ptztrack.occupancy.parameters import ForegroundParameters, OccupancyParameters
 
 
 @dataclass(frozen=True)
@@ -109,12 +112,22 @@ class LpomDetector:
                 scored_boxes(view, frame, parameters.min_box_score)[:, :4], parameters.outline_points_per_box
             )
             return points_map(view.calibration, outline, self.grid, parameters.sampling)
-        image = view.frames(frame)
+        pixels = self.motion_pixels(index, frame)
+        if pixels is None:
+            return np.zeros(self.grid.cells)
+        return table_map(self.tables[index], pixels)
+
+    def motion_pixels(self, index: int, frame: int) -> np.ndarray | None:
+        """The motion edges (height, width) bool of view ``index`` (one with video) at ``frame``, against
+        the frame before; None on the first frame or after a jump (no motion to see)."""
+        frames = self.recording.views[index].frames
+        assert frames is not None
+        image = frames(frame)
         previous_frame, previous = self._previous.get(index, (-1, image))
         self._previous[index] = (frame, image)
         if previous_frame != frame - 1:
-            return np.zeros(self.grid.cells)  # the first frame, or after a jump: no motion to see
-        return table_map(self.tables[index], motion_edges(previous, image, parameters.edges))
+            return None
+        return motion_edges(previous, image, self.parameters.edges)
 
     def detect(self, frame: int) -> tuple[np.ndarray, Modes]:
         """The occupancy map (rows, columns) at ``frame`` and its candidate modes."""
@@ -124,6 +137,34 @@ class LpomDetector:
         pom = occupancy_map(loci, weights, self.grid, parameters.kernel_sigma_m)
         modes = map_modes(pom, self.grid, parameters.separation_m, parameters.window_m, parameters.candidate_strength)
         return pom, modes
+
+
+class LpomForegroundDetector(LpomDetector):
+    """LPOM whose video views' pixels are the edges of their foreground silhouettes, not motion edges.
+
+    Each view with video gets its own background model (:class:`~ptztrack.occupancy.foreground.ViewForeground`,
+    learned online on the frames before each), whose silhouettes' boundary pixels feed the view's loci;
+    views without video give their boxes' outlines, as in :class:`LpomDetector`, and the map and its
+    modes are :class:`LpomDetector`'s.
+
+    Parameters
+    ----------
+    recording : the views, their frames or boxes.
+    parameters : the map's (its ``edges``, the motion edges' settings, go unused).
+    foreground : the background models' and their clean-up.
+    """
+
+    def __init__(self, recording: MultiViewRecording, parameters: LpomParameters, foreground: ForegroundParameters):
+        super().__init__(recording, parameters)
+        self.foreground = {
+            index: ViewForeground(view.frames, foreground)
+            for index, view in enumerate(recording.views)
+            if view.frames is not None
+        }
+
+    def motion_pixels(self, index: int, frame: int) -> np.ndarray | None:
+        """The edges (height, width) bool of view ``index``'s silhouettes at ``frame`` (none on frame 0)."""
+        return self.foreground[index].edges(frame)
 
 
 class ClusteringDetector:

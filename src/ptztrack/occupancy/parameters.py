@@ -84,3 +84,30 @@ class PomParameters:
     window_m: float = 0.25
     candidate_probability: float = 0.02
     min_probability: float = 0.5
+
+
+class ForegroundParameters:
+    """A fixed view's background model and the clean-up of its foreground (:mod:`ptztrack.occupancy.foreground`).
+
+    The model is OpenCV's MOG2 (Zivkovic, "Improved adaptive Gaussian mixture model for background
+    subtraction", ICPR 2004); its defaults are OpenCV's (``cv2.createBackgroundSubtractorMOG2``).
+
+    history : frames; the learning rate is ``1 / min(2 n, history)`` at the model's n-th frame
+        (OpenCV's schedule), so ``1 / history`` once warmed up. OpenCV's default, 500.
+    var_threshold : squared Mahalanobis distance (sigmas squared) within which a pixel is explained
+        by a background component. OpenCV's default, 16 (4 sigmas).
+    detect_shadows : whether MOG2 marks shadows (then dropped from the silhouettes) rather than
+        counting them as foreground. OpenCV's default, True.
+    shadow_threshold : the least brightness ratio to its background component (``tau`` of Prati et al.,
+        PAMI 2003, whom OpenCV follows) of a pixel that can be a shadow. OpenCV's default, 0.5.
+    opening_px, closing_px : sides of the square structuring elements of the morphological opening
+        (drops specks of sensor noise) and the closing (joins a body's parts) that follow; the clustering
+        baseline's blob boxes use the same (:mod:`ptztrack.occupancy.clustering`), 3 and 9 pixels.
+    """
+
+    history: int = 500
+    var_threshold: float = 16.0
+    detect_shadows: bool = True
+    shadow_threshold: float = 0.5
+    opening_px: int = 3
+    closing_px: int = 9
