@@ -1,11 +1,14 @@
 """From a validated configuration section to the maths' parameter dataclass it maps onto."""
 
 from dataclasses import fields
-from typing import TypeVar
+from typing import TYPE_CHECKING, TypeVar
 
 from pydantic import BaseModel
 
-P = TypeVar("P")
+if TYPE_CHECKING:
+    from _typeshed import DataclassInstance
+
+P = TypeVar("P", bound="DataclassInstance")
 
 
 def parameters_from(section: BaseModel, parameters_type: type[P], **overrides) -> P:
