@@ -12,6 +12,7 @@ from ptztrack.config import MAX_DATASET_FRAMES, DatasetView, MultiViewDataset
 from ptztrack.geometry.calibration import PinholeCalibration, load_pinhole, load_tsai, pinhole_from_tsai
 from ptztrack.occupancy.detectors import LpomParameters
 from ptztrack.occupancy.multiview import CameraView, ImageFolder, MultiViewRecording, load_mot_detections, mot_truth
+from ptztrack.occupancy.render import SceneRenderer
 from ptztrack.occupancy.room import RoomLayout, RoomRenderer, room_truth
 from ptztrack.scene.pets import DatasetError, RecordedVideo
 
@@ -139,6 +140,6 @@ def room_recording(people: int, frames: int, seed: int, layout: RoomLayout = ROO
     return MultiViewRecording(f"room-{people}", views, frames, layout.frame_rate_hz, np.asarray(ROOM_AREA_M), truth)
 
 
-def _view_frames(renderer: RoomRenderer, view: int) -> Callable[[int], np.ndarray]:
+def _view_frames(renderer: SceneRenderer, view: int) -> Callable[[int], np.ndarray]:
     """The view's frames, the last two kept: both detectors ask for each frame, LPOM for the one before too."""
     return functools.lru_cache(maxsize=2)(functools.partial(renderer.image, view))
