@@ -12,6 +12,7 @@ import cv2
 import numpy as np
 
 from ptztrack.files import InputError, read_json, read_xml_root, shown
+from ptztrack.geometry.lens import UNDISTORT_CRITERIA
 
 NEWTON_STEPS = 20
 MAX_IMAGE_SIDE_PX = 8192
@@ -108,11 +109,20 @@ def pixel_rays(calibration: PinholeCalibration, pixels_px) -> tuple[np.ndarray, 
     """The rays through pixels: the camera centre (3,) and unit directions (N, 3), in metres.
 
     pixels_px : (N, 2) distorted image coordinates (the centre of pixel (i, j) at (i + 0.5, j + 0.5),
-    as the calibrations map world points). ``cv2.undistortPoints`` inverts the distortion; the
-    calibration's millimetres become ptztrack's metres.
+    as the calibrations map world points). ``cv2.undistortPointsIter`` inverts the distortion, iterated
+    until the point distorts back to within 1e-10 px or for at most 100 steps
+    (:data:`~ptztrack.geometry.lens.UNDISTORT_CRITERIA`); the calibration's millimetres become
+    ptztrack's metres.
     """
+    # Not cv2.undistortPoints: its fixed 5 steps leave a strong distortion (PETS View_007's) far
+    # from converged.
     pixels = np.asarray(pixels_px, dtype=float).reshape(-1, 1, 2)
-    normalised = cv2.undistortPoints(pixels, calibration.K, calibration.dist)[:, 0, :]
+    if len(pixels):
+        normalised = cv2.undistortPointsIter(pixels, calibration.K, calibration.dist, None, None, UNDISTORT_CRITERIA)[
+            :, 0, :
+        ]
+    else:
+        normalised = np.zeros((0, 2))
     in_camera = np.concatenate([normalised, np.ones((len(normalised), 1))], axis=-1)
     direction = in_camera @ calibration.R  # R^T d for each row d
     centre_m = -calibration.R.T @ calibration.t / 1000.0
