@@ -1,5 +1,5 @@
-"""The occupancy-map experiment's inputs: a dataset file or the synthetic room made into a
-:class:`~ptztrack.occupancy.multiview.MultiViewRecording`, and the detectors' parameters from the configuration."""
+"""The occupancy-map experiment's inputs: a dataset file, the synthetic room or the synthetic plaza made into a
+:class:`~ptztrack.occupancy.multiview.MultiViewRecording`."""
 
 import functools
 from collections.abc import Callable
@@ -8,10 +8,11 @@ from pathlib import Path
 import numpy as np
 import psutil
 
-from ptztrack.config import MAX_DATASET_FRAMES, DatasetView, MultiViewDataset
+from ptztrack.config import MAX_DATASET_FRAMES, DatasetView, MultiViewDataset, pets_dataset
 from ptztrack.geometry.calibration import PinholeCalibration, load_pinhole, load_tsai, pinhole_from_tsai
 from ptztrack.occupancy.detectors import LpomParameters
 from ptztrack.occupancy.multiview import CameraView, ImageFolder, MultiViewRecording, load_mot_detections, mot_truth
+from ptztrack.occupancy.plaza import PlazaLayout, plaza_stage, plaza_truth
 from ptztrack.occupancy.render import SceneRenderer
 from ptztrack.occupancy.room import RoomLayout, RoomRenderer, room_truth
 from ptztrack.scene.pets import DatasetError, RecordedVideo
@@ -138,6 +139,32 @@ def room_recording(people: int, frames: int, seed: int, layout: RoomLayout = ROO
         for index, camera in enumerate(renderer.cameras)
     )
     return MultiViewRecording(f"room-{people}", views, frames, layout.frame_rate_hz, np.asarray(ROOM_AREA_M), truth)
+
+
+def plaza_layout() -> PlazaLayout:
+    """The plaza on the built-in PETS 2009 S2.L1 dataset's area, at its frame rate."""
+    pets = pets_dataset()
+    return PlazaLayout(area_m=pets.area_m, frame_rate_hz=pets.frame_rate_hz)
+
+
+def plaza_recording(people: int, frames: int, seed: int) -> MultiViewRecording:
+    """The synthetic plaza with ``people`` walking for ``frames`` frames, rendered on demand: PETS 2009
+    S2.L1's seven calibrated views (the built-in ``pets`` dataset's calibrations, at their image
+    sizes, 768 x 576 or 720 x 576 px), its area and frame rate (:mod:`ptztrack.occupancy.plaza`).
+    Every view has frames and no detector's boxes."""
+    pets, layout = pets_dataset(), plaza_layout()
+    calibrated = [_calibration(view, f"views.{index}") for index, view in enumerate(pets.views)]
+    cameras = [calibration for calibration, _ in calibrated]
+    sizes_px = [size_px for _, size_px in calibrated]
+    assert all(size_px is not None for size_px in sizes_px)  # Tsai files state their image size
+    truth = plaza_truth(layout, people, frames, seed)
+    renderer = SceneRenderer(cameras, sizes_px, plaza_stage(layout, cameras), truth, seed)  # type: ignore[arg-type]
+    views = tuple(
+        CameraView(view.name, camera, renderer.image_sizes_px[index], _view_frames(renderer, index), None)
+        for index, (view, camera) in enumerate(zip(pets.views, cameras, strict=True))
+    )
+    area_m = np.asarray(layout.area_m)
+    return MultiViewRecording(f"plaza-{people}", views, frames, layout.frame_rate_hz, area_m, truth)
 
 
 def _view_frames(renderer: SceneRenderer, view: int) -> Callable[[int], np.ndarray]:

@@ -94,6 +94,8 @@ def project_tsai(calibration: TsaiCalibration, points_mm) -> np.ndarray:
 
 def project_pinhole(calibration: PinholeCalibration, points_mm) -> np.ndarray:
     """World points (N, 3) mm to distorted image pixels (N, 2), with ``cv2.projectPoints``."""
+    if len(np.asarray(points_mm).reshape(-1, 3)) == 0:
+        return np.zeros((0, 2))  # cv2.projectPoints gives None for no points
     rotation_vector, _ = cv2.Rodrigues(calibration.R)
     pixels, _ = cv2.projectPoints(
         np.asarray(points_mm, dtype=float).reshape(-1, 1, 3),
