@@ -132,13 +132,9 @@ def recording_from_dataset(dataset: MultiViewDataset, frames: int | None = None)
 
 def room_recording(people: int, frames: int, seed: int, layout: RoomLayout = ROOM) -> MultiViewRecording:
     """The synthetic room with ``people`` walking for ``frames`` frames, rendered on demand."""
-    truth = room_truth(layout, people, frames, seed)
-    renderer = RoomRenderer(layout, truth, seed)
-    views = tuple(
-        CameraView(f"camera_{index + 1}", camera, layout.image_size_px, _view_frames(renderer, index), None)
-        for index, camera in enumerate(renderer.cameras)
-    )
-    return MultiViewRecording(f"room-{people}", views, frames, layout.frame_rate_hz, np.asarray(ROOM_AREA_M), truth)
+    renderer = RoomRenderer(layout, room_truth(layout, people, frames, seed), seed)
+    names = [f"camera_{index + 1}" for index in range(len(renderer.cameras))]
+    return rendered_recording(f"room-{people}", names, renderer, ROOM_AREA_M, layout.frame_rate_hz)
 
 
 def plaza_layout() -> PlazaLayout:
@@ -147,24 +143,43 @@ def plaza_layout() -> PlazaLayout:
     return PlazaLayout(area_m=pets.area_m, frame_rate_hz=pets.frame_rate_hz)
 
 
-def plaza_recording(people: int, frames: int, seed: int) -> MultiViewRecording:
-    """The synthetic plaza with ``people`` walking for ``frames`` frames, rendered on demand: PETS 2009
-    S2.L1's seven calibrated views (the built-in ``pets`` dataset's calibrations, at their image
-    sizes, 768 x 576 or 720 x 576 px), its area and frame rate (:mod:`ptztrack.occupancy.plaza`).
-    Every view has frames and no detector's boxes."""
+def plaza_renderer(people: int, frames: int, seed: int) -> SceneRenderer:
+    """The synthetic plaza's renderer (:mod:`ptztrack.occupancy.plaza`): PETS 2009 S2.L1's seven
+    calibrated views (the built-in ``pets`` dataset's calibrations, in its order, at their image
+    sizes: 768 x 576 or 720 x 576 px) watching ``people`` walk for ``frames`` frames."""
     pets, layout = pets_dataset(), plaza_layout()
-    calibrated = [_calibration(view, f"views.{index}") for index, view in enumerate(pets.views)]
-    cameras = [calibration for calibration, _ in calibrated]
-    sizes_px = [size_px for _, size_px in calibrated]
-    assert all(size_px is not None for size_px in sizes_px)  # Tsai files state their image size
+    cameras, sizes_px = [], []
+    for index, view in enumerate(pets.views):
+        calibration, size_px = _calibration(view, f"views.{index}")
+        assert size_px is not None  # a Tsai file states its image size
+        cameras.append(calibration)
+        sizes_px.append(size_px)
     truth = plaza_truth(layout, people, frames, seed)
-    renderer = SceneRenderer(cameras, sizes_px, plaza_stage(layout, cameras), truth, seed)  # type: ignore[arg-type]
+    return SceneRenderer(cameras, sizes_px, plaza_stage(layout, cameras), truth, seed)
+
+
+def plaza_recording(people: int, frames: int, seed: int) -> MultiViewRecording:
+    """The synthetic plaza with ``people`` walking for ``frames`` frames at PETS's frame rate over its
+    area, rendered on demand (:func:`plaza_renderer`); every view has frames and no detector's boxes."""
+    layout = plaza_layout()
+    names = [view.name for view in pets_dataset().views]
+    renderer = plaza_renderer(people, frames, seed)
+    return rendered_recording(f"plaza-{people}", names, renderer, layout.area_m, layout.frame_rate_hz)
+
+
+def rendered_recording(
+    name: str, view_names: list[str], renderer: SceneRenderer, area_m, frame_rate_hz: float
+) -> MultiViewRecording:
+    """The recording of a renderer's views (named ``view_names``), its frames rendered on demand, every
+    frame of its truth; area_m : [[x0, y0], [x1, y1]] the ground scored."""
     views = tuple(
-        CameraView(view.name, camera, renderer.image_sizes_px[index], _view_frames(renderer, index), None)
-        for index, (view, camera) in enumerate(zip(pets.views, cameras, strict=True))
+        CameraView(view_name, camera, size_px, _view_frames(renderer, index), None)
+        for index, (view_name, camera, size_px) in enumerate(
+            zip(view_names, renderer.cameras, renderer.image_sizes_px, strict=True)
+        )
     )
-    area_m = np.asarray(layout.area_m)
-    return MultiViewRecording(f"plaza-{people}", views, frames, layout.frame_rate_hz, area_m, truth)
+    frames = renderer.truth.positions_m.shape[0]
+    return MultiViewRecording(name, views, frames, frame_rate_hz, np.asarray(area_m), renderer.truth)
 
 
 def _view_frames(renderer: SceneRenderer, view: int) -> Callable[[int], np.ndarray]:
