@@ -104,12 +104,14 @@ def _dataset(
     files: dict | None = None,
     extra: tuple = (),
     exit_status: int = 2,
+    area: str = "[[-12, -13], [-3, -5]]",
 ) -> Case:
     """A one-view PETS dataset file (``view``: the view's fields besides its name and calibration;
     ``top``: more top-level lines), its calibration, two frames of detections and the first
-    ground-truth rows; run by ``experiment occupancy``."""
+    ground-truth rows; run by ``experiment occupancy``. ``area``: its area_m, by default one that
+    View_001 sees whole and that holds those rows' people."""
     document = (
-        "frame_rate_hz: 10\narea_m: [[-20, -15], [20, 25]]\nground_truth: gt.txt\n"
+        f"frame_rate_hz: 10\narea_m: {area}\nground_truth: gt.txt\n"
         f"views:\n  - {{name: View_001, calibration: c.xml, {view}}}\n{top}"
     )
     given = {"d.yaml": document, "c.xml": TSAI, "det.txt": "\n".join(DETECTION_ROWS) + "\n"}
@@ -228,6 +230,9 @@ def cases(scratch: Path | None) -> list[Case]:
         _dataset("dataset samples 1e9", top="occupancy: {samples_per_height: 1000000000}\n"),
         _dataset("dataset view without evidence", view="weight: 1"),
         _dataset("dataset view calibration missing", files={"c.xml": None}),
+        _dataset("dataset area behind the view", area="[[-60, -60], [-40, -40]]"),
+        _dataset("dataset area outside the view's image", area="[[-40, 0], [-30, 10]]"),
+        _dataset("dataset area partly seen", area="[[-20, -15], [20, 25]]", exit_status=0),
         _dataset("dataset calibration of another size", view="detections: det.txt, image_size_px: [640, 480]"),
         _dataset("detections frame 1e9", files={"det.txt": "1000000000,-1,300,200,40,100,0.9,-1,-1,-1\n"}),
         _dataset("detections a box of width 0", files={"det.txt": "1,-1,300,200,0,100,0.9,-1,-1,-1\n"}),

@@ -1,3 +1,4 @@
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -5,10 +6,13 @@ import pytest
 
 from ptztrack.geometry.calibration import (
     CalibrationError,
+    imaged_radius,
+    in_image,
     load_calibration,
     load_pinhole,
     load_tsai,
     pinhole_from_tsai,
+    pixel_rays,
     project_pinhole,
     project_tsai,
 )
@@ -56,6 +60,39 @@ def test_a_tsai_calibration_becomes_a_pinhole_camera_that_projects_the_same_over
     converted_px = project_pinhole(pinhole, points_mm[camera_z_mm > 0][inside])
     assert np.abs(converted_px - expected_px[inside]).max() < 0.01
     np.testing.assert_array_equal(pinhole_from_tsai(tsai).dist[2:4], 0.0)
+
+
+PETS_VIEWS = Path(__file__).resolve().parents[1] / "src" / "ptztrack" / "data" / "pets2009_s2l1"
+
+
+@pytest.mark.parametrize("view", ["View_001", "View_003", "View_004", "View_005", "View_006", "View_007", "View_008"])
+def test_every_pixels_ray_projects_back_onto_its_pixel(view):
+    """Back-projection inverts the distortion: PETS View_007's is strong enough that OpenCV's default
+    five steps of undistortion leave rays hundreds of pixels off."""
+    tsai = load_tsai(PETS_VIEWS / f"{view}.xml")
+    calibration = pinhole_from_tsai(tsai)
+    width, height = tsai.image_size_px
+    u, v = np.meshgrid(np.arange(0, width, 8) + 0.5, np.arange(0, height, 8) + 0.5)
+    pixels = np.stack([u.ravel(), v.ravel()], axis=-1)
+    centre_m, direction = pixel_rays(calibration, pixels)
+    back_px = project_pinhole(calibration, (centre_m + 5.0 * direction) * 1000.0)
+    assert np.abs(back_px - pixels).max() < 0.1
+
+
+def test_points_past_the_fold_of_the_distortion_are_not_seen():
+    """OpenCV's polynomial turns back beyond the imaged radius (53 degrees off View_001's axis): it puts
+    a point 60 degrees off the axis inside the image, which is 25 degrees wide; in_image does not."""
+    calibration = pinhole_from_tsai(load_tsai(PETS_VIEWS / "View_001.xml"))
+    limit = imaged_radius(calibration)
+    k1, k2, _, _, k3 = calibration.dist
+    assert 1 + 3 * k1 * limit**2 + 5 * k2 * limit**4 + 7 * k3 * limit**6 == pytest.approx(0.0, abs=1e-9)
+    in_camera_mm = np.array([[np.tan(np.radians(60.0)), 0.0, 1.0], [np.tan(np.radians(10.0)), 0.0, 1.0]]) * 1000.0
+    points_mm = (in_camera_mm - calibration.t) @ calibration.R  # R^T (camera - t) for each row
+    assert np.all(
+        (project_pinhole(calibration, points_mm)[:, 0] >= 0) & (project_pinhole(calibration, points_mm)[:, 0] < 768)
+    )
+    assert in_image(calibration, (768, 576), points_mm).tolist() == [False, True]
+    assert imaged_radius(replace(calibration, dist=np.zeros(5))) == np.inf
 
 
 def test_tsai_without_distortion_is_a_pinhole_projection():

@@ -28,6 +28,8 @@ OTB_TRACKS = 5
 """People the follow experiment's one-pass (OTB) protocol runs by default."""
 ROOM_FRAMES = 300
 """Frames of each synthetic-room sequence of the occupancy experiment."""
+PLAZA_FRAMES = 200
+"""Frames of each synthetic-plaza sequence of the occupancy experiment (20 s at PETS's 10 Hz)."""
 EXECUTORS = ("local", "ray", "serial")
 """Where an experiment's cells run (:mod:`ptztrack.evaluate.executors`)."""
 PASSWORD_VARIABLE = "PTZTRACK_CAMERA_PASSWORD"

@@ -1,21 +1,28 @@
-"""The occupancy-map experiment's inputs: a dataset file or the synthetic room made into a
-:class:`~ptztrack.occupancy.multiview.MultiViewRecording`, and the detectors' parameters from the configuration."""
+"""The occupancy-map experiment's inputs: a dataset file, the synthetic room or the synthetic plaza made into a
+:class:`~ptztrack.occupancy.multiview.MultiViewRecording`."""
 
 import functools
+import logging
 from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
 import psutil
 
-from ptztrack.config import MAX_DATASET_FRAMES, DatasetView, MultiViewDataset
-from ptztrack.geometry.calibration import PinholeCalibration, load_pinhole, load_tsai, pinhole_from_tsai
+from ptztrack.config import MAX_DATASET_FRAMES, DatasetView, MultiViewDataset, pets_dataset
+from ptztrack.geometry.calibration import PinholeCalibration, in_image, load_pinhole, load_tsai, pinhole_from_tsai
 from ptztrack.occupancy.detectors import LpomParameters
 from ptztrack.occupancy.multiview import CameraView, ImageFolder, MultiViewRecording, load_mot_detections, mot_truth
+from ptztrack.occupancy.plaza import PlazaLayout, plaza_stage, plaza_truth
+from ptztrack.occupancy.render import SceneRenderer
 from ptztrack.occupancy.room import RoomLayout, RoomRenderer, room_truth
 from ptztrack.scene.pets import DatasetError, RecordedVideo
 
+log = logging.getLogger(__name__)
+
 ROOM_AREA_M = ((0.0, 0.0), (5.0, 6.0))
+AREA_SAMPLES = 256
+"""Points per side of the grid on which a dataset's area is checked against its views."""
 # 20 s at 15 Hz per sequence (the paper's were 3.5 and 7 minutes long).
 ROOM = RoomLayout()
 
@@ -90,15 +97,18 @@ def recording_from_dataset(dataset: MultiViewDataset, frames: int | None = None)
     """The recording a dataset describes; ``frames`` (or the dataset's) caps how many frames are used.
 
     Without either, every frame that all views' videos or image folders have (or, without any, up to
-    the last frame of the detection files).
+    the last frame of the detection files). A view that sees none of the area is refused, and a part of
+    the area that no view sees is warned of (:func:`_view_sees_area`, :func:`_warn_of_unseen_area`).
     """
-    loaded = []
+    loaded, seen = [], []
+    area_mm = area_points_mm(dataset.area_m)
     for index, view in enumerate(dataset.views):
         field = f"views.{index}"
         calibration, size_px = _calibration(view, field)
         source, count = None, None
         if view.video is not None or view.images is not None:
             source, count, size_px = _frames(view, size_px, field)
+        seen.append(_view_sees_area(view, field, calibration, size_px, area_mm))
         boxes = None if view.detections is None else load_mot_detections(view.detections, MAX_DATASET_FRAMES)
         loaded.append((view, calibration, size_px, source, count, boxes))
     counts = [count for *_, count, _ in loaded if count is not None]
@@ -125,20 +135,106 @@ def recording_from_dataset(dataset: MultiViewDataset, frames: int | None = None)
     truth = None
     if dataset.ground_truth is not None:
         truth = mot_truth(dataset.ground_truth, wanted, dataset.frame_rate_hz)
+    # Last, after every error the files could still raise: a refused dataset gets its one line alone.
+    _warn_of_unseen_area(dataset.name, area_mm, np.any(seen, axis=0))
     return MultiViewRecording(dataset.name, views, wanted, dataset.frame_rate_hz, np.asarray(dataset.area_m), truth)
+
+
+def area_points_mm(area_m) -> np.ndarray:
+    """The area [[x0, y0], [x1, y1]] m as AREA_SAMPLES x AREA_SAMPLES ground points (N, 3) mm, its
+    edges included."""
+    (x0, y0), (x1, y1) = area_m
+    x_m, y_m = np.meshgrid(np.linspace(x0, x1, AREA_SAMPLES), np.linspace(y0, y1, AREA_SAMPLES))
+    return np.stack([x_m.ravel(), y_m.ravel(), np.zeros(x_m.size)], axis=-1) * 1000.0
+
+
+def _view_sees_area(
+    view: DatasetView, field: str, calibration: PinholeCalibration, size_px: tuple[int, int] | None, area_mm
+) -> np.ndarray:
+    """Which of the area's points (N, 3) mm the view sees, (N,) bool; a :class:`DatasetError` naming the
+    view if it sees none: all behind the camera (camera depth R p + t at most 0), or, with a known
+    image size, all outside its image (:func:`~ptztrack.geometry.calibration.in_image`). Without an
+    image size (a pinhole JSON, detections only) every point in front counts as seen."""
+    label = f"{view.calibration}: {field} ({view.name}) sees none of area_m"
+    ahead = area_mm @ calibration.R[2] + calibration.t[2] > 0
+    if not ahead.any():
+        raise DatasetError(f"{label}: the whole area is behind the camera")
+    if size_px is None:
+        return ahead
+    seen = in_image(calibration, size_px, area_mm)
+    if not seen.any():
+        raise DatasetError(f"{label}: the whole area projects outside its {size_px[0]}x{size_px[1]} px image")
+    return seen
+
+
+def _warn_of_unseen_area(name: str, area_mm, seen) -> None:
+    """A warning line if some of the area's points (N, 3) mm are seen by no view (``seen`` (N,) bool):
+    their share and the box around them. Not an error: a dataset's area is a rectangle around where
+    people walk, which its cameras rarely cover whole (people there can only be missed, and the
+    scores show it); an area that no view sees at all never gets here, since every view must see
+    some of it."""
+    unseen_m = area_mm[~seen, :2] / 1000.0
+    if len(unseen_m) == 0:
+        return
+    (x0, y0), (x1, y1) = unseen_m.min(axis=0), unseen_m.max(axis=0)
+    log.warning(
+        f"{name}: {len(unseen_m) / len(seen):.1%} of area_m is seen by no view (all of it within x "
+        f"{x0:.1f} to {x1:.1f} m, y {y0:.1f} to {y1:.1f} m); people there can only be missed"
+    )
 
 
 def room_recording(people: int, frames: int, seed: int, layout: RoomLayout = ROOM) -> MultiViewRecording:
     """The synthetic room with ``people`` walking for ``frames`` frames, rendered on demand."""
-    truth = room_truth(layout, people, frames, seed)
-    renderer = RoomRenderer(layout, truth, seed)
+    renderer = RoomRenderer(layout, room_truth(layout, people, frames, seed), seed)
+    names = [f"camera_{index + 1}" for index in range(len(renderer.cameras))]
+    return rendered_recording(f"room-{people}", names, renderer, ROOM_AREA_M, layout.frame_rate_hz)
+
+
+def plaza_layout() -> PlazaLayout:
+    """The plaza on the built-in PETS 2009 S2.L1 dataset's area, at its frame rate."""
+    pets = pets_dataset()
+    return PlazaLayout(area_m=pets.area_m, frame_rate_hz=pets.frame_rate_hz)
+
+
+def plaza_renderer(people: int, frames: int, seed: int) -> SceneRenderer:
+    """The synthetic plaza's renderer (:mod:`ptztrack.occupancy.plaza`): PETS 2009 S2.L1's seven
+    calibrated views (the built-in ``pets`` dataset's calibrations, in its order, at their image
+    sizes: 768 x 576 or 720 x 576 px) watching ``people`` walk for ``frames`` frames."""
+    pets, layout = pets_dataset(), plaza_layout()
+    cameras, sizes_px = [], []
+    for index, view in enumerate(pets.views):
+        calibration, size_px = _calibration(view, f"views.{index}")
+        assert size_px is not None  # a Tsai file states its image size
+        cameras.append(calibration)
+        sizes_px.append(size_px)
+    truth = plaza_truth(layout, people, frames, seed)
+    return SceneRenderer(cameras, sizes_px, plaza_stage(layout, cameras), truth, seed)
+
+
+def plaza_recording(people: int, frames: int, seed: int) -> MultiViewRecording:
+    """The synthetic plaza with ``people`` walking for ``frames`` frames at PETS's frame rate over its
+    area, rendered on demand (:func:`plaza_renderer`); every view has frames and no detector's boxes."""
+    layout = plaza_layout()
+    names = [view.name for view in pets_dataset().views]
+    renderer = plaza_renderer(people, frames, seed)
+    return rendered_recording(f"plaza-{people}", names, renderer, layout.area_m, layout.frame_rate_hz)
+
+
+def rendered_recording(
+    name: str, view_names: list[str], renderer: SceneRenderer, area_m, frame_rate_hz: float
+) -> MultiViewRecording:
+    """The recording of a renderer's views (named ``view_names``), its frames rendered on demand, every
+    frame of its truth; area_m : [[x0, y0], [x1, y1]] the ground scored."""
     views = tuple(
-        CameraView(f"camera_{index + 1}", camera, layout.image_size_px, _view_frames(renderer, index), None)
-        for index, camera in enumerate(renderer.cameras)
+        CameraView(view_name, camera, size_px, _view_frames(renderer, index), None)
+        for index, (view_name, camera, size_px) in enumerate(
+            zip(view_names, renderer.cameras, renderer.image_sizes_px, strict=True)
+        )
     )
-    return MultiViewRecording(f"room-{people}", views, frames, layout.frame_rate_hz, np.asarray(ROOM_AREA_M), truth)
+    frames = renderer.truth.positions_m.shape[0]
+    return MultiViewRecording(name, views, frames, frame_rate_hz, np.asarray(area_m), renderer.truth)
 
 
-def _view_frames(renderer: RoomRenderer, view: int) -> Callable[[int], np.ndarray]:
+def _view_frames(renderer: SceneRenderer, view: int) -> Callable[[int], np.ndarray]:
     """The view's frames, the last two kept: both detectors ask for each frame, LPOM for the one before too."""
     return functools.lru_cache(maxsize=2)(functools.partial(renderer.image, view))

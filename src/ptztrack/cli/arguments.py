@@ -15,6 +15,7 @@ from ptztrack.names import (
     FOLLOW_TRACKERS,
     OTB_TRACKS,
     PASSWORD_VARIABLE,
+    PLAZA_FRAMES,
     POSE_SOURCES,
     PROTOCOLS,
     ROOM_FRAMES,
@@ -259,12 +260,18 @@ def _add_occupancy_parser(experiments) -> None:
     occupancy = experiments.add_parser(
         "occupancy", help="the LPOM paper: people on the ground from several calibrated views, against clustering"
     )
-    occupancy.add_argument("dataset", help="'synthetic-room' or 'pets' (built in), or a multi-view dataset YAML file")
     occupancy.add_argument(
-        "--frames", type=_positive_int, help=f"frames to use (synthetic-room: {ROOM_FRAMES} per sequence; else all)"
+        "dataset",
+        help="'synthetic-room' (near, steep cameras), 'synthetic-plaza' (PETS S2.L1's far, shallow cameras, "
+        "rendered) or 'pets' (built in), or a multi-view dataset YAML file",
     )
     occupancy.add_argument(
-        "--seed", type=_non_negative_int, default=0, help="synthetic-room: draws people and textures"
+        "--frames",
+        type=_positive_int,
+        help=f"frames to use (synthetic-room: {ROOM_FRAMES}, synthetic-plaza: {PLAZA_FRAMES} per sequence; else all)",
+    )
+    occupancy.add_argument(
+        "--seed", type=_non_negative_int, default=0, help="synthetic-room, synthetic-plaza: draws people and textures"
     )
     occupancy.add_argument(
         "--out", type=Path, help="directory for maps, video, detections and tracks per recording; written whole"

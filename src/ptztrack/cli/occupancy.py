@@ -5,9 +5,9 @@ import argparse
 
 from ptztrack.config import load_dataset, pets_dataset
 from ptztrack.evaluate.executors import Progress
-from ptztrack.experiments.occupancy import dataset_runs, format_occupancy_table, room_runs
+from ptztrack.experiments.occupancy import dataset_runs, format_occupancy_table, plaza_runs, room_runs
 from ptztrack.files import run_folder, write_json
-from ptztrack.names import ROOM_FRAMES
+from ptztrack.names import PLAZA_FRAMES, ROOM_FRAMES
 from ptztrack.occupancy.output import write_occupancy_outputs
 
 
@@ -15,6 +15,8 @@ def occupancy_experiment_command(args: argparse.Namespace) -> int:
     with Progress("frame", args.quiet) as progress:
         if args.dataset == "synthetic-room":
             runs = room_runs(args.frames or ROOM_FRAMES, args.seed, progress)
+        elif args.dataset == "synthetic-plaza":
+            runs = plaza_runs(args.frames or PLAZA_FRAMES, args.seed, progress)
         else:
             dataset = pets_dataset() if args.dataset == "pets" else load_dataset(args.dataset)
             runs = dataset_runs(dataset, args.frames, progress)

@@ -2,20 +2,22 @@
 the locus-based occupancy map and by the clustering baseline, scored against the truth (MODA, MODP,
 precision, recall within 0.5 m; the tracker fed by LPOM: MOTA, MOTP, IDF1).
 
-A run is one recording, a dataset's (:func:`dataset_runs`) or the synthetic room's with 1 and with
-3 people (:func:`room_runs`), both detectors over every frame (:func:`run_recording`); its rows, one
-per method, are tabled by :func:`format_occupancy_table`.
+A run is one recording, a dataset's (:func:`dataset_runs`), the synthetic room's with 1 and with
+3 people (:func:`room_runs`) or the synthetic plaza's with 4 and with 8 (:func:`plaza_runs`), both
+detectors over every frame (:func:`run_recording`); its rows, one per method, are tabled by
+:func:`format_occupancy_table`.
 """
 
 from collections.abc import Callable
 
 from ptztrack.builders.occupancy import (
+    plaza_recording,
     recording_from_dataset,
     refuse_if_tables_too_large,
     room_recording,
 )
 from ptztrack.builders.parameters import parameters_from
-from ptztrack.config import MultiViewDataset, Occupancy, OccupancyTracker, Tracker
+from ptztrack.config import MultiViewDataset, Occupancy, OccupancyTracker, Tracker, pets_dataset
 from ptztrack.occupancy.detectors import ClusteringDetector, LpomDetector, lpom_parameters
 from ptztrack.occupancy.evaluation import OccupancyRun, detect_frames, score_recording
 from ptztrack.occupancy.multiview import MultiViewRecording
@@ -24,6 +26,9 @@ from ptztrack.scene.pets import DatasetError
 from ptztrack.track.parameters import TrackerParameters
 
 ROOM_PEOPLE = (1, 3)
+# S2.L1 has 5.8 people in its area on average, 8 at most: 4 (two pairs) is a sparse plaza, where the
+# far views' loci rarely cross another person's; 8 is S2.L1 at its busiest.
+PLAZA_PEOPLE = (4, 8)
 # The table's columns (a row's key) and their formats.
 OCCUPANCY_COLUMNS = (
     ("method", "{}"),
@@ -74,6 +79,18 @@ def room_runs(frames: int, seed: int, progress=None) -> list[OccupancyRun]:
             room_recording(people, frames, seed + index), Occupancy(), OccupancyTracker(), {"people": people}, progress
         )
         for index, people in enumerate(ROOM_PEOPLE)
+    ]
+
+
+def plaza_runs(frames: int, seed: int, progress=None) -> list[OccupancyRun]:
+    """The synthetic plaza with 4 and with 8 people (seeds ``seed`` and ``seed + 1``), with the built-in
+    PETS dataset's parameters (its cells and kernel, its tracker), so that its rows compare with PETS's."""
+    pets = pets_dataset()
+    return [
+        run_recording(
+            plaza_recording(people, frames, seed + index), pets.occupancy, pets.tracker, {"people": people}, progress
+        )
+        for index, people in enumerate(PLAZA_PEOPLE)
     ]
 
 

@@ -12,6 +12,7 @@ import cv2
 import numpy as np
 
 from ptztrack.files import InputError, read_json, read_xml_root, shown
+from ptztrack.geometry.lens import UNDISTORT_CRITERIA
 
 NEWTON_STEPS = 20
 MAX_IMAGE_SIDE_PX = 8192
@@ -93,6 +94,8 @@ def project_tsai(calibration: TsaiCalibration, points_mm) -> np.ndarray:
 
 def project_pinhole(calibration: PinholeCalibration, points_mm) -> np.ndarray:
     """World points (N, 3) mm to distorted image pixels (N, 2), with ``cv2.projectPoints``."""
+    if len(np.asarray(points_mm).reshape(-1, 3)) == 0:
+        return np.zeros((0, 2))  # cv2.projectPoints gives None for no points
     rotation_vector, _ = cv2.Rodrigues(calibration.R)
     pixels, _ = cv2.projectPoints(
         np.asarray(points_mm, dtype=float).reshape(-1, 1, 3),
@@ -108,15 +111,62 @@ def pixel_rays(calibration: PinholeCalibration, pixels_px) -> tuple[np.ndarray, 
     """The rays through pixels: the camera centre (3,) and unit directions (N, 3), in metres.
 
     pixels_px : (N, 2) distorted image coordinates (the centre of pixel (i, j) at (i + 0.5, j + 0.5),
-    as the calibrations map world points). ``cv2.undistortPoints`` inverts the distortion; the
-    calibration's millimetres become ptztrack's metres.
+    as the calibrations map world points). ``cv2.undistortPointsIter`` inverts the distortion, iterated
+    until the point distorts back to within 1e-10 px or for at most 100 steps
+    (:data:`~ptztrack.geometry.lens.UNDISTORT_CRITERIA`); the calibration's millimetres become
+    ptztrack's metres.
     """
+    # Not cv2.undistortPoints: its fixed 5 steps leave a strong distortion (PETS View_007's) far
+    # from converged.
     pixels = np.asarray(pixels_px, dtype=float).reshape(-1, 1, 2)
-    normalised = cv2.undistortPoints(pixels, calibration.K, calibration.dist)[:, 0, :]
+    if len(pixels):
+        normalised = cv2.undistortPointsIter(pixels, calibration.K, calibration.dist, None, None, UNDISTORT_CRITERIA)[
+            :, 0, :
+        ]
+    else:
+        normalised = np.zeros((0, 2))
     in_camera = np.concatenate([normalised, np.ones((len(normalised), 1))], axis=-1)
     direction = in_camera @ calibration.R  # R^T d for each row d
     centre_m = -calibration.R.T @ calibration.t / 1000.0
     return centre_m, direction / np.linalg.norm(direction, axis=-1, keepdims=True)
+
+
+def imaged_radius(calibration: PinholeCalibration) -> float:
+    """The largest normalised undistorted radius that the calibration's distortion maps outwards.
+
+    A point at (x, y, z) in the camera frame has the radius r = |(x, y)| / z; OpenCV's radial
+    distortion moves it to r (1 + k1 r^2 + k2 r^4 + k3 r^6). That grows with r up to the smallest
+    r > 0 where its derivative 1 + 3 k1 r^2 + 5 k2 r^4 + 7 k3 r^6 vanishes (a cubic in r^2), and
+    folds back beyond it, where a point far outside the field of view would be projected into
+    the image. Returns that r (dimensionless), infinite where the polynomial never folds (no
+    distortion). The tangential terms are ignored (zero in Tsai's model and the room's).
+    """
+    k1, k2, _, _, k3 = np.asarray(calibration.dist, dtype=float)
+    # np.roots drops leading zero coefficients: a lower-degree polynomial, or none at all.
+    squares = np.roots([7 * k3, 5 * k2, 3 * k1, 1.0])
+    real = squares.real[(np.abs(squares.imag) < 1e-12) & (squares.real > 0)]
+    return float(np.sqrt(real.min())) if len(real) else float("inf")
+
+
+def in_image(calibration: PinholeCalibration, image_size_px, points_mm) -> np.ndarray:
+    """Whether the camera sees world points (N, 3) mm: (N,) bool.
+
+    Seen means in front of the camera (depth above 0), within the radius the distortion maps
+    outwards (:func:`imaged_radius`) and projected into the image [0, width) x [0, height) px,
+    image_size_px being (width, height).
+    """
+    points_mm = np.asarray(points_mm, dtype=float).reshape(-1, 3)
+    camera_mm = points_mm @ calibration.R.T + calibration.t
+    depth_mm = camera_mm[:, 2]
+    ahead = depth_mm > 0
+    radius = np.hypot(camera_mm[:, 0], camera_mm[:, 1]) / np.where(ahead, depth_mm, 1.0)
+    seen = ahead & (radius < imaged_radius(calibration))
+    pixels = np.full((len(points_mm), 2), -1.0)
+    if np.any(seen):
+        pixels[seen] = project_pinhole(calibration, points_mm[seen])
+    width_px, height_px = image_size_px
+    inside = (pixels[:, 0] >= 0) & (pixels[:, 0] < width_px) & (pixels[:, 1] >= 0) & (pixels[:, 1] < height_px)
+    return seen & inside
 
 
 def standing_height_px(calibration: PinholeCalibration, feet_px, height_m: float) -> np.ndarray:
