@@ -6,11 +6,12 @@ import sys
 import pytest
 
 # What parsing and printing help may load of ptztrack: the package, the command line's parser, the
-# registry's names, the shared names and defaults, and the file helpers' errors.
+# registry's names, the shared names and defaults, the file helpers' errors, and Ctrl-C's handler.
 PARSING_MODULES = {
     "ptztrack",
     "ptztrack.cli",
     "ptztrack.cli.arguments",
+    "ptztrack.cli.interrupt",
     "ptztrack.registry",
     "ptztrack.names",
     "ptztrack.files",

@@ -95,7 +95,8 @@ def test_a_dataset_in_the_generic_format_runs_and_writes_its_outputs(tmp_path, c
         == 0
     )
     rows = json.loads(rows_path.read_text())
-    assert [row["method"] for row in rows] == ["lpom", "clustering"]
+    # Its boxes-only view has no image size, which POM's rectangles need.
+    assert [row["method"] for row in rows] == ["lpom", "lpom-foreground", "clustering"]
     for row in rows:
         assert {"moda", "modp", "precision", "recall", "error_m"} <= set(row) and row["views"] == 5
     assert {"mota", "motp_m", "idf1"} <= set(rows[0])
@@ -184,7 +185,7 @@ def test_pets_runs_with_seven_views(tmp_path):
     rows_path = tmp_path / "pets.json"
     assert main(["experiment", "occupancy", "pets", "--frames", "60", "--json", str(rows_path)]) == 0
     rows = json.loads(rows_path.read_text())
-    assert [row["method"] for row in rows] == ["lpom", "clustering"]
+    assert [row["method"] for row in rows] == ["lpom", "lpom-foreground", "pom", "clustering"]
     assert all(row["views"] == 7 and row["frames"] == 60 for row in rows) and "mota" in rows[0]
 
 

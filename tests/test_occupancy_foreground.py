@@ -7,7 +7,8 @@ from ptztrack.builders.occupancy import room_recording
 from ptztrack.occupancy.detectors import LpomForegroundDetector, lpom_parameters
 from ptztrack.occupancy.foreground import ViewForeground, clean_silhouettes, silhouette_edges
 from ptztrack.occupancy.parameters import ForegroundParameters, OccupancyParameters
-from ptztrack.occupancy.room import RoomLayout, RoomRenderer, draw_people, room_truth
+from ptztrack.occupancy.render import draw_people
+from ptztrack.occupancy.room import RoomLayout, RoomRenderer, room_truth
 
 # The 3-person room long enough for the background model to have warmed up (its learning rate is
 # 1 / (2 n) at its n-th frame): the last frames are the ones checked.

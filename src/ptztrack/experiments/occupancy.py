@@ -18,10 +18,11 @@ from ptztrack.builders.occupancy import (
 )
 from ptztrack.builders.parameters import parameters_from
 from ptztrack.config import MultiViewDataset, Occupancy, OccupancyTracker, Tracker, pets_dataset
-from ptztrack.occupancy.detectors import ClusteringDetector, LpomDetector, lpom_parameters
-from ptztrack.occupancy.evaluation import OccupancyRun, detect_frames, score_recording
+from ptztrack.occupancy.detectors import ClusteringDetector, LpomDetector, LpomForegroundDetector, lpom_parameters
+from ptztrack.occupancy.evaluation import MapDetector, OccupancyRun, detect_frames, score_recording
 from ptztrack.occupancy.multiview import MultiViewRecording
-from ptztrack.occupancy.parameters import OccupancyParameters
+from ptztrack.occupancy.parameters import ForegroundParameters, OccupancyParameters, PomParameters
+from ptztrack.occupancy.pom import PomDetector
 from ptztrack.scene.pets import DatasetError
 from ptztrack.track.parameters import TrackerParameters
 
@@ -51,15 +52,22 @@ def run_recording(
     label: dict | None = None,
     progress: Callable[[int, int], None] | None = None,
 ) -> OccupancyRun:
-    """Both detectors over every frame of ``recording``, scored (the recording needs ground truth)."""
+    """Every method over every frame of ``recording``, scored (the recording needs ground truth): LPOM
+    from motion edges (the paper's), LPOM from foreground silhouettes (where a view has video), POM
+    (where every view's image size is known) and the clustering baseline."""
     if recording.truth is None:
         raise DatasetError(f"{recording.name}: the experiment needs ground truth (ground_truth)")
     settings = parameters_from(occupancy, OccupancyParameters)
     parameters = lpom_parameters(settings)
     refuse_if_tables_too_large(recording, parameters)
     lpom = LpomDetector(recording, parameters)
+    maps: dict[str, MapDetector] = {"lpom": lpom}
+    if any(view.frames is not None for view in recording.views):
+        maps["lpom-foreground"] = LpomForegroundDetector(recording, parameters, ForegroundParameters(), lpom.tables)
+    if all(view.image_size_px is not None for view in recording.views):
+        maps["pom"] = PomDetector(recording, PomParameters(), ForegroundParameters())
     clustering = ClusteringDetector(recording, settings.linkage_m, settings.min_box_score, settings.blob_min_area_px)
-    frames = detect_frames(recording, lpom, clustering, progress)
+    frames = detect_frames(recording, maps, clustering, progress)
     # People leave a dataset's area (and never the room's, whose tracks stay well localised).
     tracking = parameters_from(tracker, TrackerParameters)
     return score_recording(recording, lpom.grid, frames, tracking, occupancy.separation_m, label)
@@ -98,12 +106,18 @@ def format_occupancy_table(dataset: str, rows: list[dict]) -> str:
     """The table of the runs' ``rows`` on ``dataset`` (its name): a line per row, with the columns of
     ``OCCUPANCY_COLUMNS`` that some row has, then the parameters each row's method fitted."""
     columns = [(key, form) for key, form in OCCUPANCY_COLUMNS if any(key in row for row in rows)]
+    width = max(10, *(len(str(row["method"])) for row in rows))
     lines = [
-        f"Occupancy-map detection on {dataset}: MODA, MODP, precision, recall within 0.5 m; tracker fed by LPOM",
-        "  ".join(f"{key:>10}" for key, _ in columns),
+        f"Occupancy-map detection on {dataset}: MODA, MODP, precision, recall within 0.5 m; tracker fed by each map",
+        "  ".join(f"{key:>{width if key == 'method' else 10}}" for key, _ in columns),
     ]
     for row in rows:
-        lines.append("  ".join(f"{form.format(row[key]) if key in row else '':>10}" for key, form in columns))
+        cells = (form.format(row[key]) if key in row else "" for key, form in columns)
+        lines.append(
+            "  ".join(
+                f"{cell:>{width if key == 'method' else 10}}" for cell, (key, _) in zip(cells, columns, strict=True)
+            )
+        )
     for row in rows:
         fitted = {key: value for key, value in row.items() if key.startswith("fitted_")}
         lines.append(

@@ -89,19 +89,29 @@ def scored_boxes(view: CameraView, frame: int, min_score: float) -> np.ndarray:
 class LpomDetector:
     """The occupancy map and its modes for each frame of ``recording``, in order (``detect(frame)``).
 
-    The locus tables of the views with video are computed on construction (``tables``).
+    The locus tables of the views with video are computed on construction (``tables``), unless
+    another detector's of the same recording and parameters are given (they are read, never changed).
     """
 
-    def __init__(self, recording: MultiViewRecording, parameters: LpomParameters):
+    def __init__(
+        self,
+        recording: MultiViewRecording,
+        parameters: LpomParameters,
+        tables: dict[int, LocusTable] | None = None,
+    ):
         self.recording, self.parameters = recording, parameters
         self.grid = GroundGrid.covering(recording.area_m, parameters.cell_m)
-        self.tables: dict[int, LocusTable] = {
-            index: locus_table(
-                view.calibration, view.image_size_px, self.grid, parameters.sampling, parameters.block_px
-            )
-            for index, view in enumerate(recording.views)
-            if view.frames is not None
-        }
+        self.tables: dict[int, LocusTable] = (
+            tables
+            if tables is not None
+            else {
+                index: locus_table(
+                    view.calibration, view.image_size_px, self.grid, parameters.sampling, parameters.block_px
+                )
+                for index, view in enumerate(recording.views)
+                if view.frames is not None
+            }
+        )
         self._previous: dict[int, tuple[int, np.ndarray]] = {}
 
     def view_loci(self, index: int, frame: int) -> np.ndarray:
@@ -152,10 +162,17 @@ class LpomForegroundDetector(LpomDetector):
     recording : the views, their frames or boxes.
     parameters : the map's (its ``edges``, the motion edges' settings, go unused).
     foreground : the background models' and their clean-up.
+    tables : the locus tables of an :class:`LpomDetector` of the same recording and parameters.
     """
 
-    def __init__(self, recording: MultiViewRecording, parameters: LpomParameters, foreground: ForegroundParameters):
-        super().__init__(recording, parameters)
+    def __init__(
+        self,
+        recording: MultiViewRecording,
+        parameters: LpomParameters,
+        foreground: ForegroundParameters,
+        tables: dict[int, LocusTable] | None = None,
+    ):
+        super().__init__(recording, parameters, tables)
         self.foreground = {
             index: ViewForeground(view.frames, foreground)
             for index, view in enumerate(recording.views)

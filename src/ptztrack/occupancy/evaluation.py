@@ -24,6 +24,7 @@ by MOTA, MOTP and IDF1 (:func:`ptztrack.evaluate.metrics.clear_metrics`,
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Protocol
 
 import numpy as np
 from scipy.optimize import linear_sum_assignment
@@ -31,7 +32,7 @@ from scipy.spatial.distance import cdist
 
 from ptztrack.evaluate.metrics import clear_metrics
 from ptztrack.occupancy.clustering import Clusters
-from ptztrack.occupancy.detectors import ClusteringDetector, LpomDetector
+from ptztrack.occupancy.detectors import ClusteringDetector
 from ptztrack.occupancy.lpom import GroundGrid, Modes
 from ptztrack.occupancy.multiview import MultiViewRecording
 from ptztrack.track.kalman import constant_velocity_model
@@ -89,27 +90,39 @@ def scored_truth(recording: MultiViewRecording) -> np.ndarray:
 
 @dataclass(frozen=True)
 class Frames:
-    """What the detectors found in every frame: occupancy maps as (rows, columns) uint8 (scaled to each
-    frame's largest value, for pictures), LPOM's candidate modes and the baseline's clusters."""
+    """What the detectors found in every frame: the first map method's occupancy maps as (rows, columns)
+    uint8 (scaled to each frame's largest value, for pictures), every map method's candidate modes (by
+    method, in the order run) and the baseline's clusters."""
 
     maps_u8: list[np.ndarray]
-    modes: list[Modes]
+    modes: dict[str, list[Modes]]
     clusters: list[Clusters]
+
+
+class MapDetector(Protocol):
+    """A detector of people as the modes of a map on the ground (LPOM, POM): ``detect(frame) -> (map, modes)``."""
+
+    def detect(self, frame: int) -> tuple[np.ndarray, Modes]: ...
 
 
 def detect_frames(
     recording: MultiViewRecording,
-    lpom: LpomDetector,
+    maps: dict[str, MapDetector],
     clustering: ClusteringDetector,
     progress: Callable[[int, int], None] | None = None,
 ) -> Frames:
-    """Run both detectors over every frame, in order."""
-    maps_u8, modes, clusters = [], [], []
+    """Run every detector over every frame, in order; ``maps`` by method, the first one's maps kept."""
+    maps_u8: list[np.ndarray] = []
+    modes: dict[str, list[Modes]] = {method: [] for method in maps}
+    clusters = []
     for frame in range(recording.frames):
-        pom, found = lpom.detect(frame)
-        peak = pom.max(initial=0.0)
-        maps_u8.append(np.round(255 * pom / peak).astype(np.uint8) if peak > 0 else np.zeros(pom.shape, np.uint8))
-        modes.append(found)
+        for index, (method, detector) in enumerate(maps.items()):
+            occupancy, found = detector.detect(frame)
+            if index == 0:
+                peak = occupancy.max(initial=0.0)
+                scaled = np.round(255 * occupancy / peak) if peak > 0 else np.zeros(occupancy.shape)
+                maps_u8.append(scaled.astype(np.uint8))
+            modes[method].append(found)
         clusters.append(clustering.detect(frame))
         if progress is not None:
             progress(frame + 1, recording.frames)
@@ -182,15 +195,17 @@ def track_on_ground(
 
 @dataclass(frozen=True)
 class OccupancyRun:
-    """One recording's experiment: the rows (one per method), what each frame kept, the tracks."""
+    """One recording's experiment: the rows (one per method), what each frame kept (``kept``: by map
+    method; ``clustering``), the tracks fed by each map method's detections, the truth; ``grid`` is
+    the first map method's."""
 
     rows: list[dict]
     frame_rate_hz: float
     grid: GroundGrid
     frames: Frames
-    lpom: list[Modes]
+    kept: dict[str, list[Modes]]
     clustering: list[Clusters]
-    tracks: list[Tracks]
+    tracks: dict[str, list[Tracks]]
     truth_m: np.ndarray
 
 
@@ -202,39 +217,44 @@ def score_recording(
     separation_m: float,
     label: dict | None = None,
 ) -> OccupancyRun:
-    """Fit each method's threshold on disjoint frames, score both, and track LPOM's modes.
+    """Fit each method's threshold on disjoint frames, score every method, and track each map method's
+    detections.
 
-    label : keys added to both rows (e.g. ``{"people": 3}``).
+    label : keys added to every row (e.g. ``{"people": 3}``).
     """
     truth_m = scored_truth(recording)
-    kept_modes, strengths, recall = fitted_selection(
-        truth_m, [m.strength for m in frames.modes], [m.position_m for m in frames.modes], STRENGTH_CHOICES
-    )
-    lpom = [found.select(keep) for found, keep in zip(frames.modes, kept_modes, strict=True)]
+    common = {"dataset": recording.name, **(label or {}), "frames": recording.frames, "views": len(recording.views)}
+    rows, kept, tracks = [], {}, {}
+    for method, modes in frames.modes.items():
+        kept_modes, strengths, recall = fitted_selection(
+            truth_m, [m.strength for m in modes], [m.position_m for m in modes], STRENGTH_CHOICES
+        )
+        kept[method] = [found.select(keep) for found, keep in zip(modes, kept_modes, strict=True)]
+        tracks[method] = track_on_ground(kept[method], recall, separation_m, recording.frame_rate_hz, tracker)
+        tracking = clear_metrics(truth_m, [t.ids for t in tracks[method]], [t.mean[:, :2] for t in tracks[method]])
+        rows.append(
+            {
+                "method": method,
+                **common,
+                **detection_metrics(truth_m, [m.position_m for m in kept[method]]),
+                "fitted_min_strength": [float(value) for value in strengths],
+                "mota": tracking["mota"],
+                "motp_m": tracking["motp_m"],
+                "idf1": tracking["idf1"],
+                "switches": tracking["switches"],
+            }
+        )
     views = tuple(range(1, len(recording.views) + 1))
     kept_clusters, min_views, _ = fitted_selection(
         truth_m, [c.views for c in frames.clusters], [c.position_m for c in frames.clusters], views
     )
     clustering = [found.select(keep) for found, keep in zip(frames.clusters, kept_clusters, strict=True)]
-    tracks = track_on_ground(lpom, recall, separation_m, recording.frame_rate_hz, tracker)
-    tracking = clear_metrics(truth_m, [t.ids for t in tracks], [t.mean[:, :2] for t in tracks])
-    common = {"dataset": recording.name, **(label or {}), "frames": recording.frames, "views": len(recording.views)}
-    rows = [
-        {
-            "method": "lpom",
-            **common,
-            **detection_metrics(truth_m, [m.position_m for m in lpom]),
-            "fitted_min_strength": [float(value) for value in strengths],
-            "mota": tracking["mota"],
-            "motp_m": tracking["motp_m"],
-            "idf1": tracking["idf1"],
-            "switches": tracking["switches"],
-        },
+    rows.append(
         {
             "method": "clustering",
             **common,
             **detection_metrics(truth_m, [c.position_m for c in clustering]),
             "fitted_min_views": [int(value) for value in min_views],
-        },
-    ]
-    return OccupancyRun(rows, recording.frame_rate_hz, grid, frames, lpom, clustering, tracks, truth_m)
+        }
+    )
+    return OccupancyRun(rows, recording.frame_rate_hz, grid, frames, kept, clustering, tracks, truth_m)

@@ -1,13 +1,14 @@
 """What the occupancy-map experiment leaves behind, per recording, each file written atomically.
 
 * ``metrics.json``: the rows (one per method);
-* ``detections.csv``: every kept detection: ``method, frame, x_m, y_m, score`` (LPOM: the mode's
-  strength; clustering: its views) and LPOM's covariance ``var_x_m2, cov_xy_m2, var_y_m2``;
-* ``tracks.csv``: the tracker's reported tracks fed by LPOM: ``frame, id, x_m, y_m``;
+* ``detections.csv``: every kept detection: ``method, frame, x_m, y_m, score`` (a map method's: the
+  mode's strength, with its covariance ``var_x_m2, cov_xy_m2, var_y_m2``; clustering: its views);
+* ``tracks.csv``: the tracker's reported tracks fed by each map method: ``method, frame, id, x_m, y_m``;
 * ``maps/frame_NNNNN.png``: the occupancy map of every ``images_every``-th frame, and
   ``occupancy.mp4``: of every frame; seen from above (x right, y up), the map in colour (scaled to
-  each frame's largest value), the truth as white circles of the 0.5 m match radius, LPOM's
-  detections as green crosses, the baseline's as cyan diamonds, the tracks' ids in yellow.
+  each frame's largest value), the truth as white circles of the 0.5 m match radius, the map
+  methods' detections as crosses (LPOM green, LPOM from silhouettes magenta, POM orange), the
+  baseline's as cyan diamonds, the ids of the tracks fed by LPOM in yellow.
 """
 
 import csv
@@ -23,7 +24,10 @@ from ptztrack.occupancy.evaluation import MATCH_RADIUS_M, OccupancyRun
 
 PICTURE_WIDTH_PX = 600
 CAPTION_PX = 28
-TRUTH_BGR, LPOM_BGR, CLUSTERING_BGR, TRACK_BGR = (255, 255, 255), (60, 220, 60), (230, 200, 40), (0, 230, 255)
+TRUTH_BGR, CLUSTERING_BGR, TRACK_BGR = (255, 255, 255), (230, 200, 40), (0, 230, 255)
+# The map methods' crosses, in the order they run: green, magenta, orange.
+MAP_METHOD_BGR = ((60, 220, 60), (220, 60, 220), (0, 140, 255))
+MAP_METHOD_COLOURS = ("green", "magenta", "orange")
 
 
 def _scale(run: OccupancyRun) -> int:
@@ -53,12 +57,15 @@ def map_picture(run: OccupancyRun, frame: int, title: str) -> np.ndarray:
         cv2.circle(picture, tuple(int(value) for value in point), radius_px, TRUTH_BGR, 1, cv2.LINE_AA)
     for point in to_px(run.clustering[frame].position_m):
         cv2.drawMarker(picture, tuple(int(value) for value in point), CLUSTERING_BGR, cv2.MARKER_DIAMOND, 12, 2)
-    for point in to_px(run.lpom[frame].position_m):
-        cv2.drawMarker(picture, tuple(int(value) for value in point), LPOM_BGR, cv2.MARKER_CROSS, 14, 2)
-    tracks = run.tracks[frame]
+    for kept, colour in zip(run.kept.values(), MAP_METHOD_BGR, strict=False):
+        for point in to_px(kept[frame].position_m):
+            cv2.drawMarker(picture, tuple(int(value) for value in point), colour, cv2.MARKER_CROSS, 14, 2)
+    first = next(iter(run.kept))
+    tracks = run.tracks[first][frame]
     for track_id, point in zip(tracks.ids, to_px(tracks.mean[:, :2]), strict=True):
         cv2.putText(picture, str(track_id), (int(point[0]) + 8, int(point[1]) - 8), 0, 0.45, TRACK_BGR, 1, cv2.LINE_AA)
-    caption = f"{title}  frame {frame}   truth o   lpom +   clustering <>   tracks id"
+    crosses = ", ".join(f"{method} {name}" for method, name in zip(run.kept, MAP_METHOD_COLOURS, strict=False))
+    caption = f"{title}  frame {frame}   truth o   + {crosses}   clustering <>   {first} tracks id"
     cv2.putText(picture, caption, (6, rows * scale + 19), 0, 0.45, (255, 255, 255), 1, cv2.LINE_AA)
     return picture
 
@@ -67,9 +74,10 @@ def detections_csv(run: OccupancyRun) -> bytes:
     text = io.StringIO()
     writer = csv.writer(text, lineterminator="\n")
     writer.writerow(("method", "frame", "x_m", "y_m", "score", "var_x_m2", "cov_xy_m2", "var_y_m2"))
-    for frame, modes in enumerate(run.lpom):
-        for (x, y), strength, covariance in zip(modes.position_m, modes.strength, modes.covariance_m2, strict=True):
-            writer.writerow(("lpom", frame, x, y, strength, covariance[0, 0], covariance[0, 1], covariance[1, 1]))
+    for method, kept in run.kept.items():
+        for frame, modes in enumerate(kept):
+            for (x, y), strength, covariance in zip(modes.position_m, modes.strength, modes.covariance_m2, strict=True):
+                writer.writerow((method, frame, x, y, strength, covariance[0, 0], covariance[0, 1], covariance[1, 1]))
     for frame, clusters in enumerate(run.clustering):
         for (x, y), views in zip(clusters.position_m, clusters.views, strict=True):
             writer.writerow(("clustering", frame, x, y, views, "", "", ""))
@@ -79,11 +87,12 @@ def detections_csv(run: OccupancyRun) -> bytes:
 def tracks_csv(run: OccupancyRun) -> bytes:
     text = io.StringIO()
     writer = csv.writer(text, lineterminator="\n")
-    writer.writerow(("frame", "id", "x_m", "y_m"))
-    for frame, tracks in enumerate(run.tracks):
-        writer.writerows(
-            (frame, track_id, x, y) for track_id, (x, y) in zip(tracks.ids, tracks.mean[:, :2], strict=True)
-        )
+    writer.writerow(("method", "frame", "id", "x_m", "y_m"))
+    for method, method_tracks in run.tracks.items():
+        for frame, tracks in enumerate(method_tracks):
+            writer.writerows(
+                (method, frame, track_id, x, y) for track_id, (x, y) in zip(tracks.ids, tracks.mean[:, :2], strict=True)
+            )
     return text.getvalue().encode()
 
 
@@ -95,7 +104,7 @@ def write_occupancy_outputs(directory: Path, run: OccupancyRun, images_every: in
     write_json(directory / "metrics.json", run.rows)
     write_atomically(directory / "detections.csv", detections_csv(run))
     write_atomically(directory / "tracks.csv", tracks_csv(run))
-    frames = len(run.lpom)
+    frames = len(run.clustering)
     for frame in range(0, frames, images_every):
         ok, png = cv2.imencode(".png", map_picture(run, frame, title))
         write_atomically(directory / "maps" / f"frame_{frame:05d}.png", png.tobytes())

@@ -86,6 +86,7 @@ class PomParameters:
     min_probability: float = 0.5
 
 
+@dataclass(frozen=True)
 class ForegroundParameters:
     """A fixed view's background model and the clean-up of its foreground (:mod:`ptztrack.occupancy.foreground`).
 

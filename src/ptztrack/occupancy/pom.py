@@ -61,9 +61,10 @@ import numpy as np
 from scipy.special import expit
 
 from ptztrack.geometry.calibration import PinholeCalibration, project_pinhole
+from ptztrack.occupancy.foreground import ViewForeground
 from ptztrack.occupancy.lpom import GroundGrid, Modes, map_modes
 from ptztrack.occupancy.multiview import CameraView, MultiViewRecording
-from ptztrack.occupancy.parameters import PomParameters
+from ptztrack.occupancy.parameters import ForegroundParameters, PomParameters
 
 Q_FLOOR = 1e-9
 RIM_POINTS = (
@@ -74,6 +75,9 @@ MIN_DEPTH_M = 0.01  # a person's point closer to the camera's plane than this: n
 # The signs of a rectangle's corners (top-left, top-right, bottom-left, bottom-right) in a 2-D
 # difference array (and in an integral image's box sum).
 CORNER_SIGNS = np.array([1.0, -1.0, -1.0, 1.0])
+
+
+BOX_CHUNK_CELLS = 1024
 
 
 def person_box_px(calibration: PinholeCalibration, ground_m, height_m: float, width_m: float) -> np.ndarray:
@@ -89,12 +93,17 @@ def person_box_px(calibration: PinholeCalibration, ground_m, height_m: float, wi
     ring = 0.5 * width_m * np.stack([np.cos(angle), np.sin(angle), np.zeros_like(angle)], axis=-1)
     levels = np.linspace(0.0, height_m, RIM_LEVELS)[:, None, None] * np.array([0.0, 0.0, 1.0])
     offsets_m = (ring[None, :, :] + levels).reshape(-1, 3)  # (RIM_LEVELS * RIM_POINTS, 3)
-    feet_m = np.concatenate([ground_m, np.zeros((len(ground_m), 1))], axis=-1)
-    points_m = feet_m[:, None, :] + offsets_m[None, :, :]
-    depth_m = (points_m @ calibration.R.T + calibration.t / 1000.0)[..., 2]
-    pixels = project_pinhole(calibration, 1000.0 * points_m.reshape(-1, 3)).reshape(len(ground_m), -1, 2)
-    box = np.concatenate([pixels.min(axis=1), pixels.max(axis=1)], axis=-1)
-    return np.where(np.all(depth_m > MIN_DEPTH_M, axis=1)[:, None], box, np.nan)
+    boxes = np.empty((len(ground_m), 4))
+    # In chunks of cells: a large area's points would otherwise take gigabytes at once.
+    for start in range(0, len(ground_m), BOX_CHUNK_CELLS):
+        chunk = ground_m[start : start + BOX_CHUNK_CELLS]
+        feet_m = np.concatenate([chunk, np.zeros((len(chunk), 1))], axis=-1)
+        points_m = feet_m[:, None, :] + offsets_m[None, :, :]
+        depth_m = (points_m @ calibration.R.T + calibration.t / 1000.0)[..., 2]
+        pixels = project_pinhole(calibration, 1000.0 * points_m.reshape(-1, 3)).reshape(len(chunk), -1, 2)
+        box = np.concatenate([pixels.min(axis=1), pixels.max(axis=1)], axis=-1)
+        boxes[start : start + len(chunk)] = np.where(np.all(depth_m > MIN_DEPTH_M, axis=1)[:, None], box, np.nan)
+    return boxes
 
 
 def covered_span(low, high) -> tuple[np.ndarray, np.ndarray]:
@@ -341,12 +350,21 @@ class PomDetector:
     """The POM and its candidates for frames of ``recording`` (``detect(frame, masks)``).
 
     The cells' rectangles (:func:`person_boxes`) are computed on construction, for every view; each
-    view needs its image size. A view's mask at a frame is the one given, else the union of its
-    detector's boxes (:func:`boxes_mask`); a view with neither is left out of that frame.
+    view needs its image size. A view's mask at a frame is the one given, else, with ``foreground``,
+    the silhouettes of its own background model where it has video
+    (:class:`~ptztrack.occupancy.foreground.ViewForeground`, learned online on the frames before),
+    else the union of its detector's boxes (:func:`boxes_mask`); a view with none is left out.
     """
 
-    def __init__(self, recording: MultiViewRecording, parameters: PomParameters):
+    def __init__(
+        self, recording: MultiViewRecording, parameters: PomParameters, foreground: ForegroundParameters | None = None
+    ):
         self.recording, self.parameters = recording, parameters
+        self.foreground = {
+            index: ViewForeground(view.frames, foreground)
+            for index, view in enumerate(recording.views)
+            if foreground is not None and view.frames is not None
+        }
         self.grid = GroundGrid.covering(recording.area_m, parameters.cell_m)
         for view in recording.views:
             if view.image_size_px is None:
@@ -363,8 +381,11 @@ class PomDetector:
 
     def view_masks(self, frame: int, masks: Sequence[np.ndarray | None] | None = None) -> list[np.ndarray | None]:
         """Per view, its working mask at ``frame``: from ``masks`` (full-resolution, per view, None where
-        not given) or from its boxes; None where it has neither."""
-        given = list(masks) if masks is not None else [None] * len(self.recording.views)
+        not given), its silhouettes or its boxes; None where it has none."""
+        given: list[np.ndarray | None] = list(masks) if masks is not None else [None] * len(self.recording.views)
+        for index, model in self.foreground.items():
+            if given[index] is None:
+                given[index] = model.silhouettes(frame)
         working: list[np.ndarray | None] = []
         for view, mask in zip(self.recording.views, given, strict=True):
             if mask is None and view.boxes is not None:
