@@ -14,7 +14,7 @@ import os
 import sys
 
 from ptztrack.cli.arguments import parser
-from ptztrack.cli.interrupt import catch_interrupts, raise_if_interrupted
+from ptztrack.cli.interrupt import catch_interrupts
 from ptztrack.files import InputError, check_output_file, check_output_folder
 
 __all__ = ["main", "parser", "check_outputs"]
@@ -41,9 +41,7 @@ def main(argv: list[str] | None = None) -> int:
         args = parser().parse_args(argv)
         check_outputs(args)
         module, _, function = args.handler.partition(":")
-        status = getattr(importlib.import_module(module), function)(args)
-        raise_if_interrupted()
-        return status
+        return getattr(importlib.import_module(module), function)(args)
     except (InputError, RuntimeError) as error:
         print(f"ptztrack: error: {error}", file=sys.stderr)
         return 2

@@ -3,8 +3,9 @@
 Python raises KeyboardInterrupt where the signal arrives. Inside Numba's compiler, which runs while a
 run warms up, that is unsafe: in a ctypes callback the exception is printed and dropped (the command
 would go on to its end), elsewhere it can leave LLVM's objects half-built (a double free at exit).
-So the handler records the signal, raises at once only outside the compiler, and the steps of a long
-command ask :func:`raise_if_interrupted`.
+So the handler records the signal, raises at once only outside the compiler, and the steps of a run
+ask :func:`raise_if_interrupted`. A command that ends on Ctrl-C by design (a camera served until
+stopped) catches the KeyboardInterrupt itself and ends as it means to.
 """
 
 import signal
