@@ -52,7 +52,15 @@ def test_a_live_smpl_run_with_hog_at_the_recordings_pace_scores_near_the_offline
     command = [sys.executable, "-m", "ptztrack.cli", "serve-camera", "--port", "0", "--truth-log", str(log)]
     command += ["--user", USER]
     environment = {**os.environ, "PTZTRACK_CAMERA_PASSWORD": PASSWORD}
-    server = subprocess.Popen(command, stdout=subprocess.PIPE, text=True, env=environment)
+    server = subprocess.Popen(
+        command,
+        stdout=subprocess.PIPE,
+        text=True,
+        env=environment,
+        # A test run in the background of a non-interactive shell inherits SIGINT ignored: give the
+        # server the disposition a terminal gives, so that the Ctrl-C below stops it.
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
+    )
     try:
         port = int(re.search(r"onvif://127\.0\.0\.1:(\d+)", server.stdout.readline()).group(1))
         scenario = pets_scenario("hog")

@@ -60,7 +60,7 @@ def test_the_view_that_sees_nothing_is_named_among_views_that_see(tmp_path, caps
     """View_005 (720 x 576 px) sees none of an area that View_001 and View_003 see whole; View_007, which
     sees part of another, passes."""
     path = write_dataset(tmp_path, SEEN_WHOLE, views=("View_001", "View_003", "View_007"))
-    assert main(["experiment", "occupancy", str(path)]) == 0
+    assert main(["experiment", "occupancy", str(path), "--methods"]) == 0
     capsys.readouterr()
     path = write_dataset(tmp_path, "[[0, 3], [6, 8]]", views=("View_001", "View_003", "View_005"))
     assert refused(path, capsys) == (
@@ -72,7 +72,7 @@ def test_the_view_that_sees_nothing_is_named_among_views_that_see(tmp_path, caps
 def test_a_part_that_no_view_sees_is_a_warning(tmp_path, capsys, caplog):
     path = write_dataset(tmp_path, "[[-20, -15], [20, 25]]")
     with caplog.at_level(logging.WARNING):
-        assert main(["experiment", "occupancy", str(path), "--quiet"]) == 0
+        assert main(["experiment", "occupancy", str(path), "--quiet", "--methods"]) == 0
     warnings = [record.getMessage() for record in caplog.records if record.levelno >= logging.WARNING]
     assert warnings == [
         "small: 36.0% of area_m is seen by no view (all of it within x -20.0 to 20.0 m, y -15.0 to 25.0 m); "
@@ -84,20 +84,20 @@ def test_a_part_that_no_view_sees_is_a_warning(tmp_path, capsys, caplog):
 def test_an_area_seen_whole_gets_no_warning(tmp_path, caplog):
     path = write_dataset(tmp_path, SEEN_WHOLE, views=("View_001", "View_003"))
     with caplog.at_level(logging.WARNING):
-        assert main(["experiment", "occupancy", str(path), "--quiet"]) == 0
+        assert main(["experiment", "occupancy", str(path), "--quiet", "--methods"]) == 0
     assert [record.getMessage() for record in caplog.records if record.levelno >= logging.WARNING] == []
 
 
 @pytest.mark.slow
 def test_the_command_exits_2_with_the_line_and_warns_on_stderr(tmp_path):
     """As a user runs it: the refusal's exit status and line, and the warning as a line of its own."""
-    command = [sys.executable, "-m", "ptztrack.cli", "experiment", "occupancy", "--quiet"]
+    command, options = [sys.executable, "-m", "ptztrack.cli", "experiment", "occupancy"], ["--quiet", "--methods"]
     behind = write_dataset(tmp_path, BEHIND)
-    result = subprocess.run([*command, str(behind)], capture_output=True, text=True)
+    result = subprocess.run([*command, str(behind), *options], capture_output=True, text=True)
     assert result.returncode == 2
     assert result.stderr.strip().endswith("views.0 (View_001) sees none of area_m: the whole area is behind the camera")
     partly = write_dataset(tmp_path, "[[-20, -15], [20, 25]]")
-    result = subprocess.run([*command, str(partly)], capture_output=True, text=True)
+    result = subprocess.run([*command, str(partly), *options], capture_output=True, text=True)
     assert result.returncode == 0
     assert result.stderr.strip().splitlines() == [
         "ptztrack: small: 36.0% of area_m is seen by no view (all of it within x -20.0 to 20.0 m, y -15.0 to "

@@ -172,7 +172,8 @@ def test_the_synthetic_room_meets_the_papers_accuracy(tmp_path):
     """Acceptance: mean position error <= 0.08 m with 1 and with 3 people, MODA >= 90 %, over the first
     100 frames of each sequence (the detector-and-clustering baseline misses the error bound there)."""
     rows_path = tmp_path / "room.json"
-    assert main(["experiment", "occupancy", "synthetic-room", "--frames", "100", "--json", str(rows_path)]) == 0
+    command = ["experiment", "occupancy", "synthetic-room", "--frames", "100", "--methods", "--json", str(rows_path)]
+    assert main(command) == 0
     rows = json.loads(rows_path.read_text())
     lpom = {row["people"]: row for row in rows if row["method"] == "lpom"}
     assert sorted(lpom) == [1, 3] and {row["people"] for row in rows if row["method"] == "clustering"} == {1, 3}
@@ -183,10 +184,10 @@ def test_the_synthetic_room_meets_the_papers_accuracy(tmp_path):
 @pytest.mark.slow
 def test_pets_runs_with_seven_views(tmp_path):
     rows_path = tmp_path / "pets.json"
-    assert main(["experiment", "occupancy", "pets", "--frames", "60", "--json", str(rows_path)]) == 0
+    assert main(["experiment", "occupancy", "pets", "--frames", "20", "--json", str(rows_path)]) == 0
     rows = json.loads(rows_path.read_text())
     assert [row["method"] for row in rows] == ["lpom", "lpom-foreground", "pom", "clustering"]
-    assert all(row["views"] == 7 and row["frames"] == 60 for row in rows) and "mota" in rows[0]
+    assert all(row["views"] == 7 and row["frames"] == 20 for row in rows) and "mota" in rows[0]
 
 
 def test_the_example_dataset_file_is_the_built_in_pets_dataset():

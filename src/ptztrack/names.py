@@ -29,6 +29,8 @@ OTB_TRACKS = 5
 ROOM_FRAMES = 300
 """Frames of each synthetic-room sequence of the occupancy experiment."""
 PLAZA_FRAMES = 200
+# The occupancy experiment's methods beside LPOM and the clustering baseline, which always run.
+OCCUPANCY_MAP_METHODS = ("lpom-foreground", "pom")
 """Frames of each synthetic-plaza sequence of the occupancy experiment (20 s at PETS's 10 Hz)."""
 EXECUTORS = ("local", "ray", "serial")
 """Where an experiment's cells run (:mod:`ptztrack.evaluate.executors`)."""

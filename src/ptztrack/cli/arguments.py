@@ -13,6 +13,7 @@ from ptztrack import registry
 from ptztrack.names import (
     EXECUTORS,
     FOLLOW_TRACKERS,
+    OCCUPANCY_MAP_METHODS,
     OTB_TRACKS,
     PASSWORD_VARIABLE,
     PLAZA_FRAMES,
@@ -272,6 +273,14 @@ def _add_occupancy_parser(experiments) -> None:
     )
     occupancy.add_argument(
         "--seed", type=_non_negative_int, default=0, help="synthetic-room, synthetic-plaza: draws people and textures"
+    )
+    occupancy.add_argument(
+        "--methods",
+        nargs="*",
+        choices=OCCUPANCY_MAP_METHODS,
+        default=list(OCCUPANCY_MAP_METHODS),
+        help="the methods to run beside LPOM and the clustering baseline (default: both; none: neither; "
+        "lpom-foreground needs a view with video, pom every view's image size)",
     )
     occupancy.add_argument(
         "--out", type=Path, help="directory for maps, video, detections and tracks per recording; written whole"

@@ -14,12 +14,12 @@ from ptztrack.occupancy.output import write_occupancy_outputs
 def occupancy_experiment_command(args: argparse.Namespace) -> int:
     with Progress("frame", args.quiet) as progress:
         if args.dataset == "synthetic-room":
-            runs = room_runs(args.frames or ROOM_FRAMES, args.seed, progress)
+            runs = room_runs(args.frames or ROOM_FRAMES, args.seed, progress, args.methods)
         elif args.dataset == "synthetic-plaza":
-            runs = plaza_runs(args.frames or PLAZA_FRAMES, args.seed, progress)
+            runs = plaza_runs(args.frames or PLAZA_FRAMES, args.seed, progress, args.methods)
         else:
             dataset = pets_dataset() if args.dataset == "pets" else load_dataset(args.dataset)
-            runs = dataset_runs(dataset, args.frames, progress)
+            runs = dataset_runs(dataset, args.frames, progress, args.methods)
     rows = [row for run in runs for row in run.rows]
     print(format_occupancy_table(args.dataset, rows))
     written = []

@@ -8,7 +8,7 @@ detectors over every frame (:func:`run_recording`); its rows, one per method, ar
 :func:`format_occupancy_table`.
 """
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 
 from ptztrack.builders.occupancy import (
     plaza_recording,
@@ -18,6 +18,7 @@ from ptztrack.builders.occupancy import (
 )
 from ptztrack.builders.parameters import parameters_from
 from ptztrack.config import MultiViewDataset, Occupancy, OccupancyTracker, Tracker, pets_dataset
+from ptztrack.names import OCCUPANCY_MAP_METHODS
 from ptztrack.occupancy.detectors import ClusteringDetector, LpomDetector, LpomForegroundDetector, lpom_parameters
 from ptztrack.occupancy.evaluation import MapDetector, OccupancyRun, detect_frames, score_recording
 from ptztrack.occupancy.multiview import MultiViewRecording
@@ -51,10 +52,12 @@ def run_recording(
     tracker: Tracker,
     label: dict | None = None,
     progress: Callable[[int, int], None] | None = None,
+    methods: Sequence[str] = OCCUPANCY_MAP_METHODS,
 ) -> OccupancyRun:
     """Every method over every frame of ``recording``, scored (the recording needs ground truth): LPOM
     from motion edges (the paper's), LPOM from foreground silhouettes (where a view has video), POM
-    (where every view's image size is known) and the clustering baseline."""
+    (where every view's image size is known), the last two where ``methods`` names them, and the
+    clustering baseline."""
     if recording.truth is None:
         raise DatasetError(f"{recording.name}: the experiment needs ground truth (ground_truth)")
     settings = parameters_from(occupancy, OccupancyParameters)
@@ -62,9 +65,9 @@ def run_recording(
     refuse_if_tables_too_large(recording, parameters)
     lpom = LpomDetector(recording, parameters)
     maps: dict[str, MapDetector] = {"lpom": lpom}
-    if any(view.frames is not None for view in recording.views):
+    if "lpom-foreground" in methods and any(view.frames is not None for view in recording.views):
         maps["lpom-foreground"] = LpomForegroundDetector(recording, parameters, ForegroundParameters(), lpom.tables)
-    if all(view.image_size_px is not None for view in recording.views):
+    if "pom" in methods and all(view.image_size_px is not None for view in recording.views):
         maps["pom"] = PomDetector(recording, PomParameters(), ForegroundParameters())
     clustering = ClusteringDetector(recording, settings.linkage_m, settings.min_box_score, settings.blob_min_area_px)
     frames = detect_frames(recording, maps, clustering, progress)
@@ -73,30 +76,46 @@ def run_recording(
     return score_recording(recording, lpom.grid, frames, tracking, occupancy.separation_m, label)
 
 
-def dataset_runs(dataset: MultiViewDataset, frames: int | None, progress=None) -> list[OccupancyRun]:
+def dataset_runs(
+    dataset: MultiViewDataset, frames: int | None, progress=None, methods: Sequence[str] = OCCUPANCY_MAP_METHODS
+) -> list[OccupancyRun]:
     """The dataset's recording (:func:`ptztrack.builders.occupancy.recording_from_dataset`, ``frames`` as
     there), its own parameters."""
     recording = recording_from_dataset(dataset, frames)
-    return [run_recording(recording, dataset.occupancy, dataset.tracker, None, progress)]
+    return [run_recording(recording, dataset.occupancy, dataset.tracker, None, progress, methods)]
 
 
-def room_runs(frames: int, seed: int, progress=None) -> list[OccupancyRun]:
+def room_runs(
+    frames: int, seed: int, progress=None, methods: Sequence[str] = OCCUPANCY_MAP_METHODS
+) -> list[OccupancyRun]:
     """The synthetic room with 1 and with 3 people (seeds ``seed`` and ``seed + 1``), default parameters."""
     return [
         run_recording(
-            room_recording(people, frames, seed + index), Occupancy(), OccupancyTracker(), {"people": people}, progress
+            room_recording(people, frames, seed + index),
+            Occupancy(),
+            OccupancyTracker(),
+            {"people": people},
+            progress,
+            methods,
         )
         for index, people in enumerate(ROOM_PEOPLE)
     ]
 
 
-def plaza_runs(frames: int, seed: int, progress=None) -> list[OccupancyRun]:
+def plaza_runs(
+    frames: int, seed: int, progress=None, methods: Sequence[str] = OCCUPANCY_MAP_METHODS
+) -> list[OccupancyRun]:
     """The synthetic plaza with 4 and with 8 people (seeds ``seed`` and ``seed + 1``), with the built-in
     PETS dataset's parameters (its cells and kernel, its tracker), so that its rows compare with PETS's."""
     pets = pets_dataset()
     return [
         run_recording(
-            plaza_recording(people, frames, seed + index), pets.occupancy, pets.tracker, {"people": people}, progress
+            plaza_recording(people, frames, seed + index),
+            pets.occupancy,
+            pets.tracker,
+            {"people": people},
+            progress,
+            methods,
         )
         for index, people in enumerate(PLAZA_PEOPLE)
     ]
