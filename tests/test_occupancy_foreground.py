@@ -5,7 +5,7 @@ from scipy.spatial.distance import pdist
 
 from ptztrack.builders.occupancy import room_recording
 from ptztrack.occupancy.detectors import LpomForegroundDetector, lpom_parameters
-from ptztrack.occupancy.foreground import ViewForeground, clean_silhouettes, silhouette_edges
+from ptztrack.occupancy.foreground import ViewForeground, clean_silhouettes, silhouette_edges, view_foregrounds
 from ptztrack.occupancy.parameters import ForegroundParameters, OccupancyParameters
 from ptztrack.occupancy.render import draw_people
 from ptztrack.occupancy.room import RoomLayout, RoomRenderer, room_truth
@@ -125,7 +125,9 @@ def test_the_same_frames_give_the_same_masks_whatever_the_order_and_the_thread_c
 
 def test_lpom_from_the_silhouettes_finds_the_rooms_people_within_a_quarter_metre():
     recording = room_recording(people=3, frames=FRAMES, seed=SEED)
-    detector = LpomForegroundDetector(recording, lpom_parameters(OccupancyParameters()), ForegroundParameters())
+    detector = LpomForegroundDetector(
+        recording, lpom_parameters(OccupancyParameters()), view_foregrounds(recording, ForegroundParameters())
+    )
     assert len(detector.detect(0)[1]) == 0  # no background yet, no evidence
     for frame in range(1, FRAMES):
         pom, modes = detector.detect(frame)

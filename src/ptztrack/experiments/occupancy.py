@@ -21,6 +21,7 @@ from ptztrack.config import MultiViewDataset, Occupancy, OccupancyTracker, Track
 from ptztrack.names import OCCUPANCY_MAP_METHODS
 from ptztrack.occupancy.detectors import ClusteringDetector, LpomDetector, LpomForegroundDetector, lpom_parameters
 from ptztrack.occupancy.evaluation import MapDetector, OccupancyRun, detect_frames, score_recording
+from ptztrack.occupancy.foreground import view_foregrounds
 from ptztrack.occupancy.multiview import MultiViewRecording
 from ptztrack.occupancy.parameters import ForegroundParameters, OccupancyParameters, PomParameters
 from ptztrack.occupancy.pom import PomDetector
@@ -65,10 +66,12 @@ def run_recording(
     refuse_if_tables_too_large(recording, parameters)
     lpom = LpomDetector(recording, parameters)
     maps: dict[str, MapDetector] = {"lpom": lpom}
+    # One background model per view with video, shared: each frame's silhouettes are made once.
+    foregrounds = view_foregrounds(recording, ForegroundParameters())
     if "lpom-foreground" in methods and any(view.frames is not None for view in recording.views):
-        maps["lpom-foreground"] = LpomForegroundDetector(recording, parameters, ForegroundParameters(), lpom.tables)
+        maps["lpom-foreground"] = LpomForegroundDetector(recording, parameters, foregrounds, lpom.tables)
     if "pom" in methods and all(view.image_size_px is not None for view in recording.views):
-        maps["pom"] = PomDetector(recording, PomParameters(), ForegroundParameters())
+        maps["pom"] = PomDetector(recording, PomParameters(), foregrounds)
     clustering = ClusteringDetector(recording, settings.linkage_m, settings.min_box_score, settings.blob_min_area_px)
     frames = detect_frames(recording, maps, clustering, progress)
     # People leave a dataset's area (and never the room's, whose tracks stay well localised).

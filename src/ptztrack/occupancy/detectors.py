@@ -32,7 +32,7 @@ from ptztrack.occupancy.lpom import (
 )
 from ptztrack.occupancy.motion_edges import MotionEdgeParameters, box_outline_points, motion_edges
 from ptztrack.occupancy.multiview import CameraView, MultiViewRecording
-from ptztrack.occupancy.parameters import ForegroundParameters, OccupancyParameters
+from ptztrack.occupancy.parameters import OccupancyParameters
 
 
 @dataclass(frozen=True)
@@ -152,7 +152,7 @@ class LpomDetector:
 class LpomForegroundDetector(LpomDetector):
     """LPOM whose video views' pixels are the edges of their foreground silhouettes, not motion edges.
 
-    Each view with video gets its own background model (:class:`~ptztrack.occupancy.foreground.ViewForeground`,
+    Each view with video has a background model (:class:`~ptztrack.occupancy.foreground.ViewForeground`,
     learned online on the frames before each), whose silhouettes' boundary pixels feed the view's loci;
     views without video give their boxes' outlines, as in :class:`LpomDetector`, and the map and its
     modes are :class:`LpomDetector`'s.
@@ -161,7 +161,8 @@ class LpomForegroundDetector(LpomDetector):
     ----------
     recording : the views, their frames or boxes.
     parameters : the map's (its ``edges``, the motion edges' settings, go unused).
-    foreground : the background models' and their clean-up.
+    foregrounds : the views' background models by view index
+        (:func:`~ptztrack.occupancy.foreground.view_foregrounds`, shared with other methods).
     tables : the locus tables of an :class:`LpomDetector` of the same recording and parameters.
     """
 
@@ -169,15 +170,11 @@ class LpomForegroundDetector(LpomDetector):
         self,
         recording: MultiViewRecording,
         parameters: LpomParameters,
-        foreground: ForegroundParameters,
+        foregrounds: dict[int, ViewForeground],
         tables: dict[int, LocusTable] | None = None,
     ):
         super().__init__(recording, parameters, tables)
-        self.foreground = {
-            index: ViewForeground(view.frames, foreground)
-            for index, view in enumerate(recording.views)
-            if view.frames is not None
-        }
+        self.foreground = foregrounds
 
     def motion_pixels(self, index: int, frame: int) -> np.ndarray | None:
         """The edges (height, width) bool of view ``index``'s silhouettes at ``frame`` (none on frame 0)."""

@@ -43,7 +43,7 @@ opening and closing are minima and maxima over fixed neighbourhoods.
 import cv2
 import numpy as np
 
-from ptztrack.occupancy.multiview import FrameSource
+from ptztrack.occupancy.multiview import FrameSource, MultiViewRecording
 from ptztrack.occupancy.parameters import ForegroundParameters
 
 FOREGROUND = 255  # MOG2's mark for a foreground pixel; shadows are 127 and background 0
@@ -153,3 +153,13 @@ class ViewForeground:
     def edges(self, frame: int) -> np.ndarray:
         """The edges of ``frame``'s silhouettes (height, width) bool: the occupancy map's pixels."""
         return silhouette_edges(self.silhouettes(frame))
+
+
+def view_foregrounds(recording: MultiViewRecording, parameters: ForegroundParameters) -> dict[int, ViewForeground]:
+    """A background model per view of ``recording`` that has video, by view index: one set that every
+    method reading silhouettes shares (each frame's masks are made once and kept)."""
+    return {
+        index: ViewForeground(view.frames, parameters)
+        for index, view in enumerate(recording.views)
+        if view.frames is not None
+    }

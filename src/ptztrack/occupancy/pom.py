@@ -64,7 +64,7 @@ from ptztrack.geometry.calibration import PinholeCalibration, project_pinhole
 from ptztrack.occupancy.foreground import ViewForeground
 from ptztrack.occupancy.lpom import GroundGrid, Modes, map_modes
 from ptztrack.occupancy.multiview import CameraView, MultiViewRecording
-from ptztrack.occupancy.parameters import ForegroundParameters, PomParameters
+from ptztrack.occupancy.parameters import PomParameters
 
 Q_FLOOR = 1e-9
 RIM_POINTS = (
@@ -350,21 +350,20 @@ class PomDetector:
     """The POM and its candidates for frames of ``recording`` (``detect(frame, masks)``).
 
     The cells' rectangles (:func:`person_boxes`) are computed on construction, for every view; each
-    view needs its image size. A view's mask at a frame is the one given, else, with ``foreground``,
-    the silhouettes of its own background model where it has video
-    (:class:`~ptztrack.occupancy.foreground.ViewForeground`, learned online on the frames before),
-    else the union of its detector's boxes (:func:`boxes_mask`); a view with none is left out.
+    view needs its image size. A view's mask at a frame is the one given, else the silhouettes of its
+    background model in ``foregrounds`` (by view index: :func:`~ptztrack.occupancy.foreground.view_foregrounds`,
+    learned online on the frames before), else the union of its detector's boxes (:func:`boxes_mask`);
+    a view with none is left out.
     """
 
     def __init__(
-        self, recording: MultiViewRecording, parameters: PomParameters, foreground: ForegroundParameters | None = None
+        self,
+        recording: MultiViewRecording,
+        parameters: PomParameters,
+        foregrounds: dict[int, ViewForeground] | None = None,
     ):
         self.recording, self.parameters = recording, parameters
-        self.foreground = {
-            index: ViewForeground(view.frames, foreground)
-            for index, view in enumerate(recording.views)
-            if foreground is not None and view.frames is not None
-        }
+        self.foreground = foregrounds or {}
         self.grid = GroundGrid.covering(recording.area_m, parameters.cell_m)
         for view in recording.views:
             if view.image_size_px is None:
