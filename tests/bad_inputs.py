@@ -232,7 +232,7 @@ def cases(scratch: Path | None) -> list[Case]:
         _dataset("dataset view calibration missing", files={"c.xml": None}),
         _dataset("dataset area behind the view", area="[[-60, -60], [-40, -40]]"),
         _dataset("dataset area outside the view's image", area="[[-40, 0], [-30, 10]]"),
-        _dataset("dataset area partly seen", area="[[-20, -15], [20, 25]]", exit_status=0),
+        _dataset("dataset area partly seen", extra=("--methods",), area="[[-20, -15], [20, 25]]", exit_status=0),
         _dataset("dataset calibration of another size", view="detections: det.txt, image_size_px: [640, 480]"),
         _dataset("detections frame 1e9", files={"det.txt": "1000000000,-1,300,200,40,100,0.9,-1,-1,-1\n"}),
         _dataset("detections a box of width 0", files={"det.txt": "1,-1,300,200,0,100,0.9,-1,-1,-1\n"}),
