@@ -14,6 +14,7 @@ from ptztrack.config import pets_dataset
 from ptztrack.geometry.calibration import in_image, load_tsai, pinhole_from_tsai, project_pinhole
 from ptztrack.occupancy.plaza import camera_centre_m, plaza_truth
 from ptztrack.occupancy.render import body_cones, draw_people, random_outfit
+from ptztrack.scene.pets import load_mot_ground_truth
 
 FRAMES = 12
 CALIBRATIONS = {view.name: view.calibration for view in pets_dataset().views}
@@ -64,7 +65,14 @@ def test_the_plaza_sees_through_petss_calibrations():
     recording = plaza_recording(people=2, frames=2, seed=0)
     assert [view.name for view in recording.views] == list(CONVERSION_PX)
     assert recording.frame_rate_hz == pets_dataset().frame_rate_hz == 10.0
-    np.testing.assert_array_equal(recording.area_m, pets_dataset().area_m)
+    # The band S2.L1's people walk in: 90 % of its annotated positions along each axis, inside its area.
+    (x0, y0), (x1, y1) = recording.area_m
+    walked_m = load_mot_ground_truth(pets_dataset().ground_truth).ground_m
+    for axis, (low, high) in enumerate([(x0, x1), (y0, y1)]):
+        inside = np.mean((walked_m[:, axis] >= low) & (walked_m[:, axis] <= high))
+        assert inside == pytest.approx(0.90, abs=0.005)
+    pets_area_m = np.asarray(pets_dataset().area_m)
+    assert np.all(recording.area_m[0] >= pets_area_m[0]) and np.all(recording.area_m[1] <= pets_area_m[1])
     for view in recording.views:
         pixels, ground_mm = tsai_ground_points(view.name)
         assert len(pixels) > 2000

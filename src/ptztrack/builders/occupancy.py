@@ -16,13 +16,16 @@ from ptztrack.occupancy.multiview import CameraView, ImageFolder, MultiViewRecor
 from ptztrack.occupancy.plaza import PlazaLayout, plaza_stage, plaza_truth
 from ptztrack.occupancy.render import SceneRenderer
 from ptztrack.occupancy.room import RoomLayout, RoomRenderer, room_truth
-from ptztrack.scene.pets import DatasetError, RecordedVideo
+from ptztrack.scene.pets import DatasetError, RecordedVideo, load_mot_ground_truth
 
 log = logging.getLogger(__name__)
 
 ROOM_AREA_M = ((0.0, 0.0), (5.0, 6.0))
 AREA_SAMPLES = 256
 """Points per side of the grid on which a dataset's area is checked against its views."""
+PLAZA_WALKED_PERCENT = 90.0
+"""The share of S2.L1's annotated positions, along each axis, inside the plaza's area (a priori: the
+band people walk in, without the few positions in the corners)."""
 # 20 s at 15 Hz per sequence (the paper's were 3.5 and 7 minutes long).
 ROOM = RoomLayout()
 
@@ -191,9 +194,19 @@ def room_recording(people: int, frames: int, seed: int, layout: RoomLayout = ROO
 
 
 def plaza_layout() -> PlazaLayout:
-    """The plaza on the built-in PETS 2009 S2.L1 dataset's area, at its frame rate."""
+    """The plaza where the built-in PETS 2009 S2.L1 dataset's people walk, at its frame rate.
+
+    The area is the central ``PLAZA_WALKED_PERCENT`` of S2.L1's annotated ground positions along each
+    axis: its annotators marked the people View_001 sees, who walk in a band that three to seven of the
+    seven views see; the dataset's whole area reaches corners that one view sees, or none.
+    """
     pets = pets_dataset()
-    return PlazaLayout(area_m=pets.area_m, frame_rate_hz=pets.frame_rate_hz)
+    assert pets.ground_truth is not None  # the built-in dataset has its annotations
+    positions_m = load_mot_ground_truth(pets.ground_truth).ground_m
+    tail = (100.0 - PLAZA_WALKED_PERCENT) / 2
+    low_m, high_m = np.percentile(positions_m, [tail, 100.0 - tail], axis=0)
+    area_m = ((float(low_m[0]), float(low_m[1])), (float(high_m[0]), float(high_m[1])))
+    return PlazaLayout(area_m=area_m, frame_rate_hz=pets.frame_rate_hz)
 
 
 def plaza_renderer(people: int, frames: int, seed: int) -> SceneRenderer:
