@@ -218,6 +218,21 @@ def test_rectangles_snap_to_blocks_and_cells_behind_or_beside_the_camera_have_no
     assert np.all((block[:, 2:] - 0.5 < px[:, 2:]) & (block[:, 2:] + 0.5 >= px[:, 2:]))
 
 
+def test_a_lens_that_folds_back_gives_no_rectangle_to_the_cells_beyond_its_fold():
+    # k1 = -0.3: r (1 - 0.3 r^2) grows up to r = 1 / sqrt(0.9) and folds back beyond it; a person at
+    # r = 2 to the camera's side would otherwise be drawn inside the image, on the other side.
+    camera = look_at((0.0, 0.0, 2.0), (5.0, 0.0, 2.0), 200.0, (320, 240))
+    camera = replace(camera, dist=np.array([-0.3, 0.0, 0.0, 0.0, 0.0]))
+    beside_m = np.array([[2.0, 4.0]])  # 4 m to the side at 2 m ahead: r = 2
+    raw_px = project_pinhole(camera, 1000.0 * np.array([[2.0, 4.0, 1.0]]))
+    assert 0 <= raw_px[0, 0] < 320 and 0 <= raw_px[0, 1] < 240  # the polynomial's fold lands in the image
+    assert np.all(np.isnan(person_box_px(camera, beside_m, 1.75, 0.5)))
+    ahead_m = np.array([[5.0, 0.5]])
+    assert np.all(np.isfinite(person_box_px(camera, ahead_m, 1.75, 0.5)))
+    grid = GroundGrid((1.75, 3.75), 0.5, (1, 1))  # the one cell at (2.0, 4.0)
+    assert not person_boxes([(camera, (320, 240))], grid, 1.75, 0.5, block_px=4).visible.any()
+
+
 def test_a_detectors_boxes_make_a_mask_of_the_pixels_whose_centres_they_hold():
     boxes = np.array([[1.0, 2.0, 3.0, 2.0, 0.9], [5.2, 0.0, 1.0, 1.0, 0.3], [7.6, 4.4, 10.0, 10.0, 0.6]])
     mask = boxes_mask(boxes, (10, 6), min_score=0.5)

@@ -53,14 +53,15 @@ snapped to the blocks: the working resolution. A view without video gets
 the union of its detector's boxes as its mask (:func:`boxes_mask`).
 """
 
+import copy
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import cv2
 import numpy as np
 from scipy.special import expit
 
-from ptztrack.geometry.calibration import PinholeCalibration, project_pinhole
+from ptztrack.geometry.calibration import PinholeCalibration, imaged_radius, project_pinhole
 from ptztrack.occupancy.foreground import ViewForeground
 from ptztrack.occupancy.lpom import GroundGrid, Modes, map_modes
 from ptztrack.occupancy.multiview import CameraView, MultiViewRecording
@@ -86,8 +87,11 @@ def person_box_px(calibration: PinholeCalibration, ground_m, height_m: float, wi
     The person is a vertical cylinder ``height_m`` tall and ``width_m`` across, standing on the ground
     point (K, 2) m; the box bounds the projections (through the calibration, lens distortion included)
     of ``RIM_LEVELS`` circles of ``RIM_POINTS`` points from its base to its top. NaN where a point of the
-    cylinder is not in front of the camera (the projection has no bound).
+    cylinder is not in front of the camera (the projection has no bound) or lies beyond the radius where
+    the lens's distortion folds back (:func:`~ptztrack.geometry.calibration.imaged_radius`; its projection
+    would land anywhere, the image's middle included).
     """
+    folding_radius = imaged_radius(calibration)
     ground_m = np.asarray(ground_m, dtype=float).reshape(-1, 2)
     angle = np.linspace(0.0, 2 * np.pi, RIM_POINTS, endpoint=False)
     ring = 0.5 * width_m * np.stack([np.cos(angle), np.sin(angle), np.zeros_like(angle)], axis=-1)
@@ -99,10 +103,14 @@ def person_box_px(calibration: PinholeCalibration, ground_m, height_m: float, wi
         chunk = ground_m[start : start + BOX_CHUNK_CELLS]
         feet_m = np.concatenate([chunk, np.zeros((len(chunk), 1))], axis=-1)
         points_m = feet_m[:, None, :] + offsets_m[None, :, :]
-        depth_m = (points_m @ calibration.R.T + calibration.t / 1000.0)[..., 2]
+        camera_m = points_m @ calibration.R.T + calibration.t / 1000.0
+        depth_m = camera_m[..., 2]
+        ahead = depth_m > MIN_DEPTH_M
+        radius = np.hypot(camera_m[..., 0], camera_m[..., 1]) / np.where(ahead, depth_m, 1.0)
+        projected = np.all(ahead & (radius < folding_radius), axis=1)
         pixels = project_pinhole(calibration, 1000.0 * points_m.reshape(-1, 3)).reshape(len(chunk), -1, 2)
         box = np.concatenate([pixels.min(axis=1), pixels.max(axis=1)], axis=-1)
-        boxes[start : start + len(chunk)] = np.where(np.all(depth_m > MIN_DEPTH_M, axis=1)[:, None], box, np.nan)
+        boxes[start : start + len(chunk)] = np.where(projected[:, None], box, np.nan)
     return boxes
 
 
@@ -146,7 +154,10 @@ def person_boxes(
         shape = (height_px // block_px, width_px // block_px)
         box_px = person_box_px(calibration, centres_m, height_m, width_m)
         seen = ~np.isnan(box_px[:, 0])
-        box_px = np.where(seen[:, None], box_px, 0.0)
+        # Clipped to just outside the image before the blocks' integers: a strong distortion sends far
+        # points beyond int64's range.
+        limit_px = np.array([width_px, height_px, width_px, height_px]) + block_px
+        box_px = np.clip(np.where(seen[:, None], box_px, 0.0), -block_px, limit_px)
         left, right = covered_span(box_px[:, 0] / block_px, box_px[:, 2] / block_px)
         top, bottom = covered_span(box_px[:, 1] / block_px, box_px[:, 3] / block_px)
         box = np.stack(
@@ -377,6 +388,13 @@ class PomDetector:
         )
         self.solver = PomSolver(self.boxes)
         self.last: PomResult | None = None
+
+    def with_prior(self, prior: float) -> "PomDetector":
+        """This detector with another prior ``epsilon``, sharing its rectangles, solver and background models."""
+        other = copy.copy(self)
+        other.parameters = replace(self.parameters, prior=prior)
+        other.last = None
+        return other
 
     def view_masks(self, frame: int, masks: Sequence[np.ndarray | None] | None = None) -> list[np.ndarray | None]:
         """Per view, its working mask at ``frame``: from ``masks`` (full-resolution, per view, None where
