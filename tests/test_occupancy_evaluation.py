@@ -9,7 +9,7 @@ import pytest
 from ptztrack.cli import main
 from ptztrack.config import dataset_from_dict, load_dataset, pets_dataset
 from ptztrack.geometry.calibration import project_pinhole
-from ptztrack.occupancy.evaluation import detection_metrics, fitted_selection, halves, track_on_ground
+from ptztrack.occupancy.evaluation import detection_metrics, fitted_prior, fitted_selection, halves, track_on_ground
 from ptztrack.occupancy.lpom import Modes
 from ptztrack.occupancy.room import RoomLayout, RoomRenderer, room_truth
 from test_track_ground import PARAMETERS as GROUND_TRACKER
@@ -31,13 +31,21 @@ def test_detection_metrics_count_matches_within_the_radius_one_to_one():
     assert metrics["error_m"] == pytest.approx(0.1)
 
 
+def test_poms_prior_is_the_mean_share_of_occupied_cells_in_the_fitting_frames():
+    truth = np.full((4, 3, 2), np.nan)
+    truth[0, :2] = truth[1, :1] = truth[2, :3] = 1.0  # 2, 1, 3 and 0 people: 1.5 a frame
+    assert fitted_prior(truth, cells=100) == pytest.approx(0.015)
+    # Nobody at all: one person over the frames, not a prior of 0 (no cell could ever be occupied).
+    assert fitted_prior(np.full((4, 3, 2), np.nan), cells=100) == pytest.approx(0.25 / 100)
+
+
 def test_each_half_is_scored_with_the_threshold_fitted_on_the_other():
     truth = np.zeros((4, 1, 2))
     positions = [np.array([[0.0, 0.0], [2.0, 2.0]])] * 4
     # First half: the ghost is weaker than the person; second half: stronger. Fitting on the second half
     # keeps everything up to its person's 0.3 (and the first half's ghost at 0.2 is kept too).
     scores = [np.array([0.9, 0.2]), np.array([0.9, 0.2]), np.array([0.3, 0.5]), np.array([0.3, 0.5])]
-    kept, fitted, recall = fitted_selection(truth, scores, positions, (0.1, 0.25, 0.4, 0.6))
+    kept, fitted, recall = fitted_selection(truth, [scores] * 2, [positions] * 2, (0.1, 0.25, 0.4, 0.6))
     assert fitted == [0.1, 0.25]
     np.testing.assert_array_equal(recall, [1.0, 1.0, 1.0, 1.0])  # each half's threshold finds the person
     assert [k.tolist() for k in kept] == [[True, True], [True, True], [True, True], [True, True]]

@@ -20,7 +20,15 @@ from ptztrack.builders.parameters import parameters_from
 from ptztrack.config import MultiViewDataset, Occupancy, OccupancyTracker, Tracker, pets_dataset
 from ptztrack.names import OCCUPANCY_MAP_METHODS
 from ptztrack.occupancy.detectors import ClusteringDetector, LpomDetector, LpomForegroundDetector, lpom_parameters
-from ptztrack.occupancy.evaluation import MapDetector, OccupancyRun, detect_frames, score_recording
+from ptztrack.occupancy.evaluation import (
+    MapDetector,
+    OccupancyRun,
+    detect_frames,
+    fitted_prior,
+    halves,
+    score_recording,
+    scored_truth,
+)
 from ptztrack.occupancy.foreground import view_foregrounds
 from ptztrack.occupancy.multiview import MultiViewRecording
 from ptztrack.occupancy.parameters import ForegroundParameters, OccupancyParameters, PomParameters
@@ -65,18 +73,26 @@ def run_recording(
     parameters = lpom_parameters(settings)
     refuse_if_tables_too_large(recording, parameters)
     lpom = LpomDetector(recording, parameters)
-    maps: dict[str, MapDetector] = {"lpom": lpom}
+    maps: dict[str, Sequence[MapDetector]] = {"lpom": [lpom]}
     # One background model per view with video, shared: each frame's silhouettes are made once.
     foregrounds = view_foregrounds(recording, ForegroundParameters())
     if "lpom-foreground" in methods and any(view.frames is not None for view in recording.views):
-        maps["lpom-foreground"] = LpomForegroundDetector(recording, parameters, foregrounds, lpom.tables)
+        maps["lpom-foreground"] = [LpomForegroundDetector(recording, parameters, foregrounds, lpom.tables)]
+    priors: list[float] = []
     if "pom" in methods and all(view.image_size_px is not None for view in recording.views):
-        maps["pom"] = PomDetector(recording, PomParameters(), foregrounds)
+        pom = PomDetector(recording, PomParameters(), foregrounds)
+        truth_m = scored_truth(recording)
+        priors = [fitted_prior(truth_m[fitting], pom.grid.cells) for _, fitting in halves(recording.frames)]
+        maps["pom"] = [pom.with_prior(prior) for prior in priors]
     clustering = ClusteringDetector(recording, settings.linkage_m, settings.min_box_score, settings.blob_min_area_px)
     frames = detect_frames(recording, maps, clustering, progress)
     # People leave a dataset's area (and never the room's, whose tracks stay well localised).
     tracking = parameters_from(tracker, TrackerParameters)
-    return score_recording(recording, lpom.grid, frames, tracking, occupancy.separation_m, label)
+    run = score_recording(recording, lpom.grid, frames, tracking, occupancy.separation_m, label)
+    for row in run.rows:
+        if row["method"] == "pom":
+            row["fitted_prior"] = priors
+    return run
 
 
 def dataset_runs(

@@ -7,7 +7,10 @@ second half, each half is scored with the threshold that gives the best
 MODA on the other half (two-fold cross-validation; a recording too short to
 split is scored with the threshold fitted on itself, and the rows say so).
 LPOM's threshold is a mode's strength (its value over the frame's largest);
-the baseline's is the number of views that must support a cluster.
+the baseline's is the number of views that must support a cluster. POM has
+a second parameter fitted the same way, its prior (:func:`fitted_prior`):
+each half is detected with the prior of the other half's people, and scored
+with the threshold fitted on the other half detected with that same prior.
 
 Detection is scored as in the multi-view detection literature (MVDet,
 WILDTRACK): per frame, detections and people are matched one to one by the
@@ -22,7 +25,7 @@ by MOTA, MOTP and IDF1 (:func:`ptztrack.evaluate.metrics.clear_metrics`,
 1 m gate).
 """
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Protocol
 
@@ -92,10 +95,11 @@ def scored_truth(recording: MultiViewRecording) -> np.ndarray:
 class Frames:
     """What the detectors found in every frame: the first map method's occupancy maps as (rows, columns)
     uint8 (scaled to each frame's largest value, for pictures), every map method's candidate modes (by
-    method, in the order run) and the baseline's clusters."""
+    method, in the order run; per :func:`halves` pair, the modes of every frame by the detector that
+    pair uses, the same list for every pair where a method has one detector) and the baseline's clusters."""
 
     maps_u8: list[np.ndarray]
-    modes: dict[str, list[Modes]]
+    modes: dict[str, list[list[Modes]]]
     clusters: list[Clusters]
 
 
@@ -107,25 +111,29 @@ class MapDetector(Protocol):
 
 def detect_frames(
     recording: MultiViewRecording,
-    maps: dict[str, MapDetector],
+    maps: dict[str, Sequence[MapDetector]],
     clustering: ClusteringDetector,
     progress: Callable[[int, int], None] | None = None,
 ) -> Frames:
-    """Run every detector over every frame, in order; ``maps`` by method, the first one's maps kept."""
+    """Run every detector over every frame, in order; ``maps`` by method, one detector for every
+    :func:`halves` pair or one for each pair (in their order); the first detector's maps are kept."""
+    pairs = len(halves(recording.frames))
     maps_u8: list[np.ndarray] = []
-    modes: dict[str, list[Modes]] = {method: [] for method in maps}
+    found_by: dict[str, list[list[Modes]]] = {method: [[] for _ in detectors] for method, detectors in maps.items()}
     clusters = []
     for frame in range(recording.frames):
-        for index, (method, detector) in enumerate(maps.items()):
-            occupancy, found = detector.detect(frame)
-            if index == 0:
-                peak = occupancy.max(initial=0.0)
-                scaled = np.round(255 * occupancy / peak) if peak > 0 else np.zeros(occupancy.shape)
-                maps_u8.append(scaled.astype(np.uint8))
-            modes[method].append(found)
+        for index, (method, detectors) in enumerate(maps.items()):
+            for detector, found in zip(detectors, found_by[method], strict=True):
+                occupancy, modes = detector.detect(frame)
+                if index == 0 and detector is detectors[0]:
+                    peak = occupancy.max(initial=0.0)
+                    scaled = np.round(255 * occupancy / peak) if peak > 0 else np.zeros(occupancy.shape)
+                    maps_u8.append(scaled.astype(np.uint8))
+                found.append(modes)
         clusters.append(clustering.detect(frame))
         if progress is not None:
             progress(frame + 1, recording.frames)
+    modes = {method: found * pairs if len(found) == 1 else found for method, found in found_by.items()}
     return Frames(maps_u8, modes, clusters)
 
 
@@ -139,20 +147,32 @@ def halves(frames: int) -> list[tuple[np.ndarray, np.ndarray]]:
     return [(first, second), (second, first)]
 
 
+def fitted_prior(truth_m, cells: int) -> float:
+    """POM's prior (``epsilon``, :mod:`ptztrack.occupancy.pom`) from annotated frames: the mean number of
+    people per frame in truth (T, N, 2) m (NaN: absent or outside the area) over the grid's ``cells``,
+    the expected share of occupied cells; at least one person over the frames, so never 0."""
+    people = np.sum(~np.isnan(np.asarray(truth_m)[..., 0])) / max(len(truth_m), 1)
+    return float(max(people, 1.0 / max(len(truth_m), 1)) / cells)
+
+
 def fitted_selection(
-    truth_m, scores: list[np.ndarray], positions: list[np.ndarray], choices
+    truth_m, scores: Sequence[list[np.ndarray]], positions: Sequence[list[np.ndarray]], choices
 ) -> tuple[list, list, np.ndarray]:
     """Per frame, the detections whose score reaches the threshold fitted on the other half's frames.
 
-    scores, positions : per frame, (K_t,) and (K_t, 2). choices : thresholds to try (the first of the
-    best is taken). Returns the kept positions per frame, the fitted threshold of each half, and per
-    frame (T,) the recall at that threshold on the frames it was fitted on (what the tracker may
-    assume of the detector: it is not measured on the frames it is used for).
+    scores, positions : per :func:`halves` pair, per frame, (K_t,) and (K_t, 2): the detections of
+    the detector that pair uses (one detector's lists repeated where they are the same). choices :
+    thresholds to try (the first of the best is taken). Returns the kept positions per frame, the
+    fitted threshold of each half, and per frame (T,) the recall at that threshold on the frames it
+    was fitted on (what the tracker may assume of the detector: it is not measured on the frames it
+    is used for).
     """
-    kept: list = [None] * len(scores)
+    frames = len(truth_m)
+    kept: list = [None] * frames
     fitted = []
-    recall = np.zeros(len(scores))
-    for scored, fitting in halves(len(scores)):
+    recall = np.zeros(frames)
+    for (scored, fitting), scores_used, positions_used in zip(halves(frames), scores, positions, strict=True):
+        scores, positions = scores_used, positions_used
         figures = [
             detection_metrics(truth_m[fitting], [positions[f][scores[f] >= choice] for f in fitting])
             for choice in choices
@@ -209,6 +229,15 @@ class OccupancyRun:
     truth_m: np.ndarray
 
 
+def _used_modes(modes_by_pair: list[list[Modes]], frames: int) -> list[Modes]:
+    """Per frame, the modes of the detector its :func:`halves` pair scores it with."""
+    used: list = [None] * frames
+    for (scored, _), modes in zip(halves(frames), modes_by_pair, strict=True):
+        for frame in scored:
+            used[frame] = modes[frame]
+    return used
+
+
 def score_recording(
     recording: MultiViewRecording,
     grid: GroundGrid,
@@ -225,11 +254,15 @@ def score_recording(
     truth_m = scored_truth(recording)
     common = {"dataset": recording.name, **(label or {}), "frames": recording.frames, "views": len(recording.views)}
     rows, kept, tracks = [], {}, {}
-    for method, modes in frames.modes.items():
+    for method, modes_by_pair in frames.modes.items():
         kept_modes, strengths, recall = fitted_selection(
-            truth_m, [m.strength for m in modes], [m.position_m for m in modes], STRENGTH_CHOICES
+            truth_m,
+            [[m.strength for m in modes] for modes in modes_by_pair],
+            [[m.position_m for m in modes] for modes in modes_by_pair],
+            STRENGTH_CHOICES,
         )
-        kept[method] = [found.select(keep) for found, keep in zip(modes, kept_modes, strict=True)]
+        used = _used_modes(modes_by_pair, truth_m.shape[0])
+        kept[method] = [found.select(keep) for found, keep in zip(used, kept_modes, strict=True)]
         tracks[method] = track_on_ground(kept[method], recall, separation_m, recording.frame_rate_hz, tracker)
         tracking = clear_metrics(truth_m, [t.ids for t in tracks[method]], [t.mean[:, :2] for t in tracks[method]])
         rows.append(
@@ -245,8 +278,9 @@ def score_recording(
             }
         )
     views = tuple(range(1, len(recording.views) + 1))
+    pairs = len(halves(recording.frames))
     kept_clusters, min_views, _ = fitted_selection(
-        truth_m, [c.views for c in frames.clusters], [c.position_m for c in frames.clusters], views
+        truth_m, [[c.views for c in frames.clusters]] * pairs, [[c.position_m for c in frames.clusters]] * pairs, views
     )
     clustering = [found.select(keep) for found, keep in zip(frames.clusters, kept_clusters, strict=True)]
     rows.append(
