@@ -65,9 +65,13 @@ class PomParameters:
     Boxes: a detector's boxes with a score of at least min_box_score make a view's mask
     (OccupancyParameters.min_box_score). Candidates: a cell is a candidate when its q is the largest
     within separation_m and at least candidate_probability; its position is the q-weighted mean over
-    window_m (separation_m and window_m as OccupancyParameters'; candidate_probability 0.02, below the
-    smallest threshold the experiment's fit tries, 0.05, as LPOM's candidates). min_probability: the
-    detections' q, 0.5 (more likely there than not), where no threshold is fitted.
+    window_m. The paper reads people off the cells' q themselves: the posterior's explaining away
+    already keeps one person from lighting two cells, so separation_m only merges the cells around
+    one, its 8 neighbours, 0.375 m (1.5 cells); LPOM's 0.5 m would take the second of two people
+    0.6 m apart, whose cells' centres can be 0.5 m apart, for the first's. window_m as
+    OccupancyParameters'; candidate_probability 0.02, below the smallest threshold the experiment's
+    fit tries, 0.05, as LPOM's candidates. min_probability: the detections' q, 0.5 (more likely there
+    than not), where no threshold is fitted.
     """
 
     prior: float = 0.01
@@ -80,7 +84,7 @@ class PomParameters:
     max_iterations: int = 100
     tolerance: float = 1e-4
     min_box_score: float = 0.5
-    separation_m: float = 0.5
+    separation_m: float = 0.375
     window_m: float = 0.25
     candidate_probability: float = 0.02
     min_probability: float = 0.5
