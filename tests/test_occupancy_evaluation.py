@@ -8,6 +8,7 @@ import pytest
 
 from ptztrack.cli import main
 from ptztrack.config import dataset_from_dict, load_dataset, pets_dataset
+from ptztrack.experiments.occupancy import format_occupancy_table
 from ptztrack.geometry.calibration import project_pinhole
 from ptztrack.occupancy.evaluation import detection_metrics, fitted_selection, halves, track_on_ground
 from ptztrack.occupancy.lpom import Modes
@@ -29,6 +30,20 @@ def test_detection_metrics_count_matches_within_the_radius_one_to_one():
     assert metrics["modp"] == pytest.approx(1 - 0.1 / 0.5)
     assert metrics["precision"] == pytest.approx(1 / 3) and metrics["recall"] == pytest.approx(1 / 3)
     assert metrics["error_m"] == pytest.approx(0.1)
+
+
+def test_a_figure_without_a_value_is_shown_as_n_a_never_nan():
+    """No match makes MODP and the mean error undefined; the clustering row has no tracking figures."""
+    nothing_matched = detection_metrics(np.array([[[0.0, 0.0]]]), [np.array([[9.0, 9.0]])])
+    rows = [
+        {"method": "lpom", "dataset": "d", **nothing_matched, "mota": -1.0, "motp_m": NAN, "idf1": 0.0},
+        {"method": "clustering", "dataset": "d", **nothing_matched},
+    ]
+    table = format_occupancy_table("d", rows)
+    lpom, clustering = table.splitlines()[2:4]
+    assert lpom.split() == ["lpom", "-100.0%", "n/a", "0.0%", "0.0%", "n/a", "-100.0%", "n/a", "0.0%"]
+    assert clustering.split() == ["clustering", "-100.0%", "n/a", "0.0%", "0.0%", "n/a"]
+    assert "nan" not in table
 
 
 def test_each_half_is_scored_with_the_threshold_fitted_on_the_other():

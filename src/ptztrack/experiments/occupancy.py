@@ -8,6 +8,7 @@ detectors over every frame (:func:`run_recording`); its rows, one per method, ar
 :func:`format_occupancy_table`.
 """
 
+import math
 from collections.abc import Callable, Sequence
 
 from ptztrack.builders.occupancy import (
@@ -134,7 +135,7 @@ def format_occupancy_table(dataset: str, rows: list[dict]) -> str:
         "  ".join(f"{key:>{width if key == 'method' else 10}}" for key, _ in columns),
     ]
     for row in rows:
-        cells = (form.format(row[key]) if key in row else "" for key, form in columns)
+        cells = (_shown(row.get(key), form) for key, form in columns)
         lines.append(
             "  ".join(
                 f"{cell:>{width if key == 'method' else 10}}" for cell, (key, _) in zip(cells, columns, strict=True)
@@ -146,3 +147,11 @@ def format_occupancy_table(dataset: str, rows: list[dict]) -> str:
             f"{row['dataset']} {row['method']}: {fitted} (each half of the frames scored with the other's fit)"
         )
     return "\n".join(lines)
+
+
+def _shown(value, form: str) -> str:
+    """A table cell: empty where the row has no such figure, "n/a" where the figure is undefined (NaN:
+    MODP and the mean error without a match, MODA and recall without a person to find)."""
+    if value is None:
+        return ""
+    return "n/a" if isinstance(value, float) and math.isnan(value) else form.format(value)
