@@ -36,6 +36,7 @@ class Case:
     argv: tuple[str, ...]
     files: dict[str, bytes | str | None] = field(default_factory=dict)  # None: no such file
     exit_status: int = 2
+    says: tuple[str, ...] = ()  # what the line must name (the field, the file, the bound)
 
 
 def _scenario(name: str, text: str | bytes, *extra: str, exit_status: int = 2) -> Case:
@@ -105,6 +106,7 @@ def _dataset(
     extra: tuple = (),
     exit_status: int = 2,
     area: str = "[[-12, -13], [-3, -5]]",
+    says: tuple[str, ...] = (),
 ) -> Case:
     """A one-view PETS dataset file (``view``: the view's fields besides its name and calibration;
     ``top``: more top-level lines), its calibration, two frames of detections and the first
@@ -116,7 +118,9 @@ def _dataset(
     )
     given = {"d.yaml": document, "c.xml": TSAI, "det.txt": "\n".join(DETECTION_ROWS) + "\n"}
     given["gt.txt"] = _ground_truth([row for row in GROUND_TRUTH_ROWS if row.split(",")[0] in ("1", "2")])
-    return Case(name, ("experiment", "occupancy", "{dir}/d.yaml", *extra), {**given, **(files or {})}, exit_status)
+    return Case(
+        name, ("experiment", "occupancy", "{dir}/d.yaml", *extra), {**given, **(files or {})}, exit_status, says
+    )
 
 
 @functools.cache
@@ -257,6 +261,11 @@ def cases(scratch: Path | None) -> list[Case]:
         Case("view: a file, not a folder", ("view", "{dir}/f"), {"f": "keep me\n"}),
         Case("view: a line that is not a state", ("view", "{dir}/run"), {"run/view_states.jsonl": '{"step": 0}\n'}),
         Case("view: --steps-per-s 0", ("view", "{dir}", "--steps-per-s", "0")),
+        Case(
+            "occupancy --frames 1e6",
+            ("experiment", "occupancy", "synthetic-room", "--frames", "1000000"),
+            says=("--frames", "at most 100000"),
+        ),
         _dataset("occupancy --out not empty", files={"out/keep.txt": "keep me\n"}, extra=("--out", "{dir}/out")),
     ]
 
