@@ -231,6 +231,17 @@ def cases(scratch: Path | None) -> list[Case]:
         _dataset("dataset duplicate keys", top="frame_rate_hz: 15\n"),
         _dataset("dataset frames 1e9", top="frames: 1000000000\n"),
         _dataset("dataset cell_m 1e-5", top="occupancy: {cell_m: 0.00001}\n"),
+        _dataset(
+            "dataset cell_m 1000 on a 40 m area",
+            top="occupancy: {cell_m: 1000}\n",
+            area="[[-20, -15], [20, 25]]",
+            says=("occupancy.cell_m 1000 m makes 1 x 1 cells", "at most occupancy.separation_m (0.5 m)"),
+        ),
+        _dataset(
+            "dataset canny_low above canny_high",
+            top="occupancy: {canny_low: 200}\n",
+            says=("occupancy: canny_low (200) must be at most canny_high (150)",),
+        ),
         _dataset("dataset samples 1e9", top="occupancy: {samples_per_height: 1000000000}\n"),
         _dataset("dataset view without evidence", view="weight: 1"),
         _dataset("dataset view calibration missing", files={"c.xml": None}),
