@@ -238,6 +238,22 @@ def cases(scratch: Path | None) -> list[Case]:
             says=("occupancy.cell_m 1000 m makes 1 x 1 cells", "at most occupancy.separation_m (0.5 m)"),
         ),
         _dataset(
+            "dataset window_m 1000",
+            top="occupancy: {window_m: 1000}\n",
+            says=("occupancy.window_m 1000 m's windows of 40001 x 40001 cells", "GB available"),
+        ),
+        _dataset(
+            "dataset window_m 300",
+            top="occupancy: {window_m: 300}\n",
+            says=("occupancy.window_m 300 m's windows", "GB available"),
+        ),
+        _dataset("dataset separation_m 1000", top="occupancy: {separation_m: 1000}\n", says=("separation_m 1000 m",)),
+        _dataset(
+            "dataset kernel_sigma_m 1000",
+            top="occupancy: {kernel_sigma_m: 1000}\n",
+            says=("occupancy.kernel_sigma_m 1000 m's smoothing", "at most 2 s"),
+        ),
+        _dataset(
             "dataset canny_low above canny_high",
             top="occupancy: {canny_low: 200}\n",
             says=("occupancy: canny_low (200) must be at most canny_high (150)",),

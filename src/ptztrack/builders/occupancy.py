@@ -4,14 +4,16 @@
 import functools
 import logging
 from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-import psutil
 
+from ptztrack.builders.budget import available_memory_bytes
 from ptztrack.config import MAX_DATASET_FRAMES, DatasetView, MultiViewDataset, pets_dataset
 from ptztrack.geometry.calibration import PinholeCalibration, in_image, load_pinhole, load_tsai, pinhole_from_tsai
 from ptztrack.occupancy.detectors import LpomParameters
+from ptztrack.occupancy.lpom import GroundGrid, disc_reach, kernel_reach, most_modes
 from ptztrack.occupancy.multiview import CameraView, ImageFolder, MultiViewRecording, load_mot_detections, mot_truth
 from ptztrack.occupancy.plaza import PlazaLayout, plaza_stage, plaza_truth
 from ptztrack.occupancy.render import SceneRenderer
@@ -20,6 +22,19 @@ from ptztrack.scene.pets import DatasetError, RecordedVideo
 
 log = logging.getLogger(__name__)
 
+# What the occupancy map's parts cost, measured on this code (maps of 180 to 1500 cells a side):
+# SciPy's Gaussian filter per cell and kernel tap, both passes counted (0.23-0.37 ns with long
+# kernels); its maximum filter per cell and cell of the separation disc's square (0.38-0.48 ns);
+# map_modes' windows per mode and cell of a window's square (110-250 ns, 52-80 bytes); building a
+# disc: two int64 offset grids, their float64 distances and a bool per cell of its square.
+SMOOTHING_S_PER_CELL_TAP = 0.4e-9
+MAXIMA_S_PER_CELL_OFFSET = 0.5e-9
+WINDOW_S_PER_MODE_CELL = 250e-9
+WINDOW_BYTES_PER_MODE_CELL = 80.0
+DISC_BYTES_PER_CELL = 25.0
+FRAME_S_MAX = 2.0
+"""The longest a frame's map and its modes may take: SciPy's filters and NumPy's sums see Ctrl-C only
+once they end, and a recording has hundreds of frames."""
 ROOM_AREA_M = ((0.0, 0.0), (5.0, 6.0))
 AREA_SAMPLES = 256
 """Points per side of the grid on which a dataset's area is checked against its views."""
@@ -41,17 +56,97 @@ def locus_table_bytes(recording: MultiViewRecording, parameters: LpomParameters)
     return 8.0 * points_per_block * blocks
 
 
-def refuse_if_tables_too_large(
+@dataclass(frozen=True)
+class Cost:
+    """What one part of the occupancy map costs: ``amount`` (bytes or seconds), ``what`` it is, and
+    which parameters make it ``smaller``."""
+
+    amount: float
+    what: str
+    smaller: str
+
+
+def memory_costs(recording: MultiViewRecording, parameters: LpomParameters) -> list[Cost]:
+    """The occupancy map's estimated peak memory over ``recording``, in bytes, by part."""
+    grid = GroundGrid.covering(recording.area_m, parameters.cell_m)
+    separation = 2 * disc_reach(parameters.separation_m, parameters.cell_m) + 1
+    window = 2 * disc_reach(parameters.window_m, parameters.cell_m) + 1
+    modes = most_modes(grid, parameters.separation_m)
+    return [
+        Cost(
+            locus_table_bytes(recording, parameters),
+            "the locus tables",
+            "make occupancy.block_px larger or samples_per_height smaller",
+        ),
+        Cost(
+            float(recording.frames * grid.cells),
+            f"the maps of {recording.frames} frames of {grid.cells} cells, kept",
+            "use fewer frames or a larger occupancy.cell_m",
+        ),
+        Cost(
+            DISC_BYTES_PER_CELL * separation**2,
+            f"occupancy.separation_m {parameters.separation_m:g} m's disc of {separation} x {separation} cells",
+            "make separation_m smaller or cell_m larger",
+        ),
+        Cost(
+            (DISC_BYTES_PER_CELL + WINDOW_BYTES_PER_MODE_CELL * modes) * window**2,
+            f"occupancy.window_m {parameters.window_m:g} m's windows of {window} x {window} cells, for up to "
+            f"{modes} modes",
+            "make window_m smaller or cell_m larger",
+        ),
+    ]
+
+
+def frame_costs(recording: MultiViewRecording, parameters: LpomParameters) -> list[Cost]:
+    """The estimated time of a frame's map and its modes over ``recording``, in seconds, by part."""
+    grid = GroundGrid.covering(recording.area_m, parameters.cell_m)
+    taps = 2 * kernel_reach(parameters.kernel_sigma_m, parameters.cell_m) + 1
+    separation = 2 * disc_reach(parameters.separation_m, parameters.cell_m) + 1
+    window = 2 * disc_reach(parameters.window_m, parameters.cell_m) + 1
+    modes = most_modes(grid, parameters.separation_m)
+    return [
+        Cost(
+            SMOOTHING_S_PER_CELL_TAP * grid.cells * 2 * taps,
+            f"occupancy.kernel_sigma_m {parameters.kernel_sigma_m:g} m's smoothing, a kernel of {taps} cells a side",
+            "make kernel_sigma_m smaller or cell_m larger",
+        ),
+        Cost(
+            MAXIMA_S_PER_CELL_OFFSET * grid.cells * separation**2,
+            f"occupancy.separation_m {parameters.separation_m:g} m's maxima over {separation} x {separation} cells",
+            "make separation_m smaller or cell_m larger",
+        ),
+        Cost(
+            WINDOW_S_PER_MODE_CELL * modes * window**2,
+            f"occupancy.window_m {parameters.window_m:g} m's windows of {window} x {window} cells, for up to "
+            f"{modes} modes",
+            "make window_m smaller or cell_m larger",
+        ),
+    ]
+
+
+def refuse_if_map_too_large(
     recording: MultiViewRecording, parameters: LpomParameters, available_bytes: float | None = None
 ) -> None:
-    """A :class:`DatasetError` before the tables are built if they would not fit in the memory available
-    (``available_bytes``, by default what the machine has free now)."""
-    needed = locus_table_bytes(recording, parameters)
-    available = psutil.virtual_memory().available if available_bytes is None else available_bytes
+    """A :class:`DatasetError` before any work if the occupancy map over ``recording`` would need more
+    memory than is available (``available_bytes``, by default what the machine has free now,
+    :func:`memory_costs`) or a frame would take longer than ``FRAME_S_MAX`` (:func:`frame_costs`);
+    the line names the largest part and the parameters that make it smaller."""
+    memory = memory_costs(recording, parameters)
+    needed = sum(cost.amount for cost in memory)
+    available = available_memory_bytes() if available_bytes is None else available_bytes
     if needed > available:
+        largest = max(memory, key=lambda cost: cost.amount)
         raise DatasetError(
-            f"{recording.name}: the locus tables need an estimated {needed / 1e9:.3g} GB, more than the "
-            f"{available / 1e9:.3g} GB available; make occupancy.block_px larger or samples_per_height smaller"
+            f"{recording.name}: the occupancy map needs an estimated {needed / 1e9:.3g} GB, more than the "
+            f"{available / 1e9:.3g} GB available, most of it for {largest.what}: {largest.smaller}"
+        )
+    frame = frame_costs(recording, parameters)
+    seconds = sum(cost.amount for cost in frame)
+    if seconds > FRAME_S_MAX:
+        largest = max(frame, key=lambda cost: cost.amount)
+        raise DatasetError(
+            f"{recording.name}: a frame's occupancy map would take an estimated {seconds:.3g} s, at most "
+            f"{FRAME_S_MAX:g} s (Ctrl-C waits for it), most of it for {largest.what}: {largest.smaller}"
         )
 
 

@@ -14,7 +14,7 @@ from collections.abc import Callable, Sequence
 from ptztrack.builders.occupancy import (
     plaza_recording,
     recording_from_dataset,
-    refuse_if_tables_too_large,
+    refuse_if_map_too_large,
     room_recording,
 )
 from ptztrack.builders.parameters import parameters_from
@@ -64,7 +64,7 @@ def run_recording(
         raise DatasetError(f"{recording.name}: the experiment needs ground truth (ground_truth)")
     settings = parameters_from(occupancy, OccupancyParameters)
     parameters = lpom_parameters(settings)
-    refuse_if_tables_too_large(recording, parameters)
+    refuse_if_map_too_large(recording, parameters)
     lpom = LpomDetector(recording, parameters)
     maps: dict[str, MapDetector] = {"lpom": lpom}
     # One background model per view with video, shared: each frame's silhouettes are made once.
