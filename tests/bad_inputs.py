@@ -45,9 +45,11 @@ def _scenario(name: str, text: str | bytes, *extra: str, exit_status: int = 2) -
     return Case(name, ("run", "--scenario", "{dir}/s.yaml", *steps, *extra), {"s.yaml": text}, exit_status)
 
 
-def _recording(name: str, option: str, filename: str, content: bytes | str, *extra: str) -> Case:
+def _recording(
+    name: str, option: str, filename: str, content: bytes | str, *extra: str, says: tuple[str, ...] = ()
+) -> Case:
     argv = ("run", "--scenario", "pets", *A_FEW_STEPS, option, f"{{dir}}/{filename}", *extra)
-    return Case(name, argv, {filename: content})
+    return Case(name, argv, {filename: content}, says=says)
 
 
 def _ground_truth(rows: list[str]) -> str:
@@ -95,6 +97,7 @@ XML_LAUGHS = '<!ENTITY a "aaaaaaaaaa">' + "".join(
 )
 
 
+FIRST_TWO_FRAMES = [row for row in GROUND_TRUTH_ROWS if row.split(",")[0] in ("1", "2")]
 DETECTION_ROWS = ["1,-1,300,200,40,100,0.9,-1,-1,-1", "2,-1,302,201,40,100,0.9,-1,-1,-1"]
 
 
@@ -117,7 +120,7 @@ def _dataset(
         f"views:\n  - {{name: View_001, calibration: c.xml, {view}}}\n{top}"
     )
     given = {"d.yaml": document, "c.xml": TSAI, "det.txt": "\n".join(DETECTION_ROWS) + "\n"}
-    given["gt.txt"] = _ground_truth([row for row in GROUND_TRUTH_ROWS if row.split(",")[0] in ("1", "2")])
+    given["gt.txt"] = _ground_truth(FIRST_TWO_FRAMES)
     return Case(
         name, ("experiment", "occupancy", "{dir}/d.yaml", *extra), {**given, **(files or {})}, exit_status, says
     )
@@ -222,6 +225,15 @@ def cases(scratch: Path | None) -> list[Case]:
         _scenario("NaN frame rate", "frame_rate_hz: .nan\n"),
         _scenario("bad pose error", "camera: {pose_error: {pan_tilt_sigma_deg: .inf}}\n"),
         _recording("ground truth empty", "--gt", "gt.txt", ""),
+        _recording(
+            "ground truth beyond the video",
+            "--gt",
+            "gt.txt",
+            _ground_truth([*truth, _with_field(truth[0], 0, "99999999")]),
+            "--frames",
+            "3",
+            says=(f"gt.txt: line {len(truth) + 1}: frame 99999999 is beyond the 795 frames of", "View_001.avi"),
+        ),
         _recording("ground truth negative frame", "--gt", "gt.txt", _ground_truth([_with_field(truth[0], 0, "-3")])),
         _recording("calibration empty", "--calibration", "c.json", ""),
         _recording("calibration binary", "--calibration", "c.xml", b"\x00\xff" * 50),
@@ -265,6 +277,21 @@ def cases(scratch: Path | None) -> list[Case]:
         _dataset("dataset area outside the view's image", area="[[-40, 0], [-30, 10]]"),
         _dataset("dataset area partly seen", extra=("--methods",), area="[[-20, -15], [20, 25]]", exit_status=0),
         _dataset("dataset calibration of another size", view="detections: det.txt, image_size_px: [640, 480]"),
+        _dataset(
+            "dataset ground truth frame 99999999",
+            files={"gt.txt": _ground_truth([*FIRST_TWO_FRAMES, _with_field(truth[0], 0, "99999999")])},
+            extra=("--frames", "2"),
+            says=(f"gt.txt: line {len(FIRST_TWO_FRAMES) + 1}: frame 99999999 is beyond the 100000 frames",),
+        ),
+        _dataset(
+            "dataset ground truth beyond the video",
+            view="video: v.avi",
+            files={
+                "v.avi": video_bytes(3, (768, 576), scratch),
+                "gt.txt": _ground_truth([*FIRST_TWO_FRAMES, _with_field(truth[0], 0, "5")]),
+            },
+            says=(f"gt.txt: line {len(FIRST_TWO_FRAMES) + 1}: frame 5 is beyond the 3 frames of the views' videos",),
+        ),
         _dataset("detections frame 1e9", files={"det.txt": "1000000000,-1,300,200,40,100,0.9,-1,-1,-1\n"}),
         _dataset("detections a box of width 0", files={"det.txt": "1,-1,300,200,0,100,0.9,-1,-1,-1\n"}),
         _dataset("detections 9 fields", files={"det.txt": "1,-1,300,200,40,100,0.9,-1,-1\n"}),

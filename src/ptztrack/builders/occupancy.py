@@ -18,7 +18,7 @@ from ptztrack.occupancy.multiview import CameraView, ImageFolder, MultiViewRecor
 from ptztrack.occupancy.plaza import PlazaLayout, plaza_stage, plaza_truth
 from ptztrack.occupancy.render import SceneRenderer
 from ptztrack.occupancy.room import RoomLayout, RoomRenderer, room_truth
-from ptztrack.scene.pets import DatasetError, RecordedVideo
+from ptztrack.scene.pets import DatasetError, RecordedVideo, load_mot_ground_truth, refuse_rows_beyond
 
 log = logging.getLogger(__name__)
 
@@ -229,7 +229,16 @@ def recording_from_dataset(dataset: MultiViewDataset, frames: int | None = None)
     )
     truth = None
     if dataset.ground_truth is not None:
-        truth = mot_truth(dataset.ground_truth, wanted, dataset.frame_rate_hz)
+        annotations = load_mot_ground_truth(dataset.ground_truth)
+        # Without a video or an image folder, the recording is as long as its annotations say.
+        recorded = available if counts else MAX_DATASET_FRAMES
+        described = (
+            f"the {available} frames of the views' videos and images"
+            if counts
+            else f"the {MAX_DATASET_FRAMES} frames a recording may have (memory)"
+        )
+        refuse_rows_beyond(dataset.ground_truth, annotations.frame, annotations.line, recorded, described)
+        truth = mot_truth(annotations, wanted, dataset.frame_rate_hz)
     # Last, after every error the files could still raise: a refused dataset gets its one line alone.
     _warn_of_unseen_area(dataset.name, area_mm, np.any(seen, axis=0))
     return MultiViewRecording(dataset.name, views, wanted, dataset.frame_rate_hz, np.asarray(dataset.area_m), truth)
