@@ -294,6 +294,11 @@ def cases(scratch: Path | None) -> list[Case]:
         ),
         _dataset("detections frame 1e9", files={"det.txt": "1000000000,-1,300,200,40,100,0.9,-1,-1,-1\n"}),
         _dataset("detections a box of width 0", files={"det.txt": "1,-1,300,200,0,100,0.9,-1,-1,-1\n"}),
+        _dataset(
+            "detections a box outside the image",
+            files={"det.txt": DETECTION_ROWS[0] + "\n" + _with_field(DETECTION_ROWS[1], 2, "5000") + "\n"},
+            says=("det.txt: line 2: the box at (5000, 201) px, 40 x 100 px, lies outside the view's 768x576 px image",),
+        ),
         _dataset("detections 9 fields", files={"det.txt": "1,-1,300,200,40,100,0.9,-1,-1\n"}),
         _dataset("detections gzip bomb", view="detections: det.txt.gz", files={"det.txt.gz": _gzip_bomb(210_000_000)}),
         _dataset(

@@ -204,7 +204,7 @@ def recording_from_dataset(dataset: MultiViewDataset, frames: int | None = None)
         if view.video is not None or view.images is not None:
             source, count, size_px = _frames(view, size_px, field)
         seen.append(_view_sees_area(view, field, calibration, size_px, area_mm))
-        boxes = None if view.detections is None else load_mot_detections(view.detections, MAX_DATASET_FRAMES)
+        boxes = None if view.detections is None else load_mot_detections(view.detections, MAX_DATASET_FRAMES, size_px)
         loaded.append((view, calibration, size_px, source, count, boxes))
     counts = [count for *_, count, _ in loaded if count is not None]
     available = min(counts) if counts else max(len(boxes) for *_, boxes in loaded if boxes is not None)

@@ -62,16 +62,28 @@ class MultiViewRecording:
     truth: GroundTruth | None
 
 
-def load_mot_detections(path: str | Path, max_frames: int) -> list[np.ndarray]:
+def load_mot_detections(
+    path: str | Path, max_frames: int, image_size_px: tuple[int, int] | None = None
+) -> list[np.ndarray]:
     """A MOTChallenge detection file (``frame,-1,left,top,width,height,score,...``, frames from 1)
     as per-frame boxes (K, 5) ``(left, top, width, height, score)``, from frame 0 to the file's last,
-    which may be at most ``max_frames``."""
+    which may be at most ``max_frames``; with the view's ``image_size_px`` (width, height), every box
+    must overlap its image."""
     table, line = read_mot_rows(path, "detection")
     frame = table[:, 0].astype(np.int64) - 1
     refuse_rows_beyond(path, frame, line, max_frames, f"the {max_frames} frames a recording may have (memory)")
     frames = int(frame.max()) + 1
     if np.any((table[:, 4] <= 0) | (table[:, 5] <= 0)):
         raise DatasetError(f"{path}: a box has a width or height that is not positive")
+    if image_size_px is not None:
+        (width_px, height_px), (left, top, width, height) = image_size_px, table[:, 2:6].T
+        outside = (left >= width_px) | (top >= height_px) | (left + width <= 0) | (top + height <= 0)
+        if outside.any():
+            first = int(np.argmax(outside))
+            raise DatasetError(
+                f"{path}: line {line[first]}: the box at ({left[first]:g}, {top[first]:g}) px, {width[first]:g} x "
+                f"{height[first]:g} px, lies outside the view's {width_px}x{height_px} px image"
+            )
     order = np.argsort(frame, kind="stable")
     boxes = table[order][:, 2:7]
     bounds = np.searchsorted(frame[order], np.arange(frames + 1))
