@@ -278,6 +278,18 @@ def cases(scratch: Path | None) -> list[Case]:
         _dataset("dataset area partly seen", extra=("--methods",), area="[[-20, -15], [20, 25]]", exit_status=0),
         _dataset("dataset calibration of another size", view="detections: det.txt, image_size_px: [640, 480]"),
         _dataset(
+            "dataset ground truth 1000 m away",
+            files={"gt.txt": _ground_truth([_with_field(row, 7, "1000") for row in FIRST_TWO_FRAMES])},
+            says=("gt.txt: no row of the 2 frames used lies in area_m [[-12, -13], [-3, -5]] (line 1: (1000, ",),
+        ),
+        _dataset(
+            "dataset ground truth partly outside the area",
+            files={"gt.txt": _ground_truth([_with_field(FIRST_TWO_FRAMES[0], 7, "1000"), *FIRST_TWO_FRAMES[1:]])},
+            extra=("--methods",),
+            exit_status=0,
+            says=(f"gt.txt: 1 of {len(FIRST_TWO_FRAMES)} rows of the 2 frames used lie outside area_m",),
+        ),
+        _dataset(
             "dataset ground truth frame 99999999",
             files={"gt.txt": _ground_truth([*FIRST_TWO_FRAMES, _with_field(truth[0], 0, "99999999")])},
             extra=("--frames", "2"),

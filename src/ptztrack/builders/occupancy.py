@@ -14,11 +14,18 @@ from ptztrack.config import MAX_DATASET_FRAMES, DatasetView, MultiViewDataset, p
 from ptztrack.geometry.calibration import PinholeCalibration, in_image, load_pinhole, load_tsai, pinhole_from_tsai
 from ptztrack.occupancy.detectors import LpomParameters
 from ptztrack.occupancy.lpom import GroundGrid, disc_reach, kernel_reach, most_modes
-from ptztrack.occupancy.multiview import CameraView, ImageFolder, MultiViewRecording, load_mot_detections, mot_truth
+from ptztrack.occupancy.multiview import (
+    CameraView,
+    ImageFolder,
+    MultiViewRecording,
+    load_mot_detections,
+    mot_truth,
+    outside_area,
+)
 from ptztrack.occupancy.plaza import PlazaLayout, plaza_stage, plaza_truth
 from ptztrack.occupancy.render import SceneRenderer
 from ptztrack.occupancy.room import RoomLayout, RoomRenderer, room_truth
-from ptztrack.scene.pets import DatasetError, RecordedVideo, load_mot_ground_truth, refuse_rows_beyond
+from ptztrack.scene.pets import Annotations, DatasetError, RecordedVideo, load_mot_ground_truth, refuse_rows_beyond
 
 log = logging.getLogger(__name__)
 
@@ -193,7 +200,8 @@ def recording_from_dataset(dataset: MultiViewDataset, frames: int | None = None)
 
     Without either, every frame that all views' videos or image folders have (or, without any, up to
     the last frame of the detection files). A view that sees none of the area is refused, and a part of
-    the area that no view sees is warned of (:func:`_view_sees_area`, :func:`_warn_of_unseen_area`).
+    the area that no view sees is warned of (:func:`_view_sees_area`, :func:`_warn_of_unseen_area`);
+    so is ground truth that lies outside the area, all of it or some (:func:`_truth_outside_area`).
     """
     loaded, seen = [], []
     area_mm = area_points_mm(dataset.area_m)
@@ -227,7 +235,7 @@ def recording_from_dataset(dataset: MultiViewDataset, frames: int | None = None)
         )
         for view, calibration, size_px, source, count, boxes in loaded
     )
-    truth = None
+    truth, truth_outside = None, None
     if dataset.ground_truth is not None:
         annotations = load_mot_ground_truth(dataset.ground_truth)
         # Without a video or an image folder, the recording is as long as its annotations say.
@@ -238,10 +246,37 @@ def recording_from_dataset(dataset: MultiViewDataset, frames: int | None = None)
             else f"the {MAX_DATASET_FRAMES} frames a recording may have (memory)"
         )
         refuse_rows_beyond(dataset.ground_truth, annotations.frame, annotations.line, recorded, described)
+        truth_outside = _truth_outside_area(dataset.ground_truth, annotations, wanted, dataset.area_m)
         truth = mot_truth(annotations, wanted, dataset.frame_rate_hz)
     # Last, after every error the files could still raise: a refused dataset gets its one line alone.
     _warn_of_unseen_area(dataset.name, area_mm, np.any(seen, axis=0))
+    if truth_outside is not None:
+        log.warning(truth_outside)
     return MultiViewRecording(dataset.name, views, wanted, dataset.frame_rate_hz, np.asarray(dataset.area_m), truth)
+
+
+def _truth_outside_area(path: str, annotations: Annotations, frames: int, area_m) -> str | None:
+    """The ground truth's rows of the first ``frames`` frames against area_m: a :class:`DatasetError`
+    if none lies in it (nothing could be scored: positions in other units or columns, or another
+    area's), else a warning line naming the rows outside it (they are not scored), or None."""
+    used = annotations.select(annotations.frame < frames)
+    assert used.line is not None  # MOTChallenge rows have lines
+    outside = outside_area(used.ground_m, area_m)
+    if not outside.any():
+        return None
+    first = int(np.argmax(outside))
+    (x_m, y_m), line = used.ground_m[first], used.line[first]
+    (x0, y0), (x1, y1) = area_m
+    area = f"area_m [[{x0:g}, {y0:g}], [{x1:g}, {y1:g}]]"
+    if outside.all():
+        raise DatasetError(
+            f"{path}: no row of the {frames} frames used lies in {area} (line {line}: ({x_m:g}, {y_m:g}) m); "
+            "expected world x, y in metres in columns 8-9"
+        )
+    return (
+        f"{path}: {outside.sum()} of {len(outside)} rows of the {frames} frames used lie outside {area} and "
+        f"are not scored (line {line}: ({x_m:g}, {y_m:g}) m)"
+    )
 
 
 def area_points_mm(area_m) -> np.ndarray:

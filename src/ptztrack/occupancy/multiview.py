@@ -62,6 +62,16 @@ class MultiViewRecording:
     truth: GroundTruth | None
 
 
+def outside_area(points_m, area_m) -> np.ndarray:
+    """Which ground points (..., 2) m lie outside area_m [[x0, y0], [x1, y1]] (its edges are inside):
+    (...,) bool, False for NaN (an absent person)."""
+    points_m = np.asarray(points_m, dtype=float)
+    (x0, y0), (x1, y1) = area_m
+    with np.errstate(invalid="ignore"):
+        x_m, y_m = points_m[..., 0], points_m[..., 1]
+        return (x_m < x0) | (x_m > x1) | (y_m < y0) | (y_m > y1)
+
+
 def load_mot_detections(
     path: str | Path, max_frames: int, image_size_px: tuple[int, int] | None = None
 ) -> list[np.ndarray]:
