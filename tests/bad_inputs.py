@@ -9,6 +9,7 @@ fresh process (:func:`run_case`).
 
 import functools
 import gzip
+import json
 import os
 import subprocess
 import sys
@@ -97,6 +98,19 @@ XML_LAUGHS = '<!ENTITY a "aaaaaaaaaa">' + "".join(
 )
 
 
+def _pinhole_with_k_scaled(scale: float) -> str:
+    """PETS's pinhole calibrations with View_001's focal lengths and principal point scaled."""
+    views = json.loads(PINHOLE)
+    views["View_001"]["K"] = (np.diag([scale, scale, 1.0]) @ np.asarray(views["View_001"]["K"])).tolist()
+    return json.dumps(views)
+
+
+def _detections_of(rows: list[str]) -> str:
+    """Detection rows that are the ground-truth rows' View_001 boxes."""
+    return "".join(f"{','.join(row.split(',')[:1] + ['-1'] + row.split(',')[2:6])},1,-1,-1,-1\n" for row in rows)
+
+
+FIRST_TEN_FRAMES = [row for row in GROUND_TRUTH_ROWS if int(row.split(",")[0]) <= 10]
 FIRST_TWO_FRAMES = [row for row in GROUND_TRUTH_ROWS if row.split(",")[0] in ("1", "2")]
 DETECTION_ROWS = ["1,-1,300,200,40,100,0.9,-1,-1,-1", "2,-1,302,201,40,100,0.9,-1,-1,-1"]
 
@@ -110,14 +124,16 @@ def _dataset(
     exit_status: int = 2,
     area: str = "[[-12, -13], [-3, -5]]",
     says: tuple[str, ...] = (),
+    calibration: str = "c.xml",
 ) -> Case:
     """A one-view PETS dataset file (``view``: the view's fields besides its name and calibration;
     ``top``: more top-level lines), its calibration, two frames of detections and the first
     ground-truth rows; run by ``experiment occupancy``. ``area``: its area_m, by default one that
-    View_001 sees whole and that holds those rows' people."""
+    View_001 sees whole and that holds those rows' people; ``calibration``: the view's file (c.xml, the
+    Tsai XML, is always written); ``says``: as :class:`Case`'s."""
     document = (
         f"frame_rate_hz: 10\narea_m: {area}\nground_truth: gt.txt\n"
-        f"views:\n  - {{name: View_001, calibration: c.xml, {view}}}\n{top}"
+        f"views:\n  - {{name: View_001, calibration: {calibration}, {view}}}\n{top}"
     )
     given = {"d.yaml": document, "c.xml": TSAI, "det.txt": "\n".join(DETECTION_ROWS) + "\n"}
     given["gt.txt"] = _ground_truth(FIRST_TWO_FRAMES)
@@ -288,6 +304,19 @@ def cases(scratch: Path | None) -> list[Case]:
             extra=("--methods",),
             exit_status=0,
             says=(f"gt.txt: 1 of {len(FIRST_TWO_FRAMES)} rows of the 2 frames used lie outside area_m",),
+        ),
+        _dataset(
+            "dataset calibration with K halved",
+            view="image_size_px: [768, 576], detections: det.txt",
+            calibration="c.json",
+            files={
+                "c.json": _pinhole_with_k_scaled(0.5),
+                "det.txt": _detections_of(FIRST_TEN_FRAMES),
+                "gt.txt": _ground_truth(FIRST_TEN_FRAMES),
+            },
+            extra=("--methods",),
+            exit_status=0,
+            says=("c.json: views.0 (View_001): the ground truth projects a median", "is this the view's calibration?"),
         ),
         _dataset(
             "dataset ground truth frame 99999999",

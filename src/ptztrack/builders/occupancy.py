@@ -8,10 +8,18 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from scipy.spatial.distance import cdist
 
 from ptztrack.builders.budget import available_memory_bytes
 from ptztrack.config import MAX_DATASET_FRAMES, DatasetView, MultiViewDataset, pets_dataset
-from ptztrack.geometry.calibration import PinholeCalibration, in_image, load_pinhole, load_tsai, pinhole_from_tsai
+from ptztrack.geometry.calibration import (
+    PinholeCalibration,
+    in_image,
+    load_pinhole,
+    load_tsai,
+    pinhole_from_tsai,
+    project_pinhole,
+)
 from ptztrack.occupancy.detectors import LpomParameters
 from ptztrack.occupancy.lpom import GroundGrid, disc_reach, kernel_reach, most_modes
 from ptztrack.occupancy.multiview import (
@@ -42,6 +50,15 @@ DISC_BYTES_PER_CELL = 25.0
 FRAME_S_MAX = 2.0
 """The longest a frame's map and its modes may take: SciPy's filters and NumPy's sums see Ctrl-C only
 once they end, and a recording has hundreds of frames."""
+FIT_BOX_HEIGHTS = 0.5
+"""The median distance, in box heights, from a person's ground truth projected into a view to the
+nearest of the view's detections, beyond which the calibration is taken not to fit the view: PETS
+2009 S2.L1's seven views, 0.05 to 0.12 with their calibrations, 0.96 to 3.1 with K halved or doubled."""
+FIT_FRAMES = 100
+"""The frames that check looks at: people enough for a median, at a cost that does not grow with the
+recording."""
+FIT_PEOPLE = 20
+"""The fewest projected people that median is taken over."""
 ROOM_AREA_M = ((0.0, 0.0), (5.0, 6.0))
 AREA_SAMPLES = 256
 """Points per side of the grid on which a dataset's area is checked against its views."""
@@ -201,7 +218,8 @@ def recording_from_dataset(dataset: MultiViewDataset, frames: int | None = None)
     Without either, every frame that all views' videos or image folders have (or, without any, up to
     the last frame of the detection files). A view that sees none of the area is refused, and a part of
     the area that no view sees is warned of (:func:`_view_sees_area`, :func:`_warn_of_unseen_area`);
-    so is ground truth that lies outside the area, all of it or some (:func:`_truth_outside_area`).
+    so is ground truth that lies outside the area, all of it or some (:func:`_truth_outside_area`), and
+    a view's detections that the ground truth, projected into it, misses (:func:`_calibration_misfit`).
     """
     loaded, seen = [], []
     area_mm = area_points_mm(dataset.area_m)
@@ -235,7 +253,7 @@ def recording_from_dataset(dataset: MultiViewDataset, frames: int | None = None)
         )
         for view, calibration, size_px, source, count, boxes in loaded
     )
-    truth, truth_outside = None, None
+    truth, warnings = None, []
     if dataset.ground_truth is not None:
         annotations = load_mot_ground_truth(dataset.ground_truth)
         # Without a video or an image folder, the recording is as long as its annotations say.
@@ -246,12 +264,17 @@ def recording_from_dataset(dataset: MultiViewDataset, frames: int | None = None)
             else f"the {MAX_DATASET_FRAMES} frames a recording may have (memory)"
         )
         refuse_rows_beyond(dataset.ground_truth, annotations.frame, annotations.line, recorded, described)
-        truth_outside = _truth_outside_area(dataset.ground_truth, annotations, wanted, dataset.area_m)
+        warnings.append(_truth_outside_area(dataset.ground_truth, annotations, wanted, dataset.area_m))
+        warnings += [
+            _calibration_misfit(view, f"views.{index}", calibration, size_px, boxes, annotations, wanted)
+            for index, (view, calibration, size_px, _, _, boxes) in enumerate(loaded)
+        ]
         truth = mot_truth(annotations, wanted, dataset.frame_rate_hz)
     # Last, after every error the files could still raise: a refused dataset gets its one line alone.
     _warn_of_unseen_area(dataset.name, area_mm, np.any(seen, axis=0))
-    if truth_outside is not None:
-        log.warning(truth_outside)
+    for warning in warnings:
+        if warning is not None:
+            log.warning(warning)
     return MultiViewRecording(dataset.name, views, wanted, dataset.frame_rate_hz, np.asarray(dataset.area_m), truth)
 
 
@@ -276,6 +299,46 @@ def _truth_outside_area(path: str, annotations: Annotations, frames: int, area_m
     return (
         f"{path}: {outside.sum()} of {len(outside)} rows of the {frames} frames used lie outside {area} and "
         f"are not scored (line {line}: ({x_m:g}, {y_m:g}) m)"
+    )
+
+
+def _calibration_misfit(
+    view: DatasetView,
+    field: str,
+    calibration: PinholeCalibration,
+    size_px: tuple[int, int] | None,
+    boxes: list[np.ndarray] | None,
+    annotations: Annotations,
+    frames: int,
+) -> str | None:
+    """A warning line if the ground truth's people, projected into a view with detections and a known
+    image size, stand a median of more than ``FIT_BOX_HEIGHTS`` box heights from the nearest box's feet
+    (the bottom centre) of the same frame: the calibration, most likely, is not this view's. Over the
+    first ``FIT_FRAMES`` of the ``frames`` used, once ``FIT_PEOPLE`` people are seen; else None."""
+    if boxes is None or size_px is None:
+        return None
+    checked = min(frames, len(boxes), FIT_FRAMES)
+    points_mm = np.c_[1000.0 * annotations.ground_m, np.zeros(len(annotations.frame))]
+    seen = (annotations.frame < checked) & in_image(calibration, size_px, points_mm)
+    feet_px, frame = project_pinhole(calibration, points_mm[seen]), annotations.frame[seen]
+    misses = []
+    for index in np.unique(frame):
+        found = boxes[index]
+        if len(found):
+            box_feet_px = np.stack([found[:, 0] + found[:, 2] / 2, found[:, 1] + found[:, 3]], axis=-1)
+            distance_px = cdist(feet_px[frame == index], box_feet_px)
+            nearest = distance_px.argmin(axis=1)
+            misses.append(distance_px[np.arange(len(nearest)), nearest] / found[nearest, 3])
+    people = sum(len(miss) for miss in misses)
+    if people < FIT_PEOPLE:
+        return None
+    median = float(np.median(np.concatenate(misses)))
+    if median <= FIT_BOX_HEIGHTS:
+        return None
+    return (
+        f"{view.calibration}: {field} ({view.name}): the ground truth projects a median {median:.2g} box heights "
+        f"from the nearest detection ({people} people, first {checked} frames; expected under {FIT_BOX_HEIGHTS:g}): "
+        "is this the view's calibration?"
     )
 
 
