@@ -271,6 +271,12 @@ def cases(scratch: Path | None) -> list[Case]:
             says=("occupancy.window_m 1000 m's windows of 40001 x 40001 cells", "GB available"),
         ),
         _dataset(
+            "dataset window_m 1000 on a partly seen area",
+            top="occupancy: {window_m: 1000}\n",
+            area="[[-20, -15], [20, 25]]",
+            says=("occupancy.window_m 1000 m's windows",),
+        ),
+        _dataset(
             "dataset window_m 300",
             top="occupancy: {window_m: 300}\n",
             says=("occupancy.window_m 300 m's windows", "GB available"),

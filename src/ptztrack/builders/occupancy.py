@@ -11,6 +11,7 @@ import numpy as np
 from scipy.spatial.distance import cdist
 
 from ptztrack.builders.budget import available_memory_bytes
+from ptztrack.builders.parameters import parameters_from
 from ptztrack.config import MAX_DATASET_FRAMES, DatasetView, MultiViewDataset, pets_dataset
 from ptztrack.geometry.calibration import (
     PinholeCalibration,
@@ -20,7 +21,7 @@ from ptztrack.geometry.calibration import (
     pinhole_from_tsai,
     project_pinhole,
 )
-from ptztrack.occupancy.detectors import LpomParameters
+from ptztrack.occupancy.detectors import LpomParameters, lpom_parameters
 from ptztrack.occupancy.lpom import GroundGrid, disc_reach, kernel_reach, most_modes
 from ptztrack.occupancy.multiview import (
     CameraView,
@@ -30,6 +31,7 @@ from ptztrack.occupancy.multiview import (
     mot_truth,
     outside_area,
 )
+from ptztrack.occupancy.parameters import OccupancyParameters
 from ptztrack.occupancy.plaza import PlazaLayout, plaza_stage, plaza_truth
 from ptztrack.occupancy.render import SceneRenderer
 from ptztrack.occupancy.room import RoomLayout, RoomRenderer, room_truth
@@ -220,6 +222,7 @@ def recording_from_dataset(dataset: MultiViewDataset, frames: int | None = None)
     the area that no view sees is warned of (:func:`_view_sees_area`, :func:`_warn_of_unseen_area`);
     so is ground truth that lies outside the area, all of it or some (:func:`_truth_outside_area`), and
     a view's detections that the ground truth, projected into it, misses (:func:`_calibration_misfit`).
+    An occupancy map over it that would not fit is refused (:func:`refuse_if_map_too_large`).
     """
     loaded, seen = [], []
     area_mm = area_points_mm(dataset.area_m)
@@ -270,12 +273,16 @@ def recording_from_dataset(dataset: MultiViewDataset, frames: int | None = None)
             for index, (view, calibration, size_px, _, _, boxes) in enumerate(loaded)
         ]
         truth = mot_truth(annotations, wanted, dataset.frame_rate_hz)
-    # Last, after every error the files could still raise: a refused dataset gets its one line alone.
+    area_m = np.asarray(dataset.area_m)
+    recording = MultiViewRecording(dataset.name, views, wanted, dataset.frame_rate_hz, area_m, truth)
+    # The experiment checks the map's cost of any recording; a dataset's is checked here too, so that
+    # a refused dataset gets its one line alone: the warnings come last, after every error.
+    refuse_if_map_too_large(recording, lpom_parameters(parameters_from(dataset.occupancy, OccupancyParameters)))
     _warn_of_unseen_area(dataset.name, area_mm, np.any(seen, axis=0))
     for warning in warnings:
         if warning is not None:
             log.warning(warning)
-    return MultiViewRecording(dataset.name, views, wanted, dataset.frame_rate_hz, np.asarray(dataset.area_m), truth)
+    return recording
 
 
 def _truth_outside_area(path: str, annotations: Annotations, frames: int, area_m) -> str | None:
