@@ -35,7 +35,14 @@ from ptztrack.occupancy.parameters import OccupancyParameters
 from ptztrack.occupancy.plaza import PlazaLayout, plaza_stage, plaza_truth
 from ptztrack.occupancy.render import SceneRenderer
 from ptztrack.occupancy.room import RoomLayout, RoomRenderer, room_truth
-from ptztrack.scene.pets import Annotations, DatasetError, RecordedVideo, load_mot_ground_truth, refuse_rows_beyond
+from ptztrack.scene.pets import (
+    Annotations,
+    DatasetError,
+    RecordedVideo,
+    box_feet_px,
+    load_mot_ground_truth,
+    refuse_rows_beyond,
+)
 
 log = logging.getLogger(__name__)
 
@@ -332,8 +339,7 @@ def _calibration_misfit(
     for index in np.unique(frame):
         found = boxes[index]
         if len(found):
-            box_feet_px = np.stack([found[:, 0] + found[:, 2] / 2, found[:, 1] + found[:, 3]], axis=-1)
-            distance_px = cdist(feet_px[frame == index], box_feet_px)
+            distance_px = cdist(feet_px[frame == index], box_feet_px(found))
             nearest = distance_px.argmin(axis=1)
             misses.append(distance_px[np.arange(len(nearest)), nearest] / found[nearest, 3])
     people = sum(len(miss) for miss in misses)

@@ -43,11 +43,17 @@ class Annotations:
     @property
     def feet_px(self) -> np.ndarray:
         """(K, 2) bottom centre of each box."""
-        return np.stack([self.box_px[:, 0] + self.box_px[:, 2] / 2, self.box_px[:, 1] + self.box_px[:, 3]], axis=-1)
+        return box_feet_px(self.box_px)
 
     def select(self, keep) -> "Annotations":
         line = None if self.line is None else self.line[keep]
         return Annotations(self.frame[keep], self.person_id[keep], self.box_px[keep], self.ground_m[keep], line)
+
+
+def box_feet_px(boxes_px) -> np.ndarray:
+    """Where the people of boxes (K, 4+) px (left, top, width, height, ...) stand: their bottom centres (K, 2) px."""
+    boxes_px = np.asarray(boxes_px, dtype=float)
+    return np.stack([boxes_px[:, 0] + boxes_px[:, 2] / 2, boxes_px[:, 1] + boxes_px[:, 3]], axis=-1)
 
 
 def load_mot_ground_truth(path: str | Path) -> Annotations:
