@@ -332,9 +332,10 @@ def _calibration_misfit(
     if boxes is None or size_px is None:
         return None
     checked = min(frames, len(boxes), FIT_FRAMES)
-    points_mm = np.c_[1000.0 * annotations.ground_m, np.zeros(len(annotations.frame))]
-    seen = (annotations.frame < checked) & in_image(calibration, size_px, points_mm)
-    feet_px, frame = project_pinhole(calibration, points_mm[seen]), annotations.frame[seen]
+    early = annotations.select(annotations.frame < checked)
+    points_mm = np.c_[1000.0 * early.ground_m, np.zeros(len(early.frame))]
+    seen = in_image(calibration, size_px, points_mm)
+    feet_px, frame = project_pinhole(calibration, points_mm[seen]), early.frame[seen]
     misses = []
     for index in np.unique(frame):
         found = boxes[index]
