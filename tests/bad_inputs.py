@@ -288,6 +288,11 @@ def cases(scratch: Path | None) -> list[Case]:
             says=("occupancy.kernel_sigma_m 1000 m's smoothing", "at most 2 s"),
         ),
         _dataset(
+            "dataset outline_points_per_box 10000",
+            top="occupancy: {outline_points_per_box: 10000, samples_per_height: 1000}\n",
+            says=("box outlines (10000 points a box, 3 heights of 1000 samples)", "outline_points_per_box"),
+        ),
+        _dataset(
             "dataset canny_low above canny_high",
             top="occupancy: {canny_low: 200}\n",
             says=("occupancy: canny_low (200) must be at most canny_high (150)",),

@@ -47,10 +47,14 @@ from ptztrack.scene.pets import (
 log = logging.getLogger(__name__)
 
 # What the occupancy map's parts cost, measured on this code (maps of 180 to 1500 cells a side):
+# the loci of points off the tables' grid (a box's outline), per locus point (60-210 ns, 66-79
+# bytes: its position, weight, cell and their temporaries, all of a view's points at once);
 # SciPy's Gaussian filter per cell and kernel tap, both passes counted (0.23-0.37 ns with long
 # kernels); its maximum filter per cell and cell of the separation disc's square (0.38-0.48 ns);
 # map_modes' windows per mode and cell of a window's square (110-250 ns, 52-80 bytes); building a
 # disc: two int64 offset grids, their float64 distances and a bool per cell of its square.
+LOCUS_S_PER_POINT = 200e-9
+LOCUS_BYTES_PER_POINT = 80.0
 SMOOTHING_S_PER_CELL_TAP = 0.4e-9
 MAXIMA_S_PER_CELL_OFFSET = 0.5e-9
 WINDOW_S_PER_MODE_CELL = 250e-9
@@ -99,6 +103,29 @@ class Cost:
     smaller: str
 
 
+def outline_loci(recording: MultiViewRecording, parameters: LpomParameters) -> list[int]:
+    """Per view whose loci come from its boxes' outlines (a view without frames), the most locus points
+    a frame of it has: two per outline point (``outline_points_per_box`` per box of at least
+    ``min_box_score``), person height and tangent height."""
+    sampling = parameters.sampling
+    per_ray = 2 * len(sampling.heights_m) * sampling.samples_per_height
+    return [
+        per_ray
+        * parameters.outline_points_per_box
+        * max(int(np.sum(boxes[:, 4] >= parameters.min_box_score)) for boxes in view.boxes)
+        for view in recording.views
+        if view.frames is None and view.boxes is not None
+    ]
+
+
+def _outline_sampling(parameters: LpomParameters) -> str:
+    sampling = parameters.sampling
+    return (
+        f"{parameters.outline_points_per_box} points a box, {len(sampling.heights_m)} heights of "
+        f"{sampling.samples_per_height} samples"
+    )
+
+
 def memory_costs(recording: MultiViewRecording, parameters: LpomParameters) -> list[Cost]:
     """The occupancy map's estimated peak memory over ``recording``, in bytes, by part."""
     grid = GroundGrid.covering(recording.area_m, parameters.cell_m)
@@ -110,6 +137,11 @@ def memory_costs(recording: MultiViewRecording, parameters: LpomParameters) -> l
             locus_table_bytes(recording, parameters),
             "the locus tables",
             "make occupancy.block_px larger or samples_per_height smaller",
+        ),
+        Cost(
+            LOCUS_BYTES_PER_POINT * max(outline_loci(recording, parameters), default=0),
+            f"the loci of a frame's box outlines ({_outline_sampling(parameters)})",
+            "make occupancy.outline_points_per_box or samples_per_height smaller",
         ),
         Cost(
             float(recording.frames * grid.cells),
@@ -138,6 +170,11 @@ def frame_costs(recording: MultiViewRecording, parameters: LpomParameters) -> li
     window = 2 * disc_reach(parameters.window_m, parameters.cell_m) + 1
     modes = most_modes(grid, parameters.separation_m)
     return [
+        Cost(
+            LOCUS_S_PER_POINT * sum(outline_loci(recording, parameters)),
+            f"the loci of its box outlines ({_outline_sampling(parameters)})",
+            "make occupancy.outline_points_per_box or samples_per_height smaller",
+        ),
         Cost(
             SMOOTHING_S_PER_CELL_TAP * grid.cells * 2 * taps,
             f"occupancy.kernel_sigma_m {parameters.kernel_sigma_m:g} m's smoothing, a kernel of {taps} cells a side",
