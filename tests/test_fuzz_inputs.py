@@ -1,7 +1,7 @@
 """Fuzzing every reader: generated scenario documents, valid and near-valid, and mutations of every
 file format. Whatever the input, the result is a value or one clean :class:`InputError` line,
-never another exception. Derandomised, so that a run is repeatable; the examples per test are in
-``EXAMPLES``.
+never another exception; a small dataset file goes through the command itself, which exits 0, or 2
+with one line. Derandomised, so that a run is repeatable; the examples per test are in ``EXAMPLES``.
 """
 
 import gzip
