@@ -9,6 +9,7 @@ fresh process (:func:`run_case`).
 
 import functools
 import gzip
+import json
 import os
 import subprocess
 import sys
@@ -36,6 +37,7 @@ class Case:
     argv: tuple[str, ...]
     files: dict[str, bytes | str | None] = field(default_factory=dict)  # None: no such file
     exit_status: int = 2
+    says: tuple[str, ...] = ()  # what the line must name (the field, the file, the bound)
 
 
 def _scenario(name: str, text: str | bytes, *extra: str, exit_status: int = 2) -> Case:
@@ -44,9 +46,11 @@ def _scenario(name: str, text: str | bytes, *extra: str, exit_status: int = 2) -
     return Case(name, ("run", "--scenario", "{dir}/s.yaml", *steps, *extra), {"s.yaml": text}, exit_status)
 
 
-def _recording(name: str, option: str, filename: str, content: bytes | str, *extra: str) -> Case:
+def _recording(
+    name: str, option: str, filename: str, content: bytes | str, *extra: str, says: tuple[str, ...] = ()
+) -> Case:
     argv = ("run", "--scenario", "pets", *A_FEW_STEPS, option, f"{{dir}}/{filename}", *extra)
-    return Case(name, argv, {filename: content})
+    return Case(name, argv, {filename: content}, says=says)
 
 
 def _ground_truth(rows: list[str]) -> str:
@@ -94,6 +98,20 @@ XML_LAUGHS = '<!ENTITY a "aaaaaaaaaa">' + "".join(
 )
 
 
+def _pinhole_with_k_scaled(scale: float) -> str:
+    """PETS's pinhole calibrations with View_001's focal lengths and principal point scaled."""
+    views = json.loads(PINHOLE)
+    views["View_001"]["K"] = (np.diag([scale, scale, 1.0]) @ np.asarray(views["View_001"]["K"])).tolist()
+    return json.dumps(views)
+
+
+def _detections_of(rows: list[str]) -> str:
+    """Detection rows that are the ground-truth rows' View_001 boxes."""
+    return "".join(f"{','.join(row.split(',')[:1] + ['-1'] + row.split(',')[2:6])},1,-1,-1,-1\n" for row in rows)
+
+
+FIRST_TEN_FRAMES = [row for row in GROUND_TRUTH_ROWS if int(row.split(",")[0]) <= 10]
+FIRST_TWO_FRAMES = [row for row in GROUND_TRUTH_ROWS if row.split(",")[0] in ("1", "2")]
 DETECTION_ROWS = ["1,-1,300,200,40,100,0.9,-1,-1,-1", "2,-1,302,201,40,100,0.9,-1,-1,-1"]
 
 
@@ -105,18 +123,23 @@ def _dataset(
     extra: tuple = (),
     exit_status: int = 2,
     area: str = "[[-12, -13], [-3, -5]]",
+    says: tuple[str, ...] = (),
+    calibration: str = "c.xml",
 ) -> Case:
     """A one-view PETS dataset file (``view``: the view's fields besides its name and calibration;
     ``top``: more top-level lines), its calibration, two frames of detections and the first
     ground-truth rows; run by ``experiment occupancy``. ``area``: its area_m, by default one that
-    View_001 sees whole and that holds those rows' people."""
+    View_001 sees whole and that holds those rows' people; ``calibration``: the view's file (c.xml, the
+    Tsai XML, is always written); ``says``: as :class:`Case`'s."""
     document = (
         f"frame_rate_hz: 10\narea_m: {area}\nground_truth: gt.txt\n"
-        f"views:\n  - {{name: View_001, calibration: c.xml, {view}}}\n{top}"
+        f"views:\n  - {{name: View_001, calibration: {calibration}, {view}}}\n{top}"
     )
     given = {"d.yaml": document, "c.xml": TSAI, "det.txt": "\n".join(DETECTION_ROWS) + "\n"}
-    given["gt.txt"] = _ground_truth([row for row in GROUND_TRUTH_ROWS if row.split(",")[0] in ("1", "2")])
-    return Case(name, ("experiment", "occupancy", "{dir}/d.yaml", *extra), {**given, **(files or {})}, exit_status)
+    given["gt.txt"] = _ground_truth(FIRST_TWO_FRAMES)
+    return Case(
+        name, ("experiment", "occupancy", "{dir}/d.yaml", *extra), {**given, **(files or {})}, exit_status, says
+    )
 
 
 @functools.cache
@@ -218,6 +241,15 @@ def cases(scratch: Path | None) -> list[Case]:
         _scenario("NaN frame rate", "frame_rate_hz: .nan\n"),
         _scenario("bad pose error", "camera: {pose_error: {pan_tilt_sigma_deg: .inf}}\n"),
         _recording("ground truth empty", "--gt", "gt.txt", ""),
+        _recording(
+            "ground truth beyond the video",
+            "--gt",
+            "gt.txt",
+            _ground_truth([*truth, _with_field(truth[0], 0, "99999999")]),
+            "--frames",
+            "3",
+            says=(f"gt.txt: line {len(truth) + 1}: frame 99999999 is beyond the 795 frames of", "View_001.avi"),
+        ),
         _recording("ground truth negative frame", "--gt", "gt.txt", _ground_truth([_with_field(truth[0], 0, "-3")])),
         _recording("calibration empty", "--calibration", "c.json", ""),
         _recording("calibration binary", "--calibration", "c.xml", b"\x00\xff" * 50),
@@ -227,6 +259,44 @@ def cases(scratch: Path | None) -> list[Case]:
         _dataset("dataset duplicate keys", top="frame_rate_hz: 15\n"),
         _dataset("dataset frames 1e9", top="frames: 1000000000\n"),
         _dataset("dataset cell_m 1e-5", top="occupancy: {cell_m: 0.00001}\n"),
+        _dataset(
+            "dataset cell_m 1000 on a 40 m area",
+            top="occupancy: {cell_m: 1000}\n",
+            area="[[-20, -15], [20, 25]]",
+            says=("occupancy.cell_m 1000 m makes 1 x 1 cells", "at most occupancy.separation_m (0.5 m)"),
+        ),
+        _dataset(
+            "dataset window_m 1000",
+            top="occupancy: {window_m: 1000}\n",
+            says=("occupancy.window_m 1000 m's windows of 40001 x 40001 cells", "GB available"),
+        ),
+        _dataset(
+            "dataset window_m 1000 on a partly seen area",
+            top="occupancy: {window_m: 1000}\n",
+            area="[[-20, -15], [20, 25]]",
+            says=("occupancy.window_m 1000 m's windows",),
+        ),
+        _dataset(
+            "dataset window_m 300",
+            top="occupancy: {window_m: 300}\n",
+            says=("occupancy.window_m 300 m's windows", "GB available"),
+        ),
+        _dataset("dataset separation_m 1000", top="occupancy: {separation_m: 1000}\n", says=("separation_m 1000 m",)),
+        _dataset(
+            "dataset kernel_sigma_m 1000",
+            top="occupancy: {kernel_sigma_m: 1000}\n",
+            says=("occupancy.kernel_sigma_m 1000 m's smoothing", "at most 2 s"),
+        ),
+        _dataset(
+            "dataset outline_points_per_box 10000",
+            top="occupancy: {outline_points_per_box: 10000, samples_per_height: 1000}\n",
+            says=("box outlines (10000 points a box, 3 heights of 1000 samples)", "outline_points_per_box"),
+        ),
+        _dataset(
+            "dataset canny_low above canny_high",
+            top="occupancy: {canny_low: 200}\n",
+            says=("occupancy: canny_low (200) must be at most canny_high (150)",),
+        ),
         _dataset("dataset samples 1e9", top="occupancy: {samples_per_height: 1000000000}\n"),
         _dataset("dataset view without evidence", view="weight: 1"),
         _dataset("dataset view calibration missing", files={"c.xml": None}),
@@ -234,8 +304,53 @@ def cases(scratch: Path | None) -> list[Case]:
         _dataset("dataset area outside the view's image", area="[[-40, 0], [-30, 10]]"),
         _dataset("dataset area partly seen", extra=("--methods",), area="[[-20, -15], [20, 25]]", exit_status=0),
         _dataset("dataset calibration of another size", view="detections: det.txt, image_size_px: [640, 480]"),
+        _dataset(
+            "dataset ground truth 1000 m away",
+            files={"gt.txt": _ground_truth([_with_field(row, 7, "1000") for row in FIRST_TWO_FRAMES])},
+            says=("gt.txt: no row of the 2 frames used lies in area_m [[-12, -13], [-3, -5]] (line 1: (1000, ",),
+        ),
+        _dataset(
+            "dataset ground truth partly outside the area",
+            files={"gt.txt": _ground_truth([_with_field(FIRST_TWO_FRAMES[0], 7, "1000"), *FIRST_TWO_FRAMES[1:]])},
+            extra=("--methods",),
+            exit_status=0,
+            says=(f"gt.txt: 1 of {len(FIRST_TWO_FRAMES)} rows of the 2 frames used lie outside area_m",),
+        ),
+        _dataset(
+            "dataset calibration with K halved",
+            view="image_size_px: [768, 576], detections: det.txt",
+            calibration="c.json",
+            files={
+                "c.json": _pinhole_with_k_scaled(0.5),
+                "det.txt": _detections_of(FIRST_TEN_FRAMES),
+                "gt.txt": _ground_truth(FIRST_TEN_FRAMES),
+            },
+            extra=("--methods",),
+            exit_status=0,
+            says=("c.json: views.0 (View_001): the ground truth projects a median", "is this the view's calibration?"),
+        ),
+        _dataset(
+            "dataset ground truth frame 99999999",
+            files={"gt.txt": _ground_truth([*FIRST_TWO_FRAMES, _with_field(truth[0], 0, "99999999")])},
+            extra=("--frames", "2"),
+            says=(f"gt.txt: line {len(FIRST_TWO_FRAMES) + 1}: frame 99999999 is beyond the 100000 frames",),
+        ),
+        _dataset(
+            "dataset ground truth beyond the video",
+            view="video: v.avi",
+            files={
+                "v.avi": video_bytes(3, (768, 576), scratch),
+                "gt.txt": _ground_truth([*FIRST_TWO_FRAMES, _with_field(truth[0], 0, "5")]),
+            },
+            says=(f"gt.txt: line {len(FIRST_TWO_FRAMES) + 1}: frame 5 is beyond the 3 frames of the views' videos",),
+        ),
         _dataset("detections frame 1e9", files={"det.txt": "1000000000,-1,300,200,40,100,0.9,-1,-1,-1\n"}),
         _dataset("detections a box of width 0", files={"det.txt": "1,-1,300,200,0,100,0.9,-1,-1,-1\n"}),
+        _dataset(
+            "detections a box outside the image",
+            files={"det.txt": DETECTION_ROWS[0] + "\n" + _with_field(DETECTION_ROWS[1], 2, "5000") + "\n"},
+            says=("det.txt: line 2: the box at (5000, 201) px, 40 x 100 px, lies outside the view's 768x576 px image",),
+        ),
         _dataset("detections 9 fields", files={"det.txt": "1,-1,300,200,40,100,0.9,-1,-1\n"}),
         _dataset("detections gzip bomb", view="detections: det.txt.gz", files={"det.txt.gz": _gzip_bomb(210_000_000)}),
         _dataset(
@@ -257,6 +372,11 @@ def cases(scratch: Path | None) -> list[Case]:
         Case("view: a file, not a folder", ("view", "{dir}/f"), {"f": "keep me\n"}),
         Case("view: a line that is not a state", ("view", "{dir}/run"), {"run/view_states.jsonl": '{"step": 0}\n'}),
         Case("view: --steps-per-s 0", ("view", "{dir}", "--steps-per-s", "0")),
+        Case(
+            "occupancy --frames 1e6",
+            ("experiment", "occupancy", "synthetic-room", "--frames", "1000000"),
+            says=("--frames", "at most 100000"),
+        ),
         _dataset("occupancy --out not empty", files={"out/keep.txt": "keep me\n"}, extra=("--out", "{dir}/out")),
     ]
 

@@ -2,7 +2,8 @@
 
 Every case runs in-process through ``ptztrack.cli.main``: exit 2 with one line of at most 300 characters
 on stderr (file descriptor 2; records logged and Python warnings count as lines too) and no traceback (or
-exit 0 where the input is legitimate), in less than 1 GB of resident memory: what a fresh process holds
+exit 0 where the input is legitimate), the lines naming what the case says they must (``Case.says``: the
+field, the file, the bound), in less than 1 GB of resident memory: what a fresh process holds
 after importing the command, plus what the case's run adds to this process's peak (Linux's peak resident
 memory, reset before each case). The memory bombs, a legitimate input and an argparse error also run in a
 fresh process as a user runs the command: the exit status, the one line, under 1 GB of peak resident memory.
@@ -111,6 +112,7 @@ def test_every_bad_input_gets_one_clear_line_and_little_memory(corpus, imported_
     if case.exit_status == 2:
         assert len(lines) == 1 and len(lines[0]) <= LINE_MAX_CHARACTERS, lines
         assert lines[0].startswith("ptztrack") and "Traceback" not in stderr
+    assert all(part in "\n".join(lines) for part in case.says), (case.says, lines)
     assert imported_mb + added_mb < MEMORY_MAX_MB, (imported_mb, added_mb)
 
 

@@ -1,10 +1,12 @@
 """Fuzzing every reader: generated scenario documents, valid and near-valid, and mutations of every
 file format. Whatever the input, the result is a value or one clean :class:`InputError` line,
-never another exception. Derandomised, so that a run is repeatable; the examples per test are in
-``EXAMPLES``.
+never another exception; a small dataset file goes through the command itself, which exits 0, or 2
+with one line. Derandomised, so that a run is repeatable; the examples per test are in ``EXAMPLES``.
 """
 
 import gzip
+import json
+import logging
 import math
 import re
 from importlib import resources
@@ -15,18 +17,22 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from bad_inputs import video_bytes
+from bad_inputs import _dataset, video_bytes, write_case
 from ptztrack.builders.budget import refuse_if_too_large
 from ptztrack.builders.episode import run_episode
+from ptztrack.builders.live import camera_spaces, pose_timeline
+from ptztrack.cli import main
 from ptztrack.config import (
     MultiViewDataset,
     Scenario,
     ScenarioError,
     dataset_from_dict,
+    load_camera_calibration,
     load_dataset,
     load_scenario,
     scenario_from_dict,
 )
+from ptztrack.config.camera_calibration import CameraCalibrationFile, write_camera_calibration
 from ptztrack.files import InputError
 from ptztrack.geometry.calibration import load_calibration
 from ptztrack.geometry.registration import ReferenceIndex, load_index, save_index
@@ -36,6 +42,8 @@ from ptztrack.scene.pets import RecordedVideo, load_cvml, load_mot_ground_truth
 EXAMPLES = 200
 RUN_EXAMPLES = 20
 """Valid small scenarios run for a few steps each: fewer examples, each a closed-loop episode."""
+DATASET_RUN_EXAMPLES = 60
+"""Mutated small dataset files run through the command: fewer examples, the valid ones each an experiment."""
 FUZZ = settings(
     max_examples=EXAMPLES,
     derandomize=True,
@@ -181,6 +189,32 @@ def test_a_mutated_dataset_file_is_read_or_refused_in_one_line(tmp_path, data):
     _read_mutated(tmp_path, "dataset.yaml", data, load_dataset)
 
 
+SMALL_DATASET = _dataset(
+    "fuzz",
+    top="frames: 2\noccupancy: {cell_m: 0.05, kernel_sigma_m: 0.1, separation_m: 0.5, window_m: 0.25, block_px: 4}\n",
+    extra=("--quiet", "--methods"),
+)
+"""One PETS view's calibration, two frames of its detections and ground truth (tests/bad_inputs.py), and the
+parameters whose cost grows with them."""
+
+
+@settings(FUZZ, max_examples=DATASET_RUN_EXAMPLES)
+@given(data=mutations(SMALL_DATASET.files["d.yaml"].encode()))
+def test_a_mutated_dataset_file_runs_or_exits_2_with_one_line(tmp_path, capfd, caplog, data):
+    """Through the command, in-process: the experiment runs (exit 0), or one line says why not (exit 2)."""
+    argv = write_case(SMALL_DATASET, tmp_path)
+    (tmp_path / "d.yaml").write_bytes(data)
+    capfd.readouterr()
+    caplog.clear()
+    status = main(argv)
+    stderr = capfd.readouterr().err
+    assert status in (0, 2) and "Traceback" not in stderr, stderr
+    if status == 2:
+        warned = [record.getMessage() for record in caplog.records if record.levelno >= logging.WARNING]
+        lines = stderr.strip().splitlines() + warned
+        assert len(lines) == 1 and len(lines[0]) <= 300 and lines[0].startswith("ptztrack: error: "), lines
+
+
 DETECTIONS_HEAD = b"".join(gzip.decompress((PETS / "View_003_det.txt.gz").read_bytes()).splitlines(keepends=True)[:30])
 
 
@@ -232,6 +266,44 @@ def test_a_mutated_tsai_calibration_is_read_or_refused_in_one_line(tmp_path, dat
 @given(data=mutations((PETS / "pinhole.json").read_bytes()))
 def test_a_mutated_pinhole_calibration_is_read_or_refused_in_one_line(tmp_path, data):
     _read_mutated(tmp_path, "calibration.json", data, load_calibration)
+
+
+CAMERA_CALIBRATION = CameraCalibrationFile(
+    pan_deg=(-170.0, 170.0),
+    tilt_deg=(-30.0, 90.0),
+    zoom_curve=[(0.0, 1.0), (0.4, 3.5), (1.0, 20.0)],
+    position_m=(1.5, -2.0, 4.2),
+    f_min_px=820.0,
+    move_times={"pan": (0.3, 0.012), "tilt": (0.25, 0.015), "zoom": (0.4, 0.2)},
+)
+"""A real camera's calibration as ``ptztrack camera calibrate`` leaves it: spaces, position, focal
+length and measured move times."""
+
+
+@pytest.fixture(scope="module")
+def camera_calibration_files(tmp_path_factory) -> dict[str, bytes]:
+    """The calibration written as ``ptztrack camera calibrate`` writes it (YAML), and as JSON (YAML reads it)."""
+    path = tmp_path_factory.mktemp("camera") / "camera.yaml"
+    write_camera_calibration(path, CAMERA_CALIBRATION)
+    return {"yaml": path.read_bytes(), "json": json.dumps(CAMERA_CALIBRATION.model_dump(mode="json")).encode()}
+
+
+@FUZZ
+@given(data=st.data(), kind=st.sampled_from(["yaml", "json"]))
+def test_a_mutated_camera_calibration_is_read_or_refused_in_one_line(tmp_path, camera_calibration_files, data, kind):
+    """Read, a calibration maps every normalised position to a finite pose and back, and its move times to
+    finite speeds (what a live run does with it before it connects)."""
+
+    def read(path):
+        calibration = load_camera_calibration(path)
+        spaces = camera_spaces(calibration)
+        normalised = np.stack(np.meshgrid([-1.0, 0.0, 1.0], [-1.0, 0.5, 1.0], [0.0, 0.3, 1.0]), axis=-1)
+        pose = spaces.pose(normalised)
+        assert np.all(np.isfinite(pose)) and np.all(np.isfinite(spaces.normalised(pose)))
+        speeds = pose_timeline(calibration).speeds
+        assert speeds is None or np.all(np.isfinite(speeds) & (speeds > 0))
+
+    _read_mutated(tmp_path, f"camera.{kind}", data.draw(mutations(camera_calibration_files[kind])), read)
 
 
 def _small_index_bytes(tmp_path: Path) -> bytes:

@@ -8,6 +8,7 @@ import pytest
 
 from ptztrack.cli import main
 from ptztrack.config import dataset_from_dict, load_dataset, pets_dataset
+from ptztrack.experiments.occupancy import format_occupancy_table
 from ptztrack.geometry.calibration import project_pinhole
 from ptztrack.occupancy.evaluation import detection_metrics, fitted_prior, fitted_selection, halves, track_on_ground
 from ptztrack.occupancy.lpom import Modes
@@ -37,6 +38,20 @@ def test_poms_prior_is_the_mean_share_of_occupied_cells_in_the_fitting_frames():
     assert fitted_prior(truth, cells=100) == pytest.approx(0.015)
     # Nobody at all: one person over the frames, not a prior of 0 (no cell could ever be occupied).
     assert fitted_prior(np.full((4, 3, 2), np.nan), cells=100) == pytest.approx(0.25 / 100)
+
+
+def test_a_figure_without_a_value_is_shown_as_n_a_never_nan():
+    """No match makes MODP and the mean error undefined; the clustering row has no tracking figures."""
+    nothing_matched = detection_metrics(np.array([[[0.0, 0.0]]]), [np.array([[9.0, 9.0]])])
+    rows = [
+        {"method": "lpom", "dataset": "d", **nothing_matched, "mota": -1.0, "motp_m": NAN, "idf1": 0.0},
+        {"method": "clustering", "dataset": "d", **nothing_matched},
+    ]
+    table = format_occupancy_table("d", rows)
+    lpom, clustering = table.splitlines()[2:4]
+    assert lpom.split() == ["lpom", "-100.0%", "n/a", "0.0%", "0.0%", "n/a", "-100.0%", "n/a", "0.0%"]
+    assert clustering.split() == ["clustering", "-100.0%", "n/a", "0.0%", "0.0%", "n/a"]
+    assert "nan" not in table
 
 
 def test_each_half_is_scored_with_the_threshold_fitted_on_the_other():

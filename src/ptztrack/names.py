@@ -26,6 +26,9 @@ FOLLOW_TRACKERS = ("particle", "csrt", "mil")
 """The follow camera's trackers: the paper's particle filter and OpenCV's two."""
 OTB_TRACKS = 5
 """People the follow experiment's one-pass (OTB) protocol runs by default."""
+MAX_FRAMES = 100_000
+"""The most frames a run or a recording may use: a run keeps every step's history, the occupancy
+experiment every frame's map and modes."""
 ROOM_FRAMES = 300
 """Frames of each synthetic-room sequence of the occupancy experiment."""
 PLAZA_FRAMES = 200

@@ -66,7 +66,7 @@ def refuse_if_too_large(
     is available (``available_bytes``, by default what the machine has free now)."""
     terms = estimated_memory_bytes(scenario, policies)
     needed = runs_at_once * sum(terms.values())
-    available = psutil.virtual_memory().available if available_bytes is None else available_bytes
+    available = available_memory_bytes() if available_bytes is None else available_bytes
     if needed > available:
         largest = max(terms, key=lambda name: terms[name])
         at_once = f" x {runs_at_once} runs at once" if runs_at_once > 1 else ""
@@ -75,3 +75,8 @@ def refuse_if_too_large(
             f"{terms[largest] / 1e9:.3g} GB), more than the {available / 1e9:.3g} GB available; "
             "make the scene, the action grid or control.samples smaller"
         )
+
+
+def available_memory_bytes() -> float:
+    """The memory the machine can give now without swapping (psutil's ``available``), bytes."""
+    return psutil.virtual_memory().available

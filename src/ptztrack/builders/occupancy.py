@@ -4,22 +4,74 @@
 import functools
 import logging
 from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-import psutil
+from scipy.spatial.distance import cdist
 
+from ptztrack.builders.budget import available_memory_bytes
+from ptztrack.builders.parameters import parameters_from
 from ptztrack.config import MAX_DATASET_FRAMES, DatasetView, MultiViewDataset, pets_dataset
-from ptztrack.geometry.calibration import PinholeCalibration, in_image, load_pinhole, load_tsai, pinhole_from_tsai
-from ptztrack.occupancy.detectors import LpomParameters
-from ptztrack.occupancy.multiview import CameraView, ImageFolder, MultiViewRecording, load_mot_detections, mot_truth
+from ptztrack.geometry.calibration import (
+    PinholeCalibration,
+    in_image,
+    load_pinhole,
+    load_tsai,
+    pinhole_from_tsai,
+    project_pinhole,
+)
+from ptztrack.occupancy.detectors import LpomParameters, lpom_parameters
+from ptztrack.occupancy.lpom import GroundGrid, disc_reach, kernel_reach, most_modes
+from ptztrack.occupancy.multiview import (
+    CameraView,
+    ImageFolder,
+    MultiViewRecording,
+    load_mot_detections,
+    mot_truth,
+    outside_area,
+)
+from ptztrack.occupancy.parameters import OccupancyParameters
 from ptztrack.occupancy.plaza import PlazaLayout, plaza_stage, plaza_truth
 from ptztrack.occupancy.render import SceneRenderer
 from ptztrack.occupancy.room import RoomLayout, RoomRenderer, room_truth
-from ptztrack.scene.pets import DatasetError, RecordedVideo, load_mot_ground_truth
+from ptztrack.scene.pets import (
+    Annotations,
+    DatasetError,
+    RecordedVideo,
+    box_feet_px,
+    load_mot_ground_truth,
+    refuse_rows_beyond,
+)
 
 log = logging.getLogger(__name__)
 
+# What the occupancy map's parts cost, measured on this code (maps of 180 to 1500 cells a side):
+# the loci of points off the tables' grid (a box's outline), per locus point (60-210 ns, 66-79
+# bytes: its position, weight, cell and their temporaries, all of a view's points at once);
+# SciPy's Gaussian filter per cell and kernel tap, both passes counted (0.23-0.37 ns with long
+# kernels); its maximum filter per cell and cell of the separation disc's square (0.38-0.48 ns);
+# map_modes' windows per mode and cell of a window's square (110-250 ns, 52-80 bytes); building a
+# disc: two int64 offset grids, their float64 distances and a bool per cell of its square.
+LOCUS_S_PER_POINT = 200e-9
+LOCUS_BYTES_PER_POINT = 80.0
+SMOOTHING_S_PER_CELL_TAP = 0.4e-9
+MAXIMA_S_PER_CELL_OFFSET = 0.5e-9
+WINDOW_S_PER_MODE_CELL = 250e-9
+WINDOW_BYTES_PER_MODE_CELL = 80.0
+DISC_BYTES_PER_CELL = 25.0
+FRAME_S_MAX = 2.0
+"""The longest a frame's map and its modes may take: SciPy's filters and NumPy's sums see Ctrl-C only
+once they end, and a recording has hundreds of frames."""
+FIT_BOX_HEIGHTS = 0.5
+"""The median distance, in box heights, from a person's ground truth projected into a view to the
+nearest of the view's detections, beyond which the calibration is taken not to fit the view: PETS
+2009 S2.L1's seven views, 0.05 to 0.12 with their calibrations, 0.96 to 3.1 with K halved or doubled."""
+FIT_FRAMES = 100
+"""The frames that check looks at: people enough for a median, at a cost that does not grow with the
+recording."""
+FIT_PEOPLE = 20
+"""The fewest projected people that median is taken over."""
 ROOM_AREA_M = ((0.0, 0.0), (5.0, 6.0))
 AREA_SAMPLES = 256
 """Points per side of the grid on which a dataset's area is checked against its views."""
@@ -44,17 +96,130 @@ def locus_table_bytes(recording: MultiViewRecording, parameters: LpomParameters)
     return 8.0 * points_per_block * blocks
 
 
-def refuse_if_tables_too_large(
+@dataclass(frozen=True)
+class Cost:
+    """What one part of the occupancy map costs: ``amount`` (bytes or seconds), ``what`` it is, and
+    which parameters make it ``smaller``."""
+
+    amount: float
+    what: str
+    smaller: str
+
+
+def outline_loci(recording: MultiViewRecording, parameters: LpomParameters) -> list[int]:
+    """Per view whose loci come from its boxes' outlines (a view without frames), the most locus points
+    a frame of it has: two per outline point (``outline_points_per_box`` per box of at least
+    ``min_box_score``), person height and tangent height."""
+    sampling = parameters.sampling
+    per_ray = 2 * len(sampling.heights_m) * sampling.samples_per_height
+    return [
+        per_ray
+        * parameters.outline_points_per_box
+        * max(int(np.sum(boxes[:, 4] >= parameters.min_box_score)) for boxes in view.boxes)
+        for view in recording.views
+        if view.frames is None and view.boxes is not None
+    ]
+
+
+def _outline_sampling(parameters: LpomParameters) -> str:
+    sampling = parameters.sampling
+    return (
+        f"{parameters.outline_points_per_box} points a box, {len(sampling.heights_m)} heights of "
+        f"{sampling.samples_per_height} samples"
+    )
+
+
+def memory_costs(recording: MultiViewRecording, parameters: LpomParameters) -> list[Cost]:
+    """The occupancy map's estimated peak memory over ``recording``, in bytes, by part."""
+    grid = GroundGrid.covering(recording.area_m, parameters.cell_m)
+    separation = 2 * disc_reach(parameters.separation_m, parameters.cell_m) + 1
+    window = 2 * disc_reach(parameters.window_m, parameters.cell_m) + 1
+    modes = most_modes(grid, parameters.separation_m)
+    return [
+        Cost(
+            locus_table_bytes(recording, parameters),
+            "the locus tables",
+            "make occupancy.block_px larger or samples_per_height smaller",
+        ),
+        Cost(
+            LOCUS_BYTES_PER_POINT * max(outline_loci(recording, parameters), default=0),
+            f"the loci of a frame's box outlines ({_outline_sampling(parameters)})",
+            "make occupancy.outline_points_per_box or samples_per_height smaller",
+        ),
+        Cost(
+            float(recording.frames * grid.cells),
+            f"the maps of {recording.frames} frames of {grid.cells} cells, kept",
+            "use fewer frames or a larger occupancy.cell_m",
+        ),
+        Cost(
+            DISC_BYTES_PER_CELL * separation**2,
+            f"occupancy.separation_m {parameters.separation_m:g} m's disc of {separation} x {separation} cells",
+            "make separation_m smaller or cell_m larger",
+        ),
+        Cost(
+            (DISC_BYTES_PER_CELL + WINDOW_BYTES_PER_MODE_CELL * modes) * window**2,
+            f"occupancy.window_m {parameters.window_m:g} m's windows of {window} x {window} cells, for up to "
+            f"{modes} modes",
+            "make window_m smaller or cell_m larger",
+        ),
+    ]
+
+
+def frame_costs(recording: MultiViewRecording, parameters: LpomParameters) -> list[Cost]:
+    """The estimated time of a frame's map and its modes over ``recording``, in seconds, by part."""
+    grid = GroundGrid.covering(recording.area_m, parameters.cell_m)
+    taps = 2 * kernel_reach(parameters.kernel_sigma_m, parameters.cell_m) + 1
+    separation = 2 * disc_reach(parameters.separation_m, parameters.cell_m) + 1
+    window = 2 * disc_reach(parameters.window_m, parameters.cell_m) + 1
+    modes = most_modes(grid, parameters.separation_m)
+    return [
+        Cost(
+            LOCUS_S_PER_POINT * sum(outline_loci(recording, parameters)),
+            f"the loci of its box outlines ({_outline_sampling(parameters)})",
+            "make occupancy.outline_points_per_box or samples_per_height smaller",
+        ),
+        Cost(
+            SMOOTHING_S_PER_CELL_TAP * grid.cells * 2 * taps,
+            f"occupancy.kernel_sigma_m {parameters.kernel_sigma_m:g} m's smoothing, a kernel of {taps} cells a side",
+            "make kernel_sigma_m smaller or cell_m larger",
+        ),
+        Cost(
+            MAXIMA_S_PER_CELL_OFFSET * grid.cells * separation**2,
+            f"occupancy.separation_m {parameters.separation_m:g} m's maxima over {separation} x {separation} cells",
+            "make separation_m smaller or cell_m larger",
+        ),
+        Cost(
+            WINDOW_S_PER_MODE_CELL * modes * window**2,
+            f"occupancy.window_m {parameters.window_m:g} m's windows of {window} x {window} cells, for up to "
+            f"{modes} modes",
+            "make window_m smaller or cell_m larger",
+        ),
+    ]
+
+
+def refuse_if_map_too_large(
     recording: MultiViewRecording, parameters: LpomParameters, available_bytes: float | None = None
 ) -> None:
-    """A :class:`DatasetError` before the tables are built if they would not fit in the memory available
-    (``available_bytes``, by default what the machine has free now)."""
-    needed = locus_table_bytes(recording, parameters)
-    available = psutil.virtual_memory().available if available_bytes is None else available_bytes
+    """A :class:`DatasetError` before any work if the occupancy map over ``recording`` would need more
+    memory than is available (``available_bytes``, by default what the machine has free now,
+    :func:`memory_costs`) or a frame would take longer than ``FRAME_S_MAX`` (:func:`frame_costs`);
+    the line names the largest part and the parameters that make it smaller."""
+    memory = memory_costs(recording, parameters)
+    needed = sum(cost.amount for cost in memory)
+    available = available_memory_bytes() if available_bytes is None else available_bytes
     if needed > available:
+        largest = max(memory, key=lambda cost: cost.amount)
         raise DatasetError(
-            f"{recording.name}: the locus tables need an estimated {needed / 1e9:.3g} GB, more than the "
-            f"{available / 1e9:.3g} GB available; make occupancy.block_px larger or samples_per_height smaller"
+            f"{recording.name}: the occupancy map needs an estimated {needed / 1e9:.3g} GB, more than the "
+            f"{available / 1e9:.3g} GB available, most of it for {largest.what}: {largest.smaller}"
+        )
+    frame = frame_costs(recording, parameters)
+    seconds = sum(cost.amount for cost in frame)
+    if seconds > FRAME_S_MAX:
+        largest = max(frame, key=lambda cost: cost.amount)
+        raise DatasetError(
+            f"{recording.name}: a frame's occupancy map would take an estimated {seconds:.3g} s, at most "
+            f"{FRAME_S_MAX:g} s (Ctrl-C waits for it), most of it for {largest.what}: {largest.smaller}"
         )
 
 
@@ -101,7 +266,10 @@ def recording_from_dataset(dataset: MultiViewDataset, frames: int | None = None)
 
     Without either, every frame that all views' videos or image folders have (or, without any, up to
     the last frame of the detection files). A view that sees none of the area is refused, and a part of
-    the area that no view sees is warned of (:func:`_view_sees_area`, :func:`_warn_of_unseen_area`).
+    the area that no view sees is warned of (:func:`_view_sees_area`, :func:`_warn_of_unseen_area`);
+    so is ground truth that lies outside the area, all of it or some (:func:`_truth_outside_area`), and
+    a view's detections that the ground truth, projected into it, misses (:func:`_calibration_misfit`).
+    An occupancy map over it that would not fit is refused (:func:`refuse_if_map_too_large`).
     """
     loaded, seen = [], []
     area_mm = area_points_mm(dataset.area_m)
@@ -112,7 +280,7 @@ def recording_from_dataset(dataset: MultiViewDataset, frames: int | None = None)
         if view.video is not None or view.images is not None:
             source, count, size_px = _frames(view, size_px, field)
         seen.append(_view_sees_area(view, field, calibration, size_px, area_mm))
-        boxes = None if view.detections is None else load_mot_detections(view.detections, MAX_DATASET_FRAMES)
+        boxes = None if view.detections is None else load_mot_detections(view.detections, MAX_DATASET_FRAMES, size_px)
         loaded.append((view, calibration, size_px, source, count, boxes))
     counts = [count for *_, count, _ in loaded if count is not None]
     available = min(counts) if counts else max(len(boxes) for *_, boxes in loaded if boxes is not None)
@@ -135,12 +303,97 @@ def recording_from_dataset(dataset: MultiViewDataset, frames: int | None = None)
         )
         for view, calibration, size_px, source, count, boxes in loaded
     )
-    truth = None
+    truth, warnings = None, []
     if dataset.ground_truth is not None:
-        truth = mot_truth(dataset.ground_truth, wanted, dataset.frame_rate_hz)
-    # Last, after every error the files could still raise: a refused dataset gets its one line alone.
+        annotations = load_mot_ground_truth(dataset.ground_truth)
+        # Without a video or an image folder, the recording is as long as its annotations say.
+        recorded = available if counts else MAX_DATASET_FRAMES
+        described = (
+            f"the {available} frames of the views' videos and images"
+            if counts
+            else f"the {MAX_DATASET_FRAMES} frames a recording may have (memory)"
+        )
+        refuse_rows_beyond(dataset.ground_truth, annotations.frame, annotations.line, recorded, described)
+        warnings.append(_truth_outside_area(dataset.ground_truth, annotations, wanted, dataset.area_m))
+        warnings += [
+            _calibration_misfit(view, f"views.{index}", calibration, size_px, boxes, annotations, wanted)
+            for index, (view, calibration, size_px, _, _, boxes) in enumerate(loaded)
+        ]
+        truth = mot_truth(annotations, wanted, dataset.frame_rate_hz)
+    area_m = np.asarray(dataset.area_m)
+    recording = MultiViewRecording(dataset.name, views, wanted, dataset.frame_rate_hz, area_m, truth)
+    # The experiment checks the map's cost of any recording; a dataset's is checked here too, so that
+    # a refused dataset gets its one line alone: the warnings come last, after every error.
+    refuse_if_map_too_large(recording, lpom_parameters(parameters_from(dataset.occupancy, OccupancyParameters)))
     _warn_of_unseen_area(dataset.name, area_mm, np.any(seen, axis=0))
-    return MultiViewRecording(dataset.name, views, wanted, dataset.frame_rate_hz, np.asarray(dataset.area_m), truth)
+    for warning in warnings:
+        if warning is not None:
+            log.warning(warning)
+    return recording
+
+
+def _truth_outside_area(path: str, annotations: Annotations, frames: int, area_m) -> str | None:
+    """The ground truth's rows of the first ``frames`` frames against area_m: a :class:`DatasetError`
+    if none lies in it (nothing could be scored: positions in other units or columns, or another
+    area's), else a warning line naming the rows outside it (they are not scored), or None."""
+    used = annotations.select(annotations.frame < frames)
+    assert used.line is not None  # MOTChallenge rows have lines
+    outside = outside_area(used.ground_m, area_m)
+    if not outside.any():
+        return None
+    first = int(np.argmax(outside))
+    (x_m, y_m), line = used.ground_m[first], used.line[first]
+    (x0, y0), (x1, y1) = area_m
+    area = f"area_m [[{x0:g}, {y0:g}], [{x1:g}, {y1:g}]]"
+    if outside.all():
+        raise DatasetError(
+            f"{path}: no row of the {frames} frames used lies in {area} (line {line}: ({x_m:g}, {y_m:g}) m); "
+            "expected world x, y in metres in columns 8-9"
+        )
+    return (
+        f"{path}: {outside.sum()} of {len(outside)} rows of the {frames} frames used lie outside {area} and "
+        f"are not scored (line {line}: ({x_m:g}, {y_m:g}) m)"
+    )
+
+
+def _calibration_misfit(
+    view: DatasetView,
+    field: str,
+    calibration: PinholeCalibration,
+    size_px: tuple[int, int] | None,
+    boxes: list[np.ndarray] | None,
+    annotations: Annotations,
+    frames: int,
+) -> str | None:
+    """A warning line if the ground truth's people, projected into a view with detections and a known
+    image size, stand a median of more than ``FIT_BOX_HEIGHTS`` box heights from the nearest box's feet
+    (the bottom centre) of the same frame: the calibration, most likely, is not this view's. Over the
+    first ``FIT_FRAMES`` of the ``frames`` used, once ``FIT_PEOPLE`` people are seen; else None."""
+    if boxes is None or size_px is None:
+        return None
+    checked = min(frames, len(boxes), FIT_FRAMES)
+    early = annotations.select(annotations.frame < checked)
+    points_mm = np.c_[1000.0 * early.ground_m, np.zeros(len(early.frame))]
+    seen = in_image(calibration, size_px, points_mm)
+    feet_px, frame = project_pinhole(calibration, points_mm[seen]), early.frame[seen]
+    misses = []
+    for index in np.unique(frame):
+        found = boxes[index]
+        if len(found):
+            distance_px = cdist(feet_px[frame == index], box_feet_px(found))
+            nearest = distance_px.argmin(axis=1)
+            misses.append(distance_px[np.arange(len(nearest)), nearest] / found[nearest, 3])
+    people = sum(len(miss) for miss in misses)
+    if people < FIT_PEOPLE:
+        return None
+    median = float(np.median(np.concatenate(misses)))
+    if median <= FIT_BOX_HEIGHTS:
+        return None
+    return (
+        f"{view.calibration}: {field} ({view.name}): the ground truth projects a median {median:.2g} box heights "
+        f"from the nearest detection ({people} people, first {checked} frames; expected under {FIT_BOX_HEIGHTS:g}): "
+        "is this the view's calibration?"
+    )
 
 
 def area_points_mm(area_m) -> np.ndarray:

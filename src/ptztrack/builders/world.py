@@ -23,7 +23,7 @@ from ptztrack.geometry.ptz import PTZCamera, ground_footprint
 from ptztrack.loop import World
 from ptztrack.roles import CameraBackend, Detector, PoseSource
 from ptztrack.scene.parameters import Crowd
-from ptztrack.scene.pets import RecordedScene, RecordedVideo, load_mot_ground_truth, recorded_scene
+from ptztrack.scene.pets import RecordedScene, RecordedVideo, load_mot_ground_truth, recorded_scene, refuse_rows_beyond
 from ptztrack.scene.synthetic import walk_people
 from ptztrack.types import GroundTruth
 
@@ -89,8 +89,9 @@ def build_scene(scenario: Scenario, scene_rng: np.random.Generator) -> BuiltScen
     grid = ActionGrid(
         offsets.pan_deg + whole_frame_pose[0], offsets.tilt_deg + whole_frame_pose[1], offsets.zoom, offsets.max_steps
     )
+    annotations = load_mot_ground_truth(recording.ground_truth)
     scene = recorded_scene(
-        load_mot_ground_truth(recording.ground_truth),
+        annotations,
         recording.frame_step,
         scenario.frames,
         scenario.frame_rate_hz,
@@ -104,6 +105,13 @@ def build_scene(scenario: Scenario, scene_rng: np.random.Generator) -> BuiltScen
     video = None
     if recording.video is not None:
         video = RecordedVideo(recording.video, recording.recorded_size_px, int(scene.video_frame.max()) + 1)
+        refuse_rows_beyond(
+            recording.ground_truth,
+            annotations.frame,
+            annotations.line,
+            video.frame_count,
+            f"the {video.frame_count} frames of {recording.video}",
+        )
     return BuiltScene(virtual.camera, grid, scene.truth, area_polygon_m, scene, virtual, calibration, video)
 
 

@@ -13,6 +13,7 @@ from ptztrack import registry
 from ptztrack.names import (
     EXECUTORS,
     FOLLOW_TRACKERS,
+    MAX_FRAMES,
     OCCUPANCY_MAP_METHODS,
     OTB_TRACKS,
     PASSWORD_VARIABLE,
@@ -268,7 +269,7 @@ def _add_occupancy_parser(experiments) -> None:
     )
     occupancy.add_argument(
         "--frames",
-        type=_positive_int,
+        type=_occupancy_frames,
         help=f"frames to use (synthetic-room: {ROOM_FRAMES}, synthetic-plaza: {PLAZA_FRAMES} per sequence; else all)",
     )
     occupancy.add_argument(
@@ -382,6 +383,15 @@ def _positive_int(text: str) -> int:
     value = int(text)
     if value < 1:
         raise argparse.ArgumentTypeError(f"must be at least 1 (got {value})")
+    return value
+
+
+def _occupancy_frames(text: str) -> int:
+    value = _positive_int(text)
+    if value > MAX_FRAMES:
+        raise argparse.ArgumentTypeError(
+            f"must be at most {MAX_FRAMES} (memory: every frame's map and modes are kept; got {value})"
+        )
     return value
 
 

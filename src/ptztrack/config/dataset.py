@@ -1,6 +1,7 @@
 """Multi-view datasets and the occupancy-map detector (the LPOM paper): their models, the dataset file's
 reader and the built-in PETS 2009 S2.L1 dataset."""
 
+import math
 from importlib import resources
 from pathlib import Path
 from typing import Annotated, Any
@@ -95,6 +96,11 @@ class Occupancy(_Strict):
                 f"height_step_m {self.height_step_m:g} gives {heights:.3g} heights; at most "
                 f"{MAX_PERSON_HEIGHTS} ({_LOCUS_MEMORY})"
             )
+        if self.canny_low > self.canny_high:
+            raise ValueError(
+                f"canny_low ({self.canny_low:g}) must be at most canny_high ({self.canny_high:g}): an edge starts "
+                "above canny_high and goes on above canny_low"
+            )
         return self
 
 
@@ -136,6 +142,13 @@ class MultiViewDataset(_Strict):
             raise ValueError(
                 f"area_m at occupancy.cell_m {self.occupancy.cell_m:g} m makes {cells:.3g} cells; at most "
                 f"{MAX_GROUND_CELLS:g} (memory: a map of float64 cells per frame): make the cells larger"
+            )
+        if self.occupancy.cell_m > self.occupancy.separation_m:
+            columns, rows = math.ceil((x1 - x0) / self.occupancy.cell_m), math.ceil((y1 - y0) / self.occupancy.cell_m)
+            raise ValueError(
+                f"area_m at occupancy.cell_m {self.occupancy.cell_m:g} m makes {columns} x {rows} cells; expected "
+                f"cells of at most occupancy.separation_m ({self.occupancy.separation_m:g} m), so that two people "
+                "that close are two modes"
             )
         names = [view.name for view in self.views]
         if len(set(names)) != len(names):

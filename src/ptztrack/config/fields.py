@@ -6,6 +6,7 @@ from typing import Annotated, Any
 from pydantic import AfterValidator, BaseModel, ConfigDict, Field
 
 from ptztrack import registry
+from ptztrack.names import MAX_FRAMES
 
 PositiveFloat = Annotated[float, Field(gt=0)]
 NonNegativeFloat = Annotated[float, Field(ge=0)]
@@ -33,7 +34,7 @@ def at_most_items(limit: int, why: str):
     return AfterValidator(check)
 
 
-_MAX_FRAMES = 100_000
+_MAX_FRAMES = MAX_FRAMES
 Pixels = Annotated[int, Field(gt=0), at_most(8192, "memory: an 8192 x 8192 colour image is 200 MB")]
 Degrees = Annotated[float, Field(ge=-360), at_most(360, "an angle in degrees")]
 

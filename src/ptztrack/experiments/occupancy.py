@@ -8,12 +8,13 @@ detectors over every frame (:func:`run_recording`); its rows, one per method, ar
 :func:`format_occupancy_table`.
 """
 
+import math
 from collections.abc import Callable, Sequence
 
 from ptztrack.builders.occupancy import (
     plaza_recording,
     recording_from_dataset,
-    refuse_if_tables_too_large,
+    refuse_if_map_too_large,
     room_recording,
 )
 from ptztrack.builders.parameters import parameters_from
@@ -71,7 +72,7 @@ def run_recording(
         raise DatasetError(f"{recording.name}: the experiment needs ground truth (ground_truth)")
     settings = parameters_from(occupancy, OccupancyParameters)
     parameters = lpom_parameters(settings)
-    refuse_if_tables_too_large(recording, parameters)
+    refuse_if_map_too_large(recording, parameters)
     lpom = LpomDetector(recording, parameters)
     maps: dict[str, Sequence[MapDetector]] = {"lpom": [lpom]}
     # One background model per view with video, shared: each frame's silhouettes are made once.
@@ -150,7 +151,7 @@ def format_occupancy_table(dataset: str, rows: list[dict]) -> str:
         "  ".join(f"{key:>{width if key == 'method' else 10}}" for key, _ in columns),
     ]
     for row in rows:
-        cells = (form.format(row[key]) if key in row else "" for key, form in columns)
+        cells = (_shown(row.get(key), form) for key, form in columns)
         lines.append(
             "  ".join(
                 f"{cell:>{width if key == 'method' else 10}}" for cell, (key, _) in zip(cells, columns, strict=True)
@@ -162,3 +163,11 @@ def format_occupancy_table(dataset: str, rows: list[dict]) -> str:
             f"{row['dataset']} {row['method']}: {fitted} (each half of the frames scored with the other's fit)"
         )
     return "\n".join(lines)
+
+
+def _shown(value, form: str) -> str:
+    """A table cell: empty where the row has no such figure, "n/a" where the figure is undefined (NaN:
+    MODP and the mean error without a match, MODA and recall without a person to find)."""
+    if value is None:
+        return ""
+    return "n/a" if isinstance(value, float) and math.isnan(value) else form.format(value)

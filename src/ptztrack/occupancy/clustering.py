@@ -17,6 +17,7 @@ import numpy as np
 from scipy.cluster.hierarchy import fcluster, linkage
 
 from ptztrack.geometry.calibration import PinholeCalibration, pixel_rays
+from ptztrack.scene.pets import box_feet_px
 
 # Blob boxes from MOG2: morphological opening removes speckle, closing joins a body's parts.
 OPEN_PX, CLOSE_PX = 3, 9
@@ -28,8 +29,7 @@ def feet_on_ground(calibration: PinholeCalibration, boxes_px) -> np.ndarray:
     boxes_px = np.asarray(boxes_px, dtype=float)
     if len(boxes_px) == 0:
         return np.zeros((0, 2))
-    feet_px = np.stack([boxes_px[:, 0] + boxes_px[:, 2] / 2, boxes_px[:, 1] + boxes_px[:, 3]], axis=-1)
-    centre_m, direction = pixel_rays(calibration, feet_px)
+    centre_m, direction = pixel_rays(calibration, box_feet_px(boxes_px))
     t_m = -centre_m[2] / direction[:, 2]
     ground_m = centre_m[:2] + t_m[:, None] * direction[:, :2]
     return np.where((t_m > 0)[:, None], ground_m, np.nan)

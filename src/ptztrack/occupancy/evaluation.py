@@ -37,7 +37,7 @@ from ptztrack.evaluate.metrics import clear_metrics
 from ptztrack.occupancy.clustering import Clusters
 from ptztrack.occupancy.detectors import ClusteringDetector
 from ptztrack.occupancy.lpom import GroundGrid, Modes
-from ptztrack.occupancy.multiview import MultiViewRecording
+from ptztrack.occupancy.multiview import MultiViewRecording, outside_area
 from ptztrack.track.kalman import constant_velocity_model
 from ptztrack.track.parameters import TrackerParameters
 from ptztrack.track.tracker import predict_tracks, update_tracks_on_ground
@@ -84,10 +84,7 @@ def scored_truth(recording: MultiViewRecording) -> np.ndarray:
     """The truth (T, N, 2) m of the recording's frames, NaN outside its area (not scored)."""
     assert recording.truth is not None
     truth = recording.truth.positions_m[: recording.frames].copy()
-    (x0, y0), (x1, y1) = recording.area_m
-    with np.errstate(invalid="ignore"):
-        outside = (truth[..., 0] < x0) | (truth[..., 0] > x1) | (truth[..., 1] < y0) | (truth[..., 1] > y1)
-    truth[outside] = np.nan
+    truth[outside_area(truth, recording.area_m)] = np.nan
     return truth
 
 

@@ -196,7 +196,17 @@ def occupancy_map(view_maps, view_weights, grid: GroundGrid, kernel_sigma_m: flo
             total += weight * loci / mass
     if total.sum() > 0:
         total /= total.sum()
-    return ndimage.gaussian_filter(total.reshape(grid.shape), kernel_sigma_m / grid.cell_m, mode="constant")
+    sigma = kernel_sigma_m / grid.cell_m
+    return ndimage.gaussian_filter(
+        total.reshape(grid.shape), sigma, mode="constant", radius=kernel_reach(kernel_sigma_m, grid.cell_m)
+    )
+
+
+def kernel_reach(kernel_sigma_m: float, cell_m: float) -> int:
+    """The cells on each side of the centre that the map's Gaussian kernel weighs: SciPy's default
+    cut at 4 sigma (``gaussian_filter``'s ``truncate``)."""
+    sigma = kernel_sigma_m / cell_m
+    return int(4.0 * sigma + 0.5)
 
 
 @dataclass(frozen=True)
@@ -256,8 +266,23 @@ def map_modes(pom, grid: GroundGrid, separation_m: float, window_m: float, min_s
     return Modes(mean_m, covariance_m2, pom[rows, columns] / peak)
 
 
+def most_modes(grid: GroundGrid, separation_m: float) -> int:
+    """The most modes :func:`map_modes` can find on ``grid``: a mode holds the largest value within
+    ``separation_m``, so two modes that close hold the same value, which a map of sums of loci does not
+    repeat; the others lie farther apart, at most one in each square of side ``separation_m / sqrt(2)``
+    (whose diagonal is ``separation_m``)."""
+    side_m = separation_m / np.sqrt(2)
+    rows, columns = (int(np.ceil(cells * grid.cell_m / side_m)) for cells in grid.shape)
+    return min(grid.cells, rows * columns)
+
+
+def disc_reach(radius_m: float, cell_m: float) -> int:
+    """r: the disc of ``radius_m`` on cells of ``cell_m`` spans (2r + 1, 2r + 1) cells (:func:`_disc`)."""
+    return int(np.floor(radius_m / cell_m))
+
+
 def _disc(radius_m: float, cell_m: float) -> np.ndarray:
     """(2r + 1, 2r + 1) bool: the cells whose centres lie within ``radius_m`` of the middle one."""
-    reach = int(np.floor(radius_m / cell_m))
+    reach = disc_reach(radius_m, cell_m)
     d_row, d_column = np.mgrid[-reach : reach + 1, -reach : reach + 1]
     return np.hypot(d_row, d_column) * cell_m <= radius_m

@@ -17,7 +17,7 @@ import cv2
 import numpy as np
 
 from ptztrack.geometry.calibration import PinholeCalibration
-from ptztrack.scene.pets import DatasetError, load_mot_ground_truth, read_mot_rows, recorded_scene
+from ptztrack.scene.pets import Annotations, DatasetError, read_mot_rows, recorded_scene, refuse_rows_beyond
 from ptztrack.types import GroundTruth
 
 FrameSource = Callable[[int], np.ndarray]
@@ -62,17 +62,38 @@ class MultiViewRecording:
     truth: GroundTruth | None
 
 
-def load_mot_detections(path: str | Path, max_frames: int) -> list[np.ndarray]:
+def outside_area(points_m, area_m) -> np.ndarray:
+    """Which ground points (..., 2) m lie outside area_m [[x0, y0], [x1, y1]] (its edges are inside):
+    (...,) bool, False for NaN (an absent person)."""
+    points_m = np.asarray(points_m, dtype=float)
+    (x0, y0), (x1, y1) = area_m
+    with np.errstate(invalid="ignore"):
+        x_m, y_m = points_m[..., 0], points_m[..., 1]
+        return (x_m < x0) | (x_m > x1) | (y_m < y0) | (y_m > y1)
+
+
+def load_mot_detections(
+    path: str | Path, max_frames: int, image_size_px: tuple[int, int] | None = None
+) -> list[np.ndarray]:
     """A MOTChallenge detection file (``frame,-1,left,top,width,height,score,...``, frames from 1)
     as per-frame boxes (K, 5) ``(left, top, width, height, score)``, from frame 0 to the file's last,
-    which may be at most ``max_frames``."""
-    table = read_mot_rows(path, "detection")
+    which may be at most ``max_frames``; with the view's ``image_size_px`` (width, height), every box
+    must overlap its image."""
+    table, line = read_mot_rows(path, "detection")
     frame = table[:, 0].astype(np.int64) - 1
+    refuse_rows_beyond(path, frame, line, max_frames, f"the {max_frames} frames a recording may have (memory)")
     frames = int(frame.max()) + 1
-    if frames > max_frames:
-        raise DatasetError(f"{path}: a row of frame {frames}; at most {max_frames} frames (memory)")
     if np.any((table[:, 4] <= 0) | (table[:, 5] <= 0)):
         raise DatasetError(f"{path}: a box has a width or height that is not positive")
+    if image_size_px is not None:
+        (width_px, height_px), (left, top, width, height) = image_size_px, table[:, 2:6].T
+        outside = (left >= width_px) | (top >= height_px) | (left + width <= 0) | (top + height <= 0)
+        if outside.any():
+            first = int(np.argmax(outside))
+            raise DatasetError(
+                f"{path}: line {line[first]}: the box at ({left[first]:g}, {top[first]:g}) px, {width[first]:g} x "
+                f"{height[first]:g} px, lies outside the view's {width_px}x{height_px} px image"
+            )
     order = np.argsort(frame, kind="stable")
     boxes = table[order][:, 2:7]
     bounds = np.searchsorted(frame[order], np.arange(frames + 1))
@@ -107,11 +128,9 @@ class ImageFolder:
         return image
 
 
-def mot_truth(path: str | Path, frames: int, frame_rate_hz: float) -> GroundTruth:
-    """Ground truth (frames, N, 2) m from a MOTChallenge file with world metres in columns 8-9."""
-    annotations = load_mot_ground_truth(path)
-    if np.any(np.isnan(annotations.ground_m)):
-        raise DatasetError(f"{path}: columns 8-9 (world x, y in metres) must be numbers")
+def mot_truth(annotations: Annotations, frames: int, frame_rate_hz: float) -> GroundTruth:
+    """Ground truth (frames, N, 2) m of the first ``frames`` frames, from MOTChallenge annotations with
+    world metres in columns 8-9 (:func:`~ptztrack.scene.pets.load_mot_ground_truth`)."""
     scene = recorded_scene(annotations, 1, frames, frame_rate_hz)
     positions_m = np.full((frames, scene.truth.positions_m.shape[1], 2), np.nan)
     positions_m[scene.video_frame] = scene.truth.positions_m

@@ -30,21 +30,30 @@ class Annotations:
 
     frame : (K,) 0-based video frame; person_id : (K,);
     box_px : (K, 4) as (left, top, width, height);
-    ground_m : (K, 2) feet on the ground plane in metres (NaN where the format has none).
+    ground_m : (K, 2) feet on the ground plane in metres (NaN where the format has none);
+    line : (K,) each row's line in its file, where the format has rows (MOTChallenge), else None.
     """
 
     frame: np.ndarray
     person_id: np.ndarray
     box_px: np.ndarray
     ground_m: np.ndarray
+    line: np.ndarray | None = None
 
     @property
     def feet_px(self) -> np.ndarray:
         """(K, 2) bottom centre of each box."""
-        return np.stack([self.box_px[:, 0] + self.box_px[:, 2] / 2, self.box_px[:, 1] + self.box_px[:, 3]], axis=-1)
+        return box_feet_px(self.box_px)
 
     def select(self, keep) -> "Annotations":
-        return Annotations(self.frame[keep], self.person_id[keep], self.box_px[keep], self.ground_m[keep])
+        line = None if self.line is None else self.line[keep]
+        return Annotations(self.frame[keep], self.person_id[keep], self.box_px[keep], self.ground_m[keep], line)
+
+
+def box_feet_px(boxes_px) -> np.ndarray:
+    """Where the people of boxes (K, 4+) px (left, top, width, height, ...) stand: their bottom centres (K, 2) px."""
+    boxes_px = np.asarray(boxes_px, dtype=float)
+    return np.stack([boxes_px[:, 0] + boxes_px[:, 2] / 2, boxes_px[:, 1] + boxes_px[:, 3]], axis=-1)
 
 
 def load_mot_ground_truth(path: str | Path) -> Annotations:
@@ -52,18 +61,18 @@ def load_mot_ground_truth(path: str | Path) -> Annotations:
 
     Frames and ids must be whole numbers, each (frame, id) appear once, and every number be finite.
     """
-    table = read_mot_rows(path, "ground-truth")
+    table, line = read_mot_rows(path, "ground-truth")
     frame, person_id = table[:, 0].astype(np.int64), table[:, 1].astype(np.int64)
     _refuse_repeated_annotations(Path(path), frame, person_id)
-    return Annotations(frame=frame - 1, person_id=person_id, box_px=table[:, 2:6], ground_m=table[:, 7:9])
+    return Annotations(frame - 1, person_id, table[:, 2:6], table[:, 7:9], line)
 
 
-def read_mot_rows(path: str | Path, what: str) -> np.ndarray:
+def read_mot_rows(path: str | Path, what: str) -> tuple[np.ndarray, np.ndarray]:
     """The rows (K, 10) of a MOTChallenge file (ground truth or detections; ``.gz`` compressed or not),
-    checked: ten finite numbers a line, whole frames and ids, frames from 1. ``what`` names the kind
-    of file in errors."""
+    checked: ten finite numbers a line, whole frames and ids, frames from 1; and the line (K,) of each
+    in the file. ``what`` names the kind of file in errors."""
     path = Path(path)
-    rows = []
+    rows, lines = [], []
     for number, line in enumerate(read_text(path, what, GROUND_TRUTH_MAX_BYTES, DatasetError).splitlines(), 1):
         if not line.strip():
             continue
@@ -86,9 +95,20 @@ def read_mot_rows(path: str | Path, what: str) -> np.ndarray:
                 f"{path}: line {number}: frame {shown(fields[0])}; frames are numbered from 1 in MOTChallenge files"
             )
         rows.append(values)
+        lines.append(number)
     if not rows:
         raise DatasetError(f"{path}: no {what} rows")
-    return np.asarray(rows)
+    return np.asarray(rows), np.asarray(lines)
+
+
+def refuse_rows_beyond(path: str | Path, frame, line, frames: int, recording: str) -> None:
+    """A :class:`DatasetError` naming the first row of a MOTChallenge file whose frame the recording
+    does not have: frame (K,) 0-based, line (K,) each row's line, ``frames`` how many the recording has,
+    ``recording`` those frames in words (e.g. "the 795 frames of the video v.avi")."""
+    beyond = np.flatnonzero(np.asarray(frame) >= frames)
+    if len(beyond):
+        first = beyond[np.argmin(np.asarray(line)[beyond])]
+        raise DatasetError(f"{path}: line {line[first]}: frame {frame[first] + 1} is beyond {recording}")
 
 
 def _refuse_repeated_annotations(path: Path, frame: np.ndarray, person_id: np.ndarray) -> None:
@@ -191,7 +211,8 @@ def recorded_scene(
     NaN, which nothing on this path reads (detections come from the boxes).
     """
     first, stop = frame_range if frame_range is not None else (0, annotations.frame.max() + 1)
-    video_frame = np.arange(first, stop, frame_step)[:steps]
+    # Not arange(first, stop)[:steps]: an annotation of a distant frame would make it gigabytes.
+    video_frame = np.arange(first, min(stop, first + steps * frame_step), frame_step)
     kept = annotations.select(np.isin(annotations.frame, video_frame))
     person_id = np.unique(kept.person_id)
     positions_m = np.full((len(video_frame), len(person_id), 2), np.nan)
