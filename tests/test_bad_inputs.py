@@ -10,6 +10,7 @@ Neither checks how long a case takes on the clock: a case that hangs is stopped 
 fails; one that does the work a bad input asked for shows in its memory.
 """
 
+import contextlib
 import json
 import logging
 import os
@@ -23,6 +24,7 @@ import pytest
 
 from bad_inputs import Case, cases, run_case, write_case
 from ptztrack.cli import main
+from ptztrack.cli.interrupt import INTERRUPTED
 
 LINE_MAX_CHARACTERS = 300
 MEMORY_MAX_MB = 1024.0
@@ -127,29 +129,89 @@ def test_in_a_fresh_process_one_clear_line_and_little_resident_memory(corpus, na
     assert outcome.peak_memory_mb < MEMORY_MAX_MB
 
 
-@pytest.mark.slow
-@pytest.mark.parametrize("delay_s", [1.0, 8.0], ids=["while-numba-compiles", "while-it-runs"])
-def test_ctrl_c_stops_a_run_in_one_line_and_leaves_no_folder(tmp_path, delay_s):
-    out = tmp_path / "run"
-    process = subprocess.Popen(
-        [sys.executable, "-m", "ptztrack.cli", "run", "--frames", "2000", "--out", str(out)],
+CTRL_C_DELAYS_S = (1.0, 3.0, 8.0)
+"""When the Ctrl-C test interrupts a run: while its modules load, while its world is built, while Numba
+compiles (on an empty cache, as on a new machine: its first functions take seconds to compile)."""
+STOP_S = 2.0
+"""How long after Ctrl-C a command may take to end."""
+
+
+def start_command(argv: list[str], **options) -> subprocess.Popen:
+    """The command in a fresh process, its stderr piped, with SIGINT's default disposition: a test run
+    in the background of a non-interactive shell inherits SIGINT ignored, which would keep Python from
+    installing its handler."""
+    return subprocess.Popen(
+        [sys.executable, "-m", "ptztrack.cli", *argv],
         stdout=subprocess.DEVNULL,
         stderr=subprocess.PIPE,
         text=True,
-        # A test run in the background of a non-interactive shell inherits SIGINT ignored, which would
-        # keep Python from installing its handler: give the command the disposition a terminal gives.
         preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
-        # An empty cache makes Numba compile everything, as on a new machine: the first Ctrl-C comes then.
-        env={**os.environ, "NUMBA_CACHE_DIR": str(tmp_path.parent / f"numba-cache-{delay_s:g}")},
+        **options,
     )
-    time.sleep(delay_s)
-    assert process.poll() is None, "the run ended before it could be interrupted"
-    process.send_signal(signal.SIGINT)
-    _, stderr = process.communicate(timeout=60)
-    assert process.returncode == 130
-    assert stderr.strip().splitlines() == ["ptztrack: interrupted; nothing was left half-written"]
-    assert not out.exists()
-    assert os.listdir(tmp_path) == []
+
+
+def stopped_within(process: subprocess.Popen, seconds: float) -> str:
+    """The stderr of ``process``, which must end within ``seconds``."""
+    started = time.monotonic()
+    try:
+        _, stderr = process.communicate(timeout=seconds)
+    except subprocess.TimeoutExpired:
+        process.kill()
+        process.communicate()
+        raise AssertionError(f"still running {seconds:g} s after Ctrl-C") from None
+    assert time.monotonic() - started < seconds
+    return stderr
+
+
+@pytest.mark.slow
+def test_ctrl_c_stops_a_run_within_two_seconds_in_one_line_and_leaves_no_folder(tmp_path):
+    # Started together and interrupted in turn: one run's wait is the next one's start.
+    outputs = tmp_path / "outputs"
+    outputs.mkdir()
+    runs = {
+        delay_s: start_command(
+            ["run", "--frames", "20000", "--out", str(outputs / f"run-{delay_s:g}")],
+            env={**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / f"numba-cache-{delay_s:g}")},
+        )
+        for delay_s in CTRL_C_DELAYS_S
+    }
+    started = time.monotonic()
+    try:
+        for delay_s, process in runs.items():
+            time.sleep(max(0.0, started + delay_s - time.monotonic()))
+            assert process.poll() is None, f"the run ended before {delay_s:g} s"
+            process.send_signal(signal.SIGINT)
+            stderr = stopped_within(process, STOP_S)
+            assert process.returncode == 130, (delay_s, stderr)
+            assert stderr.strip().splitlines() == [INTERRUPTED], delay_s
+    finally:
+        for process in runs.values():
+            process.kill()
+            process.communicate()
+    assert os.listdir(outputs) == []
+
+
+@pytest.mark.slow
+def test_ctrl_c_to_the_process_and_its_group_at_once_stops_an_experiment_in_one_line(tmp_path):
+    """As a terminal's Ctrl-C (the group: the command and the local executor's workers) with a
+    supervisor's (the command), twice more while it stops."""
+    json = tmp_path / "follow.json"
+    process = start_command(["experiment", "follow", "--json", str(json)], start_new_session=True)
+    try:
+        assert "closed-loop runs, local executor" in process.stderr.readline()
+        time.sleep(0.5)  # the workers have started
+        for gap_s in (0.0, 0.01, 0.05):
+            time.sleep(gap_s)
+            with contextlib.suppress(ProcessLookupError):
+                os.kill(process.pid, signal.SIGINT)
+                os.killpg(process.pid, signal.SIGINT)
+        stderr = stopped_within(process, STOP_S)
+    finally:
+        process.kill()
+        process.communicate()
+    assert process.returncode == 130, stderr
+    assert stderr.strip().splitlines() == [INTERRUPTED]
+    assert not json.exists()
 
 
 def test_a_failed_run_leaves_an_old_folder_as_it_was(tmp_path, capsys):

@@ -14,7 +14,7 @@ import os
 import sys
 
 from ptztrack.cli.arguments import parser
-from ptztrack.cli.interrupt import catch_interrupts
+from ptztrack.cli.interrupt import catch_interrupts, interrupt_wins, stopped
 from ptztrack.files import InputError, check_output_file, check_output_folder
 
 __all__ = ["main", "parser", "check_outputs"]
@@ -38,16 +38,16 @@ def main(argv: list[str] | None = None) -> int:
     logging.basicConfig(level=logging.WARNING, format="ptztrack: %(message)s")
     catch_interrupts()
     try:
-        args = parser().parse_args(argv)
-        check_outputs(args)
-        module, _, function = args.handler.partition(":")
-        return getattr(importlib.import_module(module), function)(args)
+        with interrupt_wins():
+            args = parser().parse_args(argv)
+            check_outputs(args)
+            module, _, function = args.handler.partition(":")
+            return getattr(importlib.import_module(module), function)(args)
     except (InputError, RuntimeError) as error:
         print(f"ptztrack: error: {error}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
-        print("ptztrack: interrupted; nothing was left half-written", file=sys.stderr)
-        return 130
+        return stopped()
     except BrokenPipeError:
         # The reader (say, `head`) has gone: stop quietly, and keep Python from
         # complaining again when it flushes stdout at exit.
