@@ -36,6 +36,7 @@ class Case:
     argv: tuple[str, ...]
     files: dict[str, bytes | str | None] = field(default_factory=dict)  # None: no such file
     exit_status: int = 2
+    says: str = ""  # part of the one line ({dir}: the scratch directory)
 
 
 def _scenario(name: str, text: str | bytes, *extra: str, exit_status: int = 2) -> Case:
@@ -203,6 +204,16 @@ def cases(scratch: Path | None) -> list[Case]:
         Case("--out names a file", ("run", *A_FEW_STEPS, "--out", "{dir}/file"), {"file": "keep me\n"}),
         Case("--out in a missing folder", ("run", *A_FEW_STEPS, "--out", "{dir}/missing/out")),
         Case("--out not empty", ("run", *A_FEW_STEPS, "--out", "{dir}/out"), {"out/metrics.json": "{}\n"}),
+        Case(
+            "--out where nothing can be written",
+            ("run", *A_FEW_STEPS, "--out", "/proc/x"),
+            says="--out /proc/x: cannot write into /proc (",
+        ),
+        Case(
+            "serve-camera: --truth-log where nothing can be written",
+            ("serve-camera", "--port", "0", "--truth-log", "/proc/x.csv"),
+            says="--truth-log /proc/x.csv: cannot write into /proc (",
+        ),
         Case(
             "--json in a missing folder",
             ("experiment", "synthetic", "--sequences", "1", *A_FEW_STEPS, "--json", "{dir}/missing/x.json"),

@@ -15,6 +15,7 @@ import json
 import logging
 import os
 import signal
+import stat
 import subprocess
 import sys
 import time
@@ -25,6 +26,7 @@ import pytest
 from bad_inputs import Case, cases, run_case, write_case
 from ptztrack.cli import main
 from ptztrack.cli.interrupt import INTERRUPTED
+from ptztrack.config import load_camera_calibration, write_camera_calibration
 
 LINE_MAX_CHARACTERS = 300
 MEMORY_MAX_MB = 1024.0
@@ -113,6 +115,7 @@ def test_every_bad_input_gets_one_clear_line_and_little_memory(corpus, imported_
     if case.exit_status == 2:
         assert len(lines) == 1 and len(lines[0]) <= LINE_MAX_CHARACTERS, lines
         assert lines[0].startswith("ptztrack") and "Traceback" not in stderr
+        assert case.says.replace("{dir}", str(tmp_path)) in lines[0]
     assert imported_mb + added_mb < MEMORY_MAX_MB, (imported_mb, added_mb)
 
 
@@ -224,6 +227,35 @@ def test_a_failed_run_leaves_an_old_folder_as_it_was(tmp_path, capsys):
     after = {path.name: path.read_bytes() for path in out.iterdir()}
     assert after.keys() == before.keys() and after["steps.csv"] != before["steps.csv"]
     assert sorted(os.listdir(tmp_path)) == ["run"]
+
+
+@pytest.fixture(params=[0o022, 0o077], ids=["umask-022", "umask-077"])
+def umask(request):
+    previous = os.umask(request.param)
+    yield request.param
+    os.umask(previous)
+
+
+def test_a_run_folder_and_its_files_get_the_users_umask(tmp_path, umask, capsys):
+    out = tmp_path / "run"
+    assert main(["run", "--frames", "2", "--policy", "fix", "--out", str(out)]) == 0
+    assert stat.S_IMODE(out.stat().st_mode) == 0o777 & ~umask
+    modes = {path.name: stat.S_IMODE(path.stat().st_mode) for path in out.iterdir()}
+    assert "episode.mp4" in modes and set(modes.values()) == {0o666 & ~umask}, modes
+
+
+def test_a_rewritten_file_keeps_its_mode_and_a_new_one_gets_the_umask(tmp_path, umask):
+    """As ``camera calibrate`` rewrites a calibration file, and ``--json`` replaces an earlier one."""
+    kept, new = tmp_path / "camera.yaml", tmp_path / "new.yaml"
+    kept.write_text("pan_deg: [-90, 90]\ntilt_deg: [-45, 45]\nzoom_curve: [[0, 1], [1, 4]]\n")
+    kept.chmod(0o640)
+    calibration = load_camera_calibration(kept).model_copy(update={"image_delay_s": 0.1})
+    write_camera_calibration(kept, calibration)
+    write_camera_calibration(new, calibration)
+    assert load_camera_calibration(kept).image_delay_s == 0.1
+    assert stat.S_IMODE(kept.stat().st_mode) == 0o640
+    assert stat.S_IMODE(new.stat().st_mode) == 0o666 & ~umask
+    assert sorted(os.listdir(tmp_path)) == ["camera.yaml", "new.yaml"]
 
 
 def test_metrics_of_a_run_without_people_are_strict_json_saying_why(tmp_path):

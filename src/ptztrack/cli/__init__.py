@@ -22,9 +22,9 @@ __all__ = ["main", "parser", "check_outputs"]
 
 def check_outputs(args: argparse.Namespace) -> None:
     """Refuse, before any work, output paths that could not be written."""
-    for option in ("json", "plot", "trails", "truth_log"):
-        if getattr(args, option, None) is not None:
-            check_output_file(getattr(args, option), f"--{option}")
+    for name in ("json", "plot", "trails", "truth_log"):
+        if getattr(args, name, None) is not None:
+            check_output_file(getattr(args, name), "--" + name.replace("_", "-"))  # as the option is typed
     if getattr(args, "index", None) is not None and not args.index.exists():
         check_output_file(args.index, "--index")
     if getattr(args, "out", None) is not None:
