@@ -45,9 +45,9 @@ def _scenario(name: str, text: str | bytes, *extra: str, exit_status: int = 2) -
     return Case(name, ("run", "--scenario", "{dir}/s.yaml", *steps, *extra), {"s.yaml": text}, exit_status)
 
 
-def _recording(name: str, option: str, filename: str, content: bytes | str, *extra: str) -> Case:
+def _recording(name: str, option: str, filename: str, content: bytes | str, *extra: str, says: str = "") -> Case:
     argv = ("run", "--scenario", "pets", *A_FEW_STEPS, option, f"{{dir}}/{filename}", *extra)
-    return Case(name, argv, {filename: content})
+    return Case(name, argv, {filename: content}, says=says)
 
 
 def _ground_truth(rows: list[str]) -> str:
@@ -65,18 +65,25 @@ def _xml_with_entity(declaration: str, reference: str) -> str:
     return f'<?xml version="1.0"?>\n<!DOCTYPE Camera [{declaration}]>\n{body}'
 
 
-def video_bytes(frames: int, size_px: tuple[int, int], directory: Path | None) -> bytes:
-    """A small MJPG AVI of ``frames`` grey frames of ``size_px`` (width, height); made in
-    ``directory``, or in a temporary one."""
+def video_bytes(frames: int, size_px: tuple[int, int], directory: Path | None, codec: str = "MJPG") -> bytes:
+    """A small AVI of ``frames`` grey frames of ``size_px`` (width, height) in ``codec`` (a fourcc);
+    made in ``directory``, or in a temporary one."""
     if directory is None:
         with tempfile.TemporaryDirectory() as scratch:
-            return video_bytes(frames, size_px, Path(scratch))
-    path = directory / f"video_{frames}_{size_px[0]}.avi"
-    writer = cv2.VideoWriter(str(path), cv2.VideoWriter_fourcc(*"MJPG"), 7.0, size_px)
+            return video_bytes(frames, size_px, Path(scratch), codec)
+    path = directory / f"video_{frames}_{size_px[0]}_{codec}.avi"
+    writer = cv2.VideoWriter(str(path), cv2.VideoWriter_fourcc(*codec), 7.0, size_px)
     for _ in range(frames):
         writer.write(np.full((size_px[1], size_px[0], 3), 128, np.uint8))
     writer.release()
     return path.read_bytes()
+
+
+def _truncated(video: bytes) -> bytes:
+    """The first half of a video, as a copy cut short leaves it: its header still counts every frame, and
+    a frame cut in the middle makes FFmpeg's decoder print lines of its own (MPEG-4 Part 2 does, as
+    PETS's MS-MPEG-4 does; MJPG does not)."""
+    return video[: len(video) // 2]
 
 
 YAML_LAUGHS = "a: &a [x, x, x, x, x, x, x, x, x]\n" + "".join(
@@ -192,6 +199,20 @@ def cases(scratch: Path | None) -> list[Case]:
             "hog",
             "--frames",
             "10",
+        ),
+        _recording(
+            "a truncated video",
+            "--video",
+            "cut.avi",
+            _truncated(video_bytes(40, (768, 576), scratch, "mp4v")),
+            "--frames",
+            "20",
+            says="cut.avi: the video cannot be read at frame 38, which the run needs",
+        ),
+        Case(
+            "a folder as the video",
+            ("run", "--scenario", "pets", *A_FEW_STEPS, "--video", "{dir}"),
+            says="{dir}: is a folder, expected a video file",
         ),
         _recording(
             "a video of the wrong size",

@@ -52,15 +52,25 @@ def read_bytes(path: str | Path, what: str, max_bytes: int, error_type: type[Inp
     try:
         with open(path, "rb") as file:
             data = file.read(max_bytes + 1)
-    except FileNotFoundError:
-        raise error_type(f"{path}: no such {what} file") from None
-    except IsADirectoryError:
-        raise error_type(f"{path}: is a folder, expected a {what} file") from None
+    except (FileNotFoundError, IsADirectoryError):
+        raise _not_a_file(path, what, error_type) from None
     except OSError as error:
         raise error_type(f"{path}: cannot read the {what} file ({error.strerror or error})") from None
     if len(data) > max_bytes:
         raise error_type(f"{path}: larger than {max_bytes / 1e6:g} MB, too large for a {what} file")
     return data
+
+
+def require_file(path: str | Path, what: str, error_type: type[InputError] = InputError) -> None:
+    """``error_type`` naming ``path`` unless it is a file (for a file a library opens itself, a video say)."""
+    if not Path(path).is_file():
+        raise _not_a_file(Path(path), what, error_type)
+
+
+def _not_a_file(path: Path, what: str, error_type: type[InputError]) -> InputError:
+    if path.is_dir():
+        return error_type(f"{path}: is a folder, expected a {what} file")
+    return error_type(f"{path}: no such {what} file")
 
 
 def read_text(path: str | Path, what: str, max_bytes: int, error_type: type[InputError] = InputError) -> str:

@@ -165,7 +165,9 @@ def run_otb_cell(cell: OnePassCell) -> dict:
     mine = annotations.frame[annotations.person_id == cell.target_id]
     frames = np.arange(mine.min(), mine.max() + 1)
     boxes = _boxes_by_frame(annotations, cell.target_id, frames)
-    video = RecordedVideo(cell.scenario.required_video("the one-pass benchmark"), recording.recorded_size_px)
+    video = RecordedVideo(
+        cell.scenario.required_video("the one-pass benchmark"), recording.recorded_size_px, int(frames[-1]) + 1
+    )
     rng = np.random.default_rng(episode_seeds(cell.seed)[4])
     source = target_source(cell.scenario, cell.tracker, rng)
     still = np.eye(3)
