@@ -242,6 +242,19 @@ def cases(scratch: Path | None) -> list[Case]:
         Case("--json names a folder", ("experiment", "synthetic", "--sequences", "1", *A_FEW_STEPS, "--json", "{dir}")),
         Case("--plot in a missing folder", ("experiment", "msg", "--runs", "1", "--plot", "{dir}/missing/x.png")),
         Case("--trails in a missing folder", ("experiment", "msg", "--runs", "1", "--trails", "{dir}/missing/x.png")),
+        Case(
+            "experiment follow: a person not annotated after one who is",
+            ("experiment", "follow", "--targets", "9", "999"),
+            says="gt_mot15.txt: no person 999 (the people are 1, 2,",
+        ),
+        Case(
+            "experiment follow: --otb-tracks 0", ("experiment", "follow", "--otb-tracks", "0"), says="expected 1 to 19"
+        ),
+        Case(
+            "experiment follow: --otb-tracks 1000",
+            ("experiment", "follow", "--otb-tracks", "1000"),
+            says="--otb-tracks 1000: expected 1 to 19, as ",
+        ),
         Case("scenario missing", ("run", "--scenario", "{dir}/missing.yaml")),
         _scenario("scenario a list", "- 1\n- 2\n"),
         _scenario("scenario a huge value", "frames: [" + ", ".join(["123456789"] * 20000) + "]\n"),
