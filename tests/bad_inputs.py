@@ -150,6 +150,11 @@ def cases(scratch: Path | None) -> list[Case]:
         _scenario("area_m 1e308", "area_m: [1e308, 1e308]\n"),
         _scenario("area_m inf", "area_m: [.inf, 15]\n"),
         Case("--seed -5", ("run", *A_FEW_STEPS, "--seed", "-5")),
+        Case(
+            "follow --target x",
+            ("follow", "--target", "x"),
+            says="error: argument --target: expected a whole number >= 0, got 'x'",
+        ),
         _recording(
             "XML external entity",
             "--calibration",
