@@ -295,6 +295,16 @@ def cases(scratch: Path | None) -> list[Case]:
         ),
         Case("live: not an ONVIF URL", ("live", "--camera", "rtsp://op:pw@127.0.0.1/x", "--calibration", "virtual")),
         Case(
+            "live: port 0",
+            ("live", "--camera", "onvif://127.0.0.1:0", "--calibration", "virtual"),
+            says="--camera onvif://127.0.0.1:0: the port is not a number from 1 to 65535",
+        ),
+        Case(
+            "live: a truth log that is not there",
+            ("live", "--camera", "onvif://127.0.0.1:9", "--calibration", "virtual", "--truth", "{dir}/missing.csv"),
+            says="{dir}/missing.csv: no such truth log file",
+        ),
+        Case(
             "live: --time-scale 0", ("live", "--camera", "127.0.0.1", "--calibration", "virtual", "--time-scale", "0")
         ),
         Case(

@@ -15,6 +15,7 @@ import json
 import logging
 import os
 import signal
+import socket
 import stat
 import subprocess
 import sys
@@ -227,6 +228,25 @@ def test_a_failed_run_leaves_an_old_folder_as_it_was(tmp_path, capsys):
     after = {path.name: path.read_bytes() for path in out.iterdir()}
     assert after.keys() == before.keys() and after["steps.csv"] != before["steps.csv"]
     assert sorted(os.listdir(tmp_path)) == ["run"]
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["serve-camera", "--port", "{port}"],
+        ["view", "{dir}", "--port", "{port}"],
+        ["run", "--frames", "2", "--view", "{port}"],
+    ],
+    ids=["serve-camera", "view", "run --view"],
+)
+def test_a_port_another_program_listens_on_is_named_in_one_line(tmp_path, capfd, argv):
+    with socket.create_server(("127.0.0.1", 0)) as busy:
+        port = busy.getsockname()[1]
+        assert main([part.format(port=port, dir=tmp_path) for part in argv]) == 2
+    option = argv[-2]
+    assert capfd.readouterr().err.splitlines() == [
+        f"ptztrack: error: {option} {port}: cannot listen on 127.0.0.1:{port} (Address already in use)"
+    ]
 
 
 @pytest.fixture(params=[0o022, 0o077], ids=["umask-022", "umask-077"])

@@ -11,13 +11,30 @@ import argparse
 import importlib
 import logging
 import os
+import socket
 import sys
 
 from ptztrack.cli.arguments import parser
 from ptztrack.cli.interrupt import catch_interrupts, interrupt_wins, stopped
 from ptztrack.files import InputError, check_output_file, check_output_folder
+from ptztrack.names import LOOPBACK
 
-__all__ = ["main", "parser", "check_outputs"]
+__all__ = ["main", "parser", "check_outputs", "check_ports"]
+
+
+def check_ports(args: argparse.Namespace) -> None:
+    """Refuse, before any work, a port of ``--port`` or ``--view`` that another program listens on."""
+    for name in ("port", "view"):
+        port = getattr(args, name, None)
+        if not port:  # none, or 0: any free one
+            continue
+        with socket.socket() as probe:
+            # As the servers bind: a port that only closed connections still hold is free to them.
+            probe.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+            try:
+                probe.bind((LOOPBACK, port))
+            except OSError as error:
+                raise InputError(f"--{name} {port}: cannot listen on {LOOPBACK}:{port} ({error.strerror})") from None
 
 
 def check_outputs(args: argparse.Namespace) -> None:
@@ -41,6 +58,7 @@ def main(argv: list[str] | None = None) -> int:
         with interrupt_wins():
             args = parser().parse_args(argv)
             check_outputs(args)
+            check_ports(args)
             module, _, function = args.handler.partition(":")
             return getattr(importlib.import_module(module), function)(args)
     except (InputError, RuntimeError) as error:
