@@ -113,6 +113,7 @@ def _dataset(
     extra: tuple = (),
     exit_status: int = 2,
     area: str = "[[-12, -13], [-3, -5]]",
+    says: str = "",
 ) -> Case:
     """A one-view PETS dataset file (``view``: the view's fields besides its name and calibration;
     ``top``: more top-level lines), its calibration, two frames of detections and the first
@@ -124,7 +125,13 @@ def _dataset(
     )
     given = {"d.yaml": document, "c.xml": TSAI, "det.txt": "\n".join(DETECTION_ROWS) + "\n"}
     given["gt.txt"] = _ground_truth([row for row in GROUND_TRUTH_ROWS if row.split(",")[0] in ("1", "2")])
-    return Case(name, ("experiment", "occupancy", "{dir}/d.yaml", *extra), {**given, **(files or {})}, exit_status)
+    argv = ("experiment", "occupancy", "{dir}/d.yaml", *extra)
+    return Case(name, argv, {**given, **(files or {})}, exit_status, says)
+
+
+def _png(size_px: tuple[int, int]) -> bytes:
+    """A grey PNG image of ``size_px`` (width, height)."""
+    return cv2.imencode(".png", np.full((size_px[1], size_px[0], 3), 128, np.uint8))[1].tobytes()
 
 
 @functools.cache
@@ -284,6 +291,13 @@ def cases(scratch: Path | None) -> list[Case]:
         _dataset("dataset area outside the view's image", area="[[-40, 0], [-30, 10]]"),
         _dataset("dataset area partly seen", extra=("--methods",), area="[[-20, -15], [20, 25]]", exit_status=0),
         _dataset("dataset calibration of another size", view="detections: det.txt, image_size_px: [640, 480]"),
+        _dataset(
+            "dataset image folder whose last frame has another size",
+            view="images: frames",
+            files={f"frames/{frame}.png": _png((768, 576)) for frame in ("0001", "0002")}
+            | {"frames/0003.png": _png((640, 480))},
+            says="frames/0003.png: 640x480 px, but 0001.png is 768x576 px",
+        ),
         _dataset("detections frame 1e9", files={"det.txt": "1000000000,-1,300,200,40,100,0.9,-1,-1,-1\n"}),
         _dataset("detections a box of width 0", files={"det.txt": "1,-1,300,200,0,100,0.9,-1,-1,-1\n"}),
         _dataset("detections 9 fields", files={"det.txt": "1,-1,300,200,40,100,0.9,-1,-1\n"}),

@@ -22,12 +22,15 @@ import sys
 import time
 import warnings
 
+import PIL.Image
 import pytest
 
 from bad_inputs import Case, cases, run_case, write_case
 from ptztrack.cli import main
 from ptztrack.cli.interrupt import INTERRUPTED
 from ptztrack.config import load_camera_calibration, write_camera_calibration
+from ptztrack.occupancy.multiview import ImageFolder
+from ptztrack.scene.pets import DatasetError
 
 LINE_MAX_CHARACTERS = 300
 MEMORY_MAX_MB = 1024.0
@@ -247,6 +250,19 @@ def test_a_port_another_program_listens_on_is_named_in_one_line(tmp_path, capfd,
     assert capfd.readouterr().err.splitlines() == [
         f"ptztrack: error: {option} {port}: cannot listen on 127.0.0.1:{port} (Address already in use)"
     ]
+
+
+def test_an_image_folder_is_sized_as_opencv_decodes_it(tmp_path):
+    """A JPEG turned by its EXIF orientation (a phone's) has the size of the plain image it decodes to."""
+    exif = PIL.Image.Exif()
+    exif[0x0112] = 6  # rotated 90 degrees
+    PIL.Image.new("RGB", (64, 32)).save(tmp_path / "1.jpg", exif=exif.tobytes())
+    PIL.Image.new("RGB", (32, 64)).save(tmp_path / "2.jpg")
+    folder = ImageFolder(tmp_path)
+    assert folder.frame(0).shape == folder.frame(1).shape == (64, 32, 3)
+    PIL.Image.new("RGB", (64, 32)).save(tmp_path / "3.jpg")
+    with pytest.raises(DatasetError, match=r"3.jpg: 64x32 px, but 1.jpg is 32x64 px"):
+        ImageFolder(tmp_path)
 
 
 @pytest.fixture(params=[0o022, 0o077], ids=["umask-022", "umask-077"])
