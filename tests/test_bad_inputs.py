@@ -6,8 +6,9 @@ exit 0 where the input is legitimate), in less than 1 GB of resident memory: wha
 after importing the command, plus what the case's run adds to this process's peak (Linux's peak resident
 memory, reset before each case). The memory bombs, a legitimate input and an argparse error also run in a
 fresh process as a user runs the command: the exit status, the one line, under 1 GB of peak resident memory.
-Neither checks how long a case takes on the clock: a case that hangs is stopped after ``HANG_S`` and
-fails; one that does the work a bad input asked for shows in its memory.
+In-process, a refused case must also end within ``SECONDS_MAX`` (a bad input is checked before the
+work; a case that hangs is stopped after ``HANG_S``) and leave its scratch folder as it was: nothing
+written, not even a temporary.
 """
 
 import contextlib
@@ -21,6 +22,8 @@ import subprocess
 import sys
 import time
 import warnings
+from dataclasses import dataclass
+from pathlib import Path
 
 import PIL.Image
 import pytest
@@ -34,6 +37,7 @@ from ptztrack.scene.pets import DatasetError
 
 LINE_MAX_CHARACTERS = 300
 MEMORY_MAX_MB = 1024.0
+SECONDS_MAX = 10.0
 HANG_S = 60.0
 """A case still running after this long is a hang (the fresh-process runner kills it then too)."""
 IN_A_FRESH_PROCESS = [
@@ -74,11 +78,24 @@ class Hung(BaseException):
     command's own handlers do not turn it into an exit status)."""
 
 
-def run_in_process(case: Case, directory, capfd, caplog) -> tuple[int, list[str], str, float]:
-    """The exit status, the lines a user would see on stderr (written, logged, warned), all of stderr,
-    and how much the run raised the peak resident memory above what it found, in MB, of ``main`` on
-    the case."""
+@dataclass(frozen=True)
+class InProcess:
+    """What ``main`` did with a case: its exit status, the lines a user would see on stderr (written,
+    logged, warned), all of stderr, how much it raised the peak resident memory above what it found
+    (MB), how long it took (s), and the files it left in the case's folder beside the case's own."""
+
+    status: int
+    lines: list[str]
+    stderr: str
+    added_mb: float
+    seconds: float
+    written: set
+
+
+def run_in_process(case: Case, directory: Path, capfd, caplog) -> InProcess:
+    """``main`` on the case, its files written into ``directory``."""
     argv = write_case(case, directory)
+    given = files_in(directory)
     capfd.readouterr()
     caplog.clear()
 
@@ -90,6 +107,7 @@ def run_in_process(case: Case, directory, capfd, caplog) -> tuple[int, list[str]
     with open("/proc/self/clear_refs", "w") as clear_refs:
         clear_refs.write("5")  # the peak resident memory starts again from the current
     before_mb, _ = resident_mb()
+    started = time.monotonic()
     try:
         with warnings.catch_warnings(record=True) as caught:
             # Python's default filters outside pytest: what a user would see printed.
@@ -103,24 +121,30 @@ def run_in_process(case: Case, directory, capfd, caplog) -> tuple[int, list[str]
     finally:
         signal.setitimer(signal.ITIMER_REAL, 0.0)
         signal.signal(signal.SIGALRM, previous)
+    seconds = time.monotonic() - started
     added_mb = resident_mb()[1] - before_mb
     stderr = capfd.readouterr().err
     lines = stderr.strip().splitlines()
     lines += [f"ptztrack: {record.getMessage()}" for record in caplog.records if record.levelno >= logging.WARNING]
     lines += [f"{warning.category.__name__}: {warning.message}" for warning in caught]
-    return status, lines, stderr, added_mb
+    return InProcess(status, lines, stderr, added_mb, seconds, files_in(directory) - given)
+
+
+def files_in(directory: Path) -> set[Path]:
+    return {path.relative_to(directory) for path in directory.rglob("*")}
 
 
 @pytest.mark.parametrize("name", [case.name for case in cases(None)])
 def test_every_bad_input_gets_one_clear_line_and_little_memory(corpus, imported_mb, name, tmp_path, capfd, caplog):
     case = corpus[name]
-    status, lines, stderr, added_mb = run_in_process(case, tmp_path, capfd, caplog)
-    assert status == case.exit_status, lines
+    run = run_in_process(case, tmp_path, capfd, caplog)
+    assert run.status == case.exit_status, run.lines
     if case.exit_status == 2:
-        assert len(lines) == 1 and len(lines[0]) <= LINE_MAX_CHARACTERS, lines
-        assert lines[0].startswith("ptztrack") and "Traceback" not in stderr
-        assert case.says.replace("{dir}", str(tmp_path)) in lines[0]
-    assert imported_mb + added_mb < MEMORY_MAX_MB, (imported_mb, added_mb)
+        assert len(run.lines) == 1 and len(run.lines[0]) <= LINE_MAX_CHARACTERS, run.lines
+        assert run.lines[0].startswith("ptztrack") and "Traceback" not in run.stderr
+        assert case.says.replace("{dir}", str(tmp_path)) in run.lines[0]
+        assert run.seconds < SECONDS_MAX and not run.written, (run.seconds, run.written)
+    assert imported_mb + run.added_mb < MEMORY_MAX_MB, (imported_mb, run.added_mb)
 
 
 @pytest.mark.slow
