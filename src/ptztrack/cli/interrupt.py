@@ -41,7 +41,7 @@ _watching = threading.Lock()
 
 def _on_sigint(signum, frame) -> None:
     _interrupted.set()
-    if _raised.is_set():  # a Ctrl-C that came before the handler ignored them
+    if _raised.is_set():  # a Ctrl-C that arrived before SIGINT was ignored, handled only now
         return
     if _inside_compiler(frame):
         if _watching.acquire(blocking=False):
@@ -104,8 +104,8 @@ def raise_if_interrupted() -> None:
 @contextmanager
 def interrupt_wins() -> Iterator[None]:
     """After a Ctrl-C, whatever exception ends the block is the KeyboardInterrupt: code that calls back
-    into Python turns one raised there into an error of its own (pydantic-core a SchemaError while a
-    model class is built, an extension module's import a SystemError)."""
+    into Python may turn one raised there into an error of its own (pydantic-core made it a SchemaError
+    while a model class was built, a traceback and exit status 1)."""
     try:
         yield
     except BaseException:

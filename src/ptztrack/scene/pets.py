@@ -241,7 +241,7 @@ class RecordedVideo:
                 f"{self.path}: the video cannot be read at frame {index}, which the run needs, though its header "
                 f"says {self.frame_count} frames (a truncated file?)"
             )
-        self._capture.release()
+        self._capture.release()  # frames are read forwards from the start: a seek is not exact in every codec
         self._open()
 
     def _open(self) -> None:
