@@ -68,18 +68,25 @@ def _xml_with_entity(declaration: str, reference: str) -> str:
     return f'<?xml version="1.0"?>\n<!DOCTYPE Camera [{declaration}]>\n{body}'
 
 
-def video_bytes(frames: int, size_px: tuple[int, int], directory: Path | None) -> bytes:
-    """A small MJPG AVI of ``frames`` grey frames of ``size_px`` (width, height); made in
-    ``directory``, or in a temporary one."""
+def video_bytes(frames: int, size_px: tuple[int, int], directory: Path | None, codec: str = "MJPG") -> bytes:
+    """A small AVI of ``frames`` grey frames of ``size_px`` (width, height) in ``codec`` (a fourcc);
+    made in ``directory``, or in a temporary one."""
     if directory is None:
         with tempfile.TemporaryDirectory() as scratch:
-            return video_bytes(frames, size_px, Path(scratch))
-    path = directory / f"video_{frames}_{size_px[0]}.avi"
-    writer = cv2.VideoWriter(str(path), cv2.VideoWriter_fourcc(*"MJPG"), 7.0, size_px)
+            return video_bytes(frames, size_px, Path(scratch), codec)
+    path = directory / f"video_{frames}_{size_px[0]}_{codec}.avi"
+    writer = cv2.VideoWriter(str(path), cv2.VideoWriter_fourcc(*codec), 7.0, size_px)
     for _ in range(frames):
         writer.write(np.full((size_px[1], size_px[0], 3), 128, np.uint8))
     writer.release()
     return path.read_bytes()
+
+
+def _truncated(video: bytes) -> bytes:
+    """The first half of a video, as a copy cut short leaves it: its header still counts every frame, and
+    a frame cut in the middle makes FFmpeg's decoder print lines of its own (MPEG-4 Part 2 does, as
+    PETS's MS-MPEG-4 does; MJPG does not)."""
+    return video[: len(video) // 2]
 
 
 YAML_LAUGHS = "a: &a [x, x, x, x, x, x, x, x, x]\n" + "".join(
@@ -142,6 +149,11 @@ def _dataset(
     )
 
 
+def _png(size_px: tuple[int, int]) -> bytes:
+    """A grey PNG image of ``size_px`` (width, height)."""
+    return cv2.imencode(".png", np.full((size_px[1], size_px[0], 3), 128, np.uint8))[1].tobytes()
+
+
 @functools.cache
 def _gzip_bomb(uncompressed_bytes: int) -> bytes:
     """A gzip file of ``uncompressed_bytes`` of commas, made in pieces (about 1000 times smaller)."""
@@ -165,6 +177,11 @@ def cases(scratch: Path | None) -> list[Case]:
         _scenario("area_m 1e308", "area_m: [1e308, 1e308]\n"),
         _scenario("area_m inf", "area_m: [.inf, 15]\n"),
         Case("--seed -5", ("run", *A_FEW_STEPS, "--seed", "-5")),
+        Case(
+            "follow --target x",
+            ("follow", "--target", "x"),
+            says=("error: argument --target: expected a whole number >= 0, got 'x'",),
+        ),
         _recording(
             "XML external entity",
             "--calibration",
@@ -216,6 +233,20 @@ def cases(scratch: Path | None) -> list[Case]:
             "10",
         ),
         _recording(
+            "a truncated video",
+            "--video",
+            "cut.avi",
+            _truncated(video_bytes(40, (768, 576), scratch, "mp4v")),
+            "--frames",
+            "20",
+            says=("cut.avi: the video cannot be read at frame 38, which the run needs",),
+        ),
+        Case(
+            "a folder as the video",
+            ("run", "--scenario", "pets", *A_FEW_STEPS, "--video", "{dir}"),
+            says=("{dir}: is a folder, expected a video file",),
+        ),
+        _recording(
             "a video of the wrong size",
             "--video",
             "small.avi",
@@ -227,12 +258,37 @@ def cases(scratch: Path | None) -> list[Case]:
         Case("--out in a missing folder", ("run", *A_FEW_STEPS, "--out", "{dir}/missing/out")),
         Case("--out not empty", ("run", *A_FEW_STEPS, "--out", "{dir}/out"), {"out/metrics.json": "{}\n"}),
         Case(
+            "--out where nothing can be written",
+            ("run", *A_FEW_STEPS, "--out", "/proc/x"),
+            says=("--out /proc/x: cannot write into /proc (",),
+        ),
+        Case(
+            "serve-camera: --truth-log where nothing can be written",
+            ("serve-camera", "--port", "0", "--truth-log", "/proc/x.csv"),
+            says=("--truth-log /proc/x.csv: cannot write into /proc (",),
+        ),
+        Case(
             "--json in a missing folder",
             ("experiment", "synthetic", "--sequences", "1", *A_FEW_STEPS, "--json", "{dir}/missing/x.json"),
         ),
         Case("--json names a folder", ("experiment", "synthetic", "--sequences", "1", *A_FEW_STEPS, "--json", "{dir}")),
         Case("--plot in a missing folder", ("experiment", "msg", "--runs", "1", "--plot", "{dir}/missing/x.png")),
         Case("--trails in a missing folder", ("experiment", "msg", "--runs", "1", "--trails", "{dir}/missing/x.png")),
+        Case(
+            "experiment follow: a person not annotated after one who is",
+            ("experiment", "follow", "--targets", "9", "999"),
+            says=("gt_mot15.txt: no person 999 (the people are 1, 2,",),
+        ),
+        Case(
+            "experiment follow: --otb-tracks 0",
+            ("experiment", "follow", "--otb-tracks", "0"),
+            says=("expected 1 to 19",),
+        ),
+        Case(
+            "experiment follow: --otb-tracks 1000",
+            ("experiment", "follow", "--otb-tracks", "1000"),
+            says=("--otb-tracks 1000: expected 1 to 19, as ",),
+        ),
         Case("scenario missing", ("run", "--scenario", "{dir}/missing.yaml")),
         _scenario("scenario a list", "- 1\n- 2\n"),
         _scenario("scenario a huge value", "frames: [" + ", ".join(["123456789"] * 20000) + "]\n"),
@@ -344,6 +400,13 @@ def cases(scratch: Path | None) -> list[Case]:
             },
             says=(f"gt.txt: line {len(FIRST_TWO_FRAMES) + 1}: frame 5 is beyond the 3 frames of the views' videos",),
         ),
+        _dataset(
+            "dataset image folder whose last frame has another size",
+            view="images: frames",
+            files={f"frames/{frame}.png": _png((768, 576)) for frame in ("0001", "0002")}
+            | {"frames/0003.png": _png((640, 480))},
+            says=("frames/0003.png: 640x480 px, but 0001.png is 768x576 px",),
+        ),
         _dataset("detections frame 1e9", files={"det.txt": "1000000000,-1,300,200,40,100,0.9,-1,-1,-1\n"}),
         _dataset("detections a box of width 0", files={"det.txt": "1,-1,300,200,0,100,0.9,-1,-1,-1\n"}),
         _dataset(
@@ -359,6 +422,16 @@ def cases(scratch: Path | None) -> list[Case]:
             files={"det.txt.gz": gzip.compress(b"1,-1,300,200,40,100,0.9,-1,-1,-1\n" * 100)[:-8]},
         ),
         Case("live: not an ONVIF URL", ("live", "--camera", "rtsp://op:pw@127.0.0.1/x", "--calibration", "virtual")),
+        Case(
+            "live: port 0",
+            ("live", "--camera", "onvif://127.0.0.1:0", "--calibration", "virtual"),
+            says=("--camera onvif://127.0.0.1:0: the port is not a number from 1 to 65535",),
+        ),
+        Case(
+            "live: a truth log that is not there",
+            ("live", "--camera", "onvif://127.0.0.1:9", "--calibration", "virtual", "--truth", "{dir}/missing.csv"),
+            says=("{dir}/missing.csv: no such truth log file",),
+        ),
         Case(
             "live: --time-scale 0", ("live", "--camera", "127.0.0.1", "--calibration", "virtual", "--time-scale", "0")
         ),

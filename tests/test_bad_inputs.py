@@ -7,26 +7,38 @@ field, the file, the bound), in less than 1 GB of resident memory: what a fresh 
 after importing the command, plus what the case's run adds to this process's peak (Linux's peak resident
 memory, reset before each case). The memory bombs, a legitimate input and an argparse error also run in a
 fresh process as a user runs the command: the exit status, the one line, under 1 GB of peak resident memory.
-Neither checks how long a case takes on the clock: a case that hangs is stopped after ``HANG_S`` and
-fails; one that does the work a bad input asked for shows in its memory.
+In-process, a refused case must also end within ``SECONDS_MAX`` (a bad input is checked before the
+work; a case that hangs is stopped after ``HANG_S``) and leave its scratch folder as it was: nothing
+written, not even a temporary.
 """
 
+import contextlib
 import json
 import logging
 import os
 import signal
+import socket
+import stat
 import subprocess
 import sys
 import time
 import warnings
+from dataclasses import dataclass
+from pathlib import Path
 
+import PIL.Image
 import pytest
 
 from bad_inputs import Case, cases, run_case, write_case
 from ptztrack.cli import main
+from ptztrack.cli.interrupt import INTERRUPTED
+from ptztrack.config import load_camera_calibration, write_camera_calibration
+from ptztrack.occupancy.multiview import ImageFolder
+from ptztrack.scene.pets import DatasetError
 
 LINE_MAX_CHARACTERS = 300
 MEMORY_MAX_MB = 1024.0
+SECONDS_MAX = 10.0
 HANG_S = 60.0
 """A case still running after this long is a hang (the fresh-process runner kills it then too)."""
 IN_A_FRESH_PROCESS = [
@@ -67,11 +79,24 @@ class Hung(BaseException):
     command's own handlers do not turn it into an exit status)."""
 
 
-def run_in_process(case: Case, directory, capfd, caplog) -> tuple[int, list[str], str, float]:
-    """The exit status, the lines a user would see on stderr (written, logged, warned), all of stderr,
-    and how much the run raised the peak resident memory above what it found, in MB, of ``main`` on
-    the case."""
+@dataclass(frozen=True)
+class InProcess:
+    """What ``main`` did with a case: its exit status, the lines a user would see on stderr (written,
+    logged, warned), all of stderr, how much it raised the peak resident memory above what it found
+    (MB), how long it took (s), and the files it left in the case's folder beside the case's own."""
+
+    status: int
+    lines: list[str]
+    stderr: str
+    added_mb: float
+    seconds: float
+    written: set
+
+
+def run_in_process(case: Case, directory: Path, capfd, caplog) -> InProcess:
+    """``main`` on the case, its files written into ``directory``."""
     argv = write_case(case, directory)
+    given = files_in(directory)
     capfd.readouterr()
     caplog.clear()
 
@@ -83,6 +108,7 @@ def run_in_process(case: Case, directory, capfd, caplog) -> tuple[int, list[str]
     with open("/proc/self/clear_refs", "w") as clear_refs:
         clear_refs.write("5")  # the peak resident memory starts again from the current
     before_mb, _ = resident_mb()
+    started = time.monotonic()
     try:
         with warnings.catch_warnings(record=True) as caught:
             # Python's default filters outside pytest: what a user would see printed.
@@ -96,24 +122,31 @@ def run_in_process(case: Case, directory, capfd, caplog) -> tuple[int, list[str]
     finally:
         signal.setitimer(signal.ITIMER_REAL, 0.0)
         signal.signal(signal.SIGALRM, previous)
+    seconds = time.monotonic() - started
     added_mb = resident_mb()[1] - before_mb
     stderr = capfd.readouterr().err
     lines = stderr.strip().splitlines()
     lines += [f"ptztrack: {record.getMessage()}" for record in caplog.records if record.levelno >= logging.WARNING]
     lines += [f"{warning.category.__name__}: {warning.message}" for warning in caught]
-    return status, lines, stderr, added_mb
+    return InProcess(status, lines, stderr, added_mb, seconds, files_in(directory) - given)
+
+
+def files_in(directory: Path) -> set[Path]:
+    return {path.relative_to(directory) for path in directory.rglob("*")}
 
 
 @pytest.mark.parametrize("name", [case.name for case in cases(None)])
 def test_every_bad_input_gets_one_clear_line_and_little_memory(corpus, imported_mb, name, tmp_path, capfd, caplog):
     case = corpus[name]
-    status, lines, stderr, added_mb = run_in_process(case, tmp_path, capfd, caplog)
-    assert status == case.exit_status, lines
+    run = run_in_process(case, tmp_path, capfd, caplog)
+    assert run.status == case.exit_status, run.lines
     if case.exit_status == 2:
-        assert len(lines) == 1 and len(lines[0]) <= LINE_MAX_CHARACTERS, lines
-        assert lines[0].startswith("ptztrack") and "Traceback" not in stderr
-    assert all(part in "\n".join(lines) for part in case.says), (case.says, lines)
-    assert imported_mb + added_mb < MEMORY_MAX_MB, (imported_mb, added_mb)
+        assert len(run.lines) == 1 and len(run.lines[0]) <= LINE_MAX_CHARACTERS, run.lines
+        assert run.lines[0].startswith("ptztrack") and "Traceback" not in run.stderr
+        assert run.seconds < SECONDS_MAX and not run.written, (run.seconds, run.written)
+    said = "\n".join(run.lines)
+    assert all(part.replace("{dir}", str(tmp_path)) in said for part in case.says), (case.says, run.lines)
+    assert imported_mb + run.added_mb < MEMORY_MAX_MB, (imported_mb, run.added_mb)
 
 
 @pytest.mark.slow
@@ -129,29 +162,89 @@ def test_in_a_fresh_process_one_clear_line_and_little_resident_memory(corpus, na
     assert outcome.peak_memory_mb < MEMORY_MAX_MB
 
 
-@pytest.mark.slow
-@pytest.mark.parametrize("delay_s", [1.0, 8.0], ids=["while-numba-compiles", "while-it-runs"])
-def test_ctrl_c_stops_a_run_in_one_line_and_leaves_no_folder(tmp_path, delay_s):
-    out = tmp_path / "run"
-    process = subprocess.Popen(
-        [sys.executable, "-m", "ptztrack.cli", "run", "--frames", "2000", "--out", str(out)],
+CTRL_C_DELAYS_S = (1.0, 3.0, 8.0)
+"""When the Ctrl-C test interrupts a run: while its modules load, while its world is built, while Numba
+compiles (on an empty cache, as on a new machine: its first functions take seconds to compile)."""
+STOP_S = 2.0
+"""How long after Ctrl-C a command may take to end."""
+
+
+def start_command(argv: list[str], **options) -> subprocess.Popen:
+    """The command in a fresh process, its stderr piped, with SIGINT's default disposition: a test run
+    in the background of a non-interactive shell inherits SIGINT ignored, which would keep Python from
+    installing its handler."""
+    return subprocess.Popen(
+        [sys.executable, "-m", "ptztrack.cli", *argv],
         stdout=subprocess.DEVNULL,
         stderr=subprocess.PIPE,
         text=True,
-        # A test run in the background of a non-interactive shell inherits SIGINT ignored, which would
-        # keep Python from installing its handler: give the command the disposition a terminal gives.
         preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
-        # An empty cache makes Numba compile everything, as on a new machine: the first Ctrl-C comes then.
-        env={**os.environ, "NUMBA_CACHE_DIR": str(tmp_path.parent / f"numba-cache-{delay_s:g}")},
+        **options,
     )
-    time.sleep(delay_s)
-    assert process.poll() is None, "the run ended before it could be interrupted"
-    process.send_signal(signal.SIGINT)
-    _, stderr = process.communicate(timeout=60)
-    assert process.returncode == 130
-    assert stderr.strip().splitlines() == ["ptztrack: interrupted; nothing was left half-written"]
-    assert not out.exists()
-    assert os.listdir(tmp_path) == []
+
+
+def stopped_within(process: subprocess.Popen, seconds: float) -> str:
+    """The stderr of ``process``, which must end within ``seconds``."""
+    started = time.monotonic()
+    try:
+        _, stderr = process.communicate(timeout=seconds)
+    except subprocess.TimeoutExpired:
+        process.kill()
+        process.communicate()
+        raise AssertionError(f"still running {seconds:g} s after Ctrl-C") from None
+    assert time.monotonic() - started < seconds
+    return stderr
+
+
+@pytest.mark.slow
+def test_ctrl_c_stops_a_run_within_two_seconds_in_one_line_and_leaves_no_folder(tmp_path):
+    # Started together and interrupted in turn: one run's wait is the next one's start.
+    outputs = tmp_path / "outputs"
+    outputs.mkdir()
+    runs = {
+        delay_s: start_command(
+            ["run", "--frames", "20000", "--out", str(outputs / f"run-{delay_s:g}")],
+            env={**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / f"numba-cache-{delay_s:g}")},
+        )
+        for delay_s in CTRL_C_DELAYS_S
+    }
+    started = time.monotonic()
+    try:
+        for delay_s, process in runs.items():
+            time.sleep(max(0.0, started + delay_s - time.monotonic()))
+            assert process.poll() is None, f"the run ended before {delay_s:g} s"
+            process.send_signal(signal.SIGINT)
+            stderr = stopped_within(process, STOP_S)
+            assert process.returncode == 130, (delay_s, stderr)
+            assert stderr.strip().splitlines() == [INTERRUPTED], delay_s
+    finally:
+        for process in runs.values():
+            process.kill()
+            process.communicate()
+    assert os.listdir(outputs) == []
+
+
+@pytest.mark.slow
+def test_ctrl_c_to_the_process_and_its_group_at_once_stops_an_experiment_in_one_line(tmp_path):
+    """As a terminal's Ctrl-C (the group: the command and the local executor's workers) with a
+    supervisor's (the command), twice more while it stops."""
+    json = tmp_path / "follow.json"
+    process = start_command(["experiment", "follow", "--json", str(json)], start_new_session=True)
+    try:
+        assert "closed-loop runs, local executor" in process.stderr.readline()
+        time.sleep(0.5)  # the workers have started
+        for gap_s in (0.0, 0.01, 0.05):
+            time.sleep(gap_s)
+            with contextlib.suppress(ProcessLookupError):
+                os.kill(process.pid, signal.SIGINT)
+                os.killpg(process.pid, signal.SIGINT)
+        stderr = stopped_within(process, STOP_S)
+    finally:
+        process.kill()
+        process.communicate()
+    assert process.returncode == 130, stderr
+    assert stderr.strip().splitlines() == [INTERRUPTED]
+    assert not json.exists()
 
 
 def test_a_failed_run_leaves_an_old_folder_as_it_was(tmp_path, capsys):
@@ -164,6 +257,67 @@ def test_a_failed_run_leaves_an_old_folder_as_it_was(tmp_path, capsys):
     after = {path.name: path.read_bytes() for path in out.iterdir()}
     assert after.keys() == before.keys() and after["steps.csv"] != before["steps.csv"]
     assert sorted(os.listdir(tmp_path)) == ["run"]
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["serve-camera", "--port", "{port}"],
+        ["view", "{dir}", "--port", "{port}"],
+        ["run", "--frames", "2", "--view", "{port}"],
+    ],
+    ids=["serve-camera", "view", "run --view"],
+)
+def test_a_port_another_program_listens_on_is_named_in_one_line(tmp_path, capfd, argv):
+    with socket.create_server(("127.0.0.1", 0)) as busy:
+        port = busy.getsockname()[1]
+        assert main([part.format(port=port, dir=tmp_path) for part in argv]) == 2
+    option = argv[-2]
+    assert capfd.readouterr().err.splitlines() == [
+        f"ptztrack: error: {option} {port}: cannot listen on 127.0.0.1:{port} (Address already in use)"
+    ]
+
+
+def test_an_image_folder_is_sized_as_opencv_decodes_it(tmp_path):
+    """A JPEG turned by its EXIF orientation (a phone's) has the size of the plain image it decodes to."""
+    exif = PIL.Image.Exif()
+    exif[0x0112] = 6  # rotated 90 degrees
+    PIL.Image.new("RGB", (64, 32)).save(tmp_path / "1.jpg", exif=exif.tobytes())
+    PIL.Image.new("RGB", (32, 64)).save(tmp_path / "2.jpg")
+    folder = ImageFolder(tmp_path)
+    assert folder.frame(0).shape == folder.frame(1).shape == (64, 32, 3)
+    PIL.Image.new("RGB", (64, 32)).save(tmp_path / "3.jpg")
+    with pytest.raises(DatasetError, match=r"3.jpg: 64x32 px, but 1.jpg is 32x64 px"):
+        ImageFolder(tmp_path)
+
+
+@pytest.fixture(params=[0o022, 0o077], ids=["umask-022", "umask-077"])
+def umask(request):
+    previous = os.umask(request.param)
+    yield request.param
+    os.umask(previous)
+
+
+def test_a_run_folder_and_its_files_get_the_users_umask(tmp_path, umask, capsys):
+    out = tmp_path / "run"
+    assert main(["run", "--frames", "2", "--policy", "fix", "--out", str(out)]) == 0
+    assert stat.S_IMODE(out.stat().st_mode) == 0o777 & ~umask
+    modes = {path.name: stat.S_IMODE(path.stat().st_mode) for path in out.iterdir()}
+    assert "episode.mp4" in modes and set(modes.values()) == {0o666 & ~umask}, modes
+
+
+def test_a_rewritten_file_keeps_its_mode_and_a_new_one_gets_the_umask(tmp_path, umask):
+    """As ``camera calibrate`` rewrites a calibration file, and ``--json`` replaces an earlier one."""
+    kept, new = tmp_path / "camera.yaml", tmp_path / "new.yaml"
+    kept.write_text("pan_deg: [-90, 90]\ntilt_deg: [-45, 45]\nzoom_curve: [[0, 1], [1, 4]]\n")
+    kept.chmod(0o640)
+    calibration = load_camera_calibration(kept).model_copy(update={"image_delay_s": 0.1})
+    write_camera_calibration(kept, calibration)
+    write_camera_calibration(new, calibration)
+    assert load_camera_calibration(kept).image_delay_s == 0.1
+    assert stat.S_IMODE(kept.stat().st_mode) == 0o640
+    assert stat.S_IMODE(new.stat().st_mode) == 0o666 & ~umask
+    assert sorted(os.listdir(tmp_path)) == ["camera.yaml", "new.yaml"]
 
 
 def test_metrics_of_a_run_without_people_are_strict_json_saying_why(tmp_path):

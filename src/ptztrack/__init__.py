@@ -11,9 +11,14 @@ Roles (protocols a new implementation follows): ``CameraBackend``, ``Detector``,
 ``registered_names``.
 """
 
+import os
 from importlib import import_module
 from importlib.metadata import PackageNotFoundError, version
 from typing import TYPE_CHECKING
+
+# FFmpeg's decoders print several lines of their own for each damaged frame (a truncated video's last);
+# every bad video gets one line of ptztrack's. OpenCV reads this once, when it first uses FFmpeg.
+os.environ.setdefault("OPENCV_FFMPEG_LOGLEVEL", "-8")
 
 try:
     __version__ = version("ptztrack")

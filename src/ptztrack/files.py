@@ -8,8 +8,9 @@ line naming the file, the field or position, and what was expected; a value is s
 import json
 import math
 import os
+import secrets
 import shutil
-import tempfile
+import stat
 import zlib
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -51,15 +52,25 @@ def read_bytes(path: str | Path, what: str, max_bytes: int, error_type: type[Inp
     try:
         with open(path, "rb") as file:
             data = file.read(max_bytes + 1)
-    except FileNotFoundError:
-        raise error_type(f"{path}: no such {what} file") from None
-    except IsADirectoryError:
-        raise error_type(f"{path}: is a folder, expected a {what} file") from None
+    except (FileNotFoundError, IsADirectoryError):
+        raise _not_a_file(path, what, error_type) from None
     except OSError as error:
         raise error_type(f"{path}: cannot read the {what} file ({error.strerror or error})") from None
     if len(data) > max_bytes:
         raise error_type(f"{path}: larger than {max_bytes / 1e6:g} MB, too large for a {what} file")
     return data
+
+
+def require_file(path: str | Path, what: str, error_type: type[InputError] = InputError) -> None:
+    """``error_type`` naming ``path`` unless it is a file (for a file a library opens itself, a video say)."""
+    if not Path(path).is_file():
+        raise _not_a_file(Path(path), what, error_type)
+
+
+def _not_a_file(path: Path, what: str, error_type: type[InputError]) -> InputError:
+    if path.is_dir():
+        return error_type(f"{path}: is a folder, expected a {what} file")
+    return error_type(f"{path}: no such {what} file")
 
 
 def read_text(path: str | Path, what: str, max_bytes: int, error_type: type[InputError] = InputError) -> str:
@@ -148,7 +159,7 @@ def write_atomically(path: Path, data: bytes) -> None:
     """Write ``data`` to ``path`` through a temporary file and a rename, so that
     a reader never sees a half-written file and an old file survives a failure."""
     path = Path(path)
-    handle, temporary = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    handle, temporary = open_temporary_beside(path)
     try:
         with os.fdopen(handle, "wb") as file:
             file.write(data)
@@ -158,12 +169,45 @@ def write_atomically(path: Path, data: bytes) -> None:
         raise
 
 
+def open_temporary_beside(path: Path, suffix: str = ".tmp") -> tuple[int, Path]:
+    """A new empty file beside ``path``, hidden, for what will be renamed to ``path``, and its handle open
+    for writing. Its mode is the one ``path`` has, or for a new file what any Unix tool gives one
+    (0666 less the umask); tempfile's would be 0600 whatever the umask."""
+    path = Path(path)
+    while True:
+        temporary = _name_beside(path, suffix)
+        try:
+            handle = os.open(temporary, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)
+            break
+        except FileExistsError:
+            continue
+    if path.exists():
+        os.fchmod(handle, stat.S_IMODE(path.stat().st_mode))
+    return handle, temporary
+
+
+def _folder_beside(path: Path, suffix: str) -> Path:
+    """A new empty folder beside ``path``, hidden, of the mode any Unix tool gives one (0777 less the
+    umask; tempfile's would be 0700)."""
+    while True:
+        folder = _name_beside(path, suffix)
+        try:
+            folder.mkdir(0o777)
+            return folder
+        except FileExistsError:
+            continue
+
+
+def _name_beside(path: Path, suffix: str) -> Path:
+    return path.absolute().parent / f".{path.name}.{secrets.token_hex(4)}{suffix}"
+
+
 def check_output_file(path: Path, option: str) -> None:
     """Refuse, before any work, an output file that could not be written: ``option`` names it."""
     path = Path(path)
     if path.is_dir():
         raise InputError(f"{option} {path}: is a folder, expected a file name")
-    _check_writable_folder(path.parent, option, path)
+    _check_writable_folder(path, option)
 
 
 def check_output_folder(path: Path, option: str, overwrite: bool) -> None:
@@ -173,16 +217,23 @@ def check_output_folder(path: Path, option: str, overwrite: bool) -> None:
         raise InputError(f"{option} {path}: is a file, expected a folder")
     if path.is_dir() and any(path.iterdir()) and not overwrite:
         raise InputError(f"{option} {path}: the folder is not empty (add --overwrite to replace it)")
-    _check_writable_folder(path.absolute().parent, option, path)
+    _check_writable_folder(path, option)
 
 
-def _check_writable_folder(folder: Path, option: str, path: Path) -> None:
+def _check_writable_folder(path: Path, option: str) -> None:
+    """Refuse an output whose folder cannot take the temporary it is written through: one is made and
+    removed (permissions alone do not say: root may write anywhere by them, but not into /proc)."""
+    folder = path.absolute().parent
     if folder.exists() and not folder.is_dir():
         raise InputError(f"{option} {path}: {folder} is a file, not a folder")
     if not folder.is_dir():
         raise InputError(f"{option} {path}: the folder {folder} does not exist")
-    if not os.access(folder, os.W_OK | os.X_OK):
-        raise InputError(f"{option} {path}: cannot write into {folder}")
+    try:
+        handle, probe = open_temporary_beside(path, ".probe")
+    except OSError as error:
+        raise InputError(f"{option} {path}: cannot write into {folder} ({error.strerror or error})") from None
+    os.close(handle)
+    probe.unlink()
 
 
 @contextmanager
@@ -192,11 +243,11 @@ def run_folder(path: Path, overwrite: bool = False) -> Iterator[Path]:
     removed, if ``overwrite``); on any exception, Ctrl-C included, the temporary folder is removed."""
     path = Path(path)
     check_output_folder(path, "output folder", overwrite)
-    temporary = Path(tempfile.mkdtemp(dir=path.absolute().parent, prefix=f".{path.name}.", suffix=".tmp"))
+    temporary = _folder_beside(path, ".tmp")
     try:
         yield temporary
         if path.exists():
-            retired = Path(tempfile.mkdtemp(dir=temporary.parent, prefix=f".{path.name}.", suffix=".old"))
+            retired = _folder_beside(path, ".old")
             os.replace(path, retired / path.name)
             os.replace(temporary, path)
             shutil.rmtree(retired)

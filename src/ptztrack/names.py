@@ -39,3 +39,6 @@ EXECUTORS = ("local", "ray", "serial")
 """Where an experiment's cells run (:mod:`ptztrack.evaluate.executors`)."""
 PASSWORD_VARIABLE = "PTZTRACK_CAMERA_PASSWORD"
 """The environment variable a camera's password is read from."""
+LOOPBACK = "127.0.0.1"
+"""The one interface ptztrack's servers listen on (the web view, the virtual ONVIF camera): never
+another, as they show a camera's pictures to whoever connects."""

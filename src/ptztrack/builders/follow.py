@@ -121,6 +121,17 @@ def mil_tracker(scenario: Scenario, world: World) -> TargetTracker:
     return _target_tracker(scenario, world, "mil")
 
 
+def refuse_unknown_people(ground_truth: str, annotated_ids, wanted) -> None:
+    """A :class:`ScenarioError` naming every id of ``wanted`` that ``ground_truth`` does not annotate
+    (``annotated_ids``: the ids it does, repeated or not)."""
+    known = np.unique(annotated_ids)
+    missing = [int(person) for person in wanted if person not in known]
+    if missing:
+        people = ", ".join(str(person) for person in known)
+        names = f"person {missing[0]}" if len(missing) == 1 else f"people {', '.join(map(str, missing))}"
+        raise ScenarioError(f"{ground_truth}: no {names} (the people are {people})")
+
+
 def target_scenario(scenario: Scenario, target_id: int) -> Scenario:
     """The scenario narrowed to one person.
 
@@ -132,10 +143,8 @@ def target_scenario(scenario: Scenario, target_id: int) -> Scenario:
     """
     recording = scenario.required_recording("the follow camera")
     annotations = load_mot_ground_truth(recording.ground_truth)
+    refuse_unknown_people(recording.ground_truth, annotations.person_id, [target_id])
     rows = np.flatnonzero(annotations.person_id == target_id)
-    if len(rows) == 0:
-        known = ", ".join(str(i) for i in np.unique(annotations.person_id))
-        raise ScenarioError(f"{recording.ground_truth}: no person {target_id} (the people are {known})")
     rows = rows[np.argsort(annotations.frame[rows])]
     first, last = int(annotations.frame[rows[0]]), int(annotations.frame[rows[-1]])
     calibration = load_calibration(recording.calibration, recording.view)

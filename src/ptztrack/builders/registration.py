@@ -92,8 +92,9 @@ def reference_index(
     poses = scenario_reference_poses(scenario, whole_frame_pose)
 
     def build():
-        source = video or RecordedVideo(video_path, recording.recorded_size_px)
-        frames = [source.frame(int(frame)) for frame in reference_frames(len(poses))]
+        numbers = reference_frames(len(poses))
+        source = video or RecordedVideo(video_path, recording.recorded_size_px, int(numbers[-1]) + 1)
+        frames = [source.frame(int(frame)) for frame in numbers]
         rng = np.random.default_rng(REFERENCE_SEED)
         return build_reference_index(
             virtual, frames, poses, feedback.reference_pose_sigma_deg, feedback.reference_zoom_spread, rng

@@ -18,9 +18,11 @@ from dataclasses import dataclass
 from ipycam import NativeRTSPServer
 from ipycam.rtsp import RTSPSession, RTSPState
 
+from ptztrack.names import LOOPBACK
+
 log = logging.getLogger("ptztrack.onvif_server")
 
-HOST = "127.0.0.1"
+HOST = LOOPBACK
 # The session timeout the SETUP answers give (s): clients keep the session alive within it.
 SESSION_TIMEOUT_S = 60.0
 # What stop() waits for each thread: the longest is an ffmpeg encoder's exit (ipycam waits 2 s for it).

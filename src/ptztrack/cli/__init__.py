@@ -11,20 +11,37 @@ import argparse
 import importlib
 import logging
 import os
+import socket
 import sys
 
 from ptztrack.cli.arguments import parser
-from ptztrack.cli.interrupt import catch_interrupts
+from ptztrack.cli.interrupt import catch_interrupts, interrupt_wins, stopped
 from ptztrack.files import InputError, check_output_file, check_output_folder
+from ptztrack.names import LOOPBACK
 
-__all__ = ["main", "parser", "check_outputs"]
+__all__ = ["main", "parser", "check_outputs", "check_ports"]
+
+
+def check_ports(args: argparse.Namespace) -> None:
+    """Refuse, before any work, a port of ``--port`` or ``--view`` that another program listens on."""
+    for name in ("port", "view"):
+        port = getattr(args, name, None)
+        if not port:  # none, or 0: any free one
+            continue
+        with socket.socket() as probe:
+            # As the servers bind: a port that only closed connections still hold is free to them.
+            probe.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+            try:
+                probe.bind((LOOPBACK, port))
+            except OSError as error:
+                raise InputError(f"--{name} {port}: cannot listen on {LOOPBACK}:{port} ({error.strerror})") from None
 
 
 def check_outputs(args: argparse.Namespace) -> None:
     """Refuse, before any work, output paths that could not be written."""
-    for option in ("json", "plot", "trails", "truth_log"):
-        if getattr(args, option, None) is not None:
-            check_output_file(getattr(args, option), f"--{option}")
+    for name in ("json", "plot", "trails", "truth_log"):
+        if getattr(args, name, None) is not None:
+            check_output_file(getattr(args, name), "--" + name.replace("_", "-"))  # as the option is typed
     if getattr(args, "index", None) is not None and not args.index.exists():
         check_output_file(args.index, "--index")
     if getattr(args, "out", None) is not None:
@@ -38,16 +55,17 @@ def main(argv: list[str] | None = None) -> int:
     logging.basicConfig(level=logging.WARNING, format="ptztrack: %(message)s")
     catch_interrupts()
     try:
-        args = parser().parse_args(argv)
-        check_outputs(args)
-        module, _, function = args.handler.partition(":")
-        return getattr(importlib.import_module(module), function)(args)
+        with interrupt_wins():
+            args = parser().parse_args(argv)
+            check_outputs(args)
+            check_ports(args)
+            module, _, function = args.handler.partition(":")
+            return getattr(importlib.import_module(module), function)(args)
     except (InputError, RuntimeError) as error:
         print(f"ptztrack: error: {error}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
-        print("ptztrack: interrupted; nothing was left half-written", file=sys.stderr)
-        return 130
+        return stopped()
     except BrokenPipeError:
         # The reader (say, `head`) has gone: stop quietly, and keep Python from
         # complaining again when it flushes stdout at exit.

@@ -362,28 +362,10 @@ def _add_recording_arguments(command: argparse.ArgumentParser) -> None:
     recording.add_argument("--gt", type=Path, help="MOTChallenge ground truth with world positions in metres")
 
 
+# The types of the options: an error names what was expected and what was typed (argparse would say
+# "invalid _non_negative_int value" of a ValueError), after argparse's "argument --option: ".
 def _non_negative_float(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a number (got {text!r})") from None
-    if not (math.isfinite(value) and value >= 0):
-        raise argparse.ArgumentTypeError(f"must be a finite number of at least 0 (got {text})")
-    return value
-
-
-def _non_negative_int(text: str) -> int:
-    value = int(text)
-    if value < 0:
-        raise argparse.ArgumentTypeError(f"must be at least 0 (got {value})")
-    return value
-
-
-def _positive_int(text: str) -> int:
-    value = int(text)
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"must be at least 1 (got {value})")
-    return value
+    return _finite_number(text, 0.0, above=False)
 
 
 def _occupancy_frames(text: str) -> int:
@@ -396,14 +378,43 @@ def _occupancy_frames(text: str) -> int:
 
 
 def _positive_float(text: str) -> float:
-    value = _non_negative_float(text)
-    if value == 0:
-        raise argparse.ArgumentTypeError(f"must be above 0 (got {text})")
-    return value
+    return _finite_number(text, 0.0, above=True)
+
+
+def _non_negative_int(text: str) -> int:
+    return _whole_number(text, 0)
+
+
+def _positive_int(text: str) -> int:
+    return _whole_number(text, 1)
 
 
 def _port(text: str) -> int:
-    value = _non_negative_int(text)
-    if value > 65535:
-        raise argparse.ArgumentTypeError(f"must be a port from 0 to 65535 (got {value})")
+    value = _integer(text)
+    if value is None or not 0 <= value <= 65535:
+        raise argparse.ArgumentTypeError(f"expected a port from 0 to 65535, got {text!r}")
     return value
+
+
+def _finite_number(text: str, lowest: float, above: bool) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not (math.isfinite(value) and (value > lowest if above else value >= lowest)):
+        raise argparse.ArgumentTypeError(f"expected a finite number {'>' if above else '>='} {lowest:g}, got {text!r}")
+    return value
+
+
+def _whole_number(text: str, lowest: int) -> int:
+    value = _integer(text)
+    if value is None or value < lowest:
+        raise argparse.ArgumentTypeError(f"expected a whole number >= {lowest}, got {text!r}")
+    return value
+
+
+def _integer(text: str) -> int | None:
+    try:
+        return int(text)
+    except ValueError:
+        return None

@@ -35,7 +35,7 @@ from ptztrack.config import (
 from ptztrack.evaluate.metrics import episode_metrics
 from ptztrack.evaluate.report import write_outputs
 from ptztrack.evaluate.view_state import ViewState
-from ptztrack.files import read_text, run_folder
+from ptztrack.files import check_output_file, read_text, run_folder
 from ptztrack.names import PASSWORD_VARIABLE
 
 
@@ -98,6 +98,7 @@ def read_truth_log(path: Path) -> np.ndarray:
 
 def calibrate_camera_command(args: argparse.Namespace) -> int:
     calibration = load_camera_calibration(args.calibration)
+    check_output_file(args.calibration, "--calibration")  # rewritten after minutes of timed moves
     client = ONVIFClient(camera_address(args.camera, _credentials(args)), args.timeout_s)
     stream = None
     try:

@@ -72,10 +72,10 @@ def follow_command(args: argparse.Namespace) -> int:
 def follow_experiment_command(args: argparse.Namespace) -> int:
     scenario = _follow_scenario(args)
     cells = follow_cells(scenario, args.trackers, args.targets, args.seed)
+    otb_runs = otb_cells(scenario, args.trackers, args.otb_tracks, args.seed)
     print(f"{len(cells)} closed-loop runs, {args.executor} executor", file=sys.stderr)
     execution = Execution(args.executor, args.workers, args.quiet)
     people = run_experiment_cells(cells, run_follow_cell, execution)
-    otb_runs = otb_cells(scenario, args.trackers, args.otb_tracks, args.seed)
     print(f"{len(otb_runs)} one-pass runs on the still recording", file=sys.stderr)
     otb_people = run_experiment_cells(otb_runs, run_otb_cell, execution, "run")
     summary = summarise_follow_experiment(people, otb_people)

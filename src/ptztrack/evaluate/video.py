@@ -20,7 +20,6 @@ not in the pip wheels).
 
 import functools
 import os
-import tempfile
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
@@ -28,6 +27,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 
+from ptztrack.files import open_temporary_beside
 from ptztrack.geometry.ptz import PTZCamera, feet_jacobian, ground_footprint, project_people
 from ptztrack.loop import Episode, World
 from ptztrack.track.tracker import predicted_feet_px
@@ -170,10 +170,10 @@ def write_video(path: str | Path, frames: Iterable[np.ndarray], frame_rate_hz: f
     """Write ``frames`` ((height, width, 3) uint8 BGR of ``size_px`` (width, height)) to ``path`` (.mp4,
     MPEG-4 Part 2) through a temporary file beside it and a rename."""
     path = Path(path)
-    handle, temporary = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".mp4")
+    handle, temporary = open_temporary_beside(path, ".mp4")  # OpenCV picks the container by the suffix
     os.close(handle)
     try:
-        writer = cv2.VideoWriter(temporary, cv2.VideoWriter.fourcc(*"mp4v"), frame_rate_hz, tuple(size_px))
+        writer = cv2.VideoWriter(str(temporary), cv2.VideoWriter.fourcc(*"mp4v"), frame_rate_hz, tuple(size_px))
         try:
             if not writer.isOpened():
                 raise RuntimeError(f"{path}: OpenCV cannot write MPEG-4 video here")

@@ -30,7 +30,9 @@ from starlette.responses import HTMLResponse
 from starlette.routing import Route, WebSocketRoute
 from starlette.websockets import WebSocket, WebSocketDisconnect
 
-HOST = "127.0.0.1"  # never another interface: the view shows a camera's pictures
+from ptztrack.names import LOOPBACK
+
+HOST = LOOPBACK
 MAX_STATES_PER_S = 30.0  # faster than a page redraws is wasted work
 # The share of a fast run's CPU time for taking, building and sending states; the run loses about twice
 # that (the threads' switching, the caches), as benchmarks/view_overhead.py measures.

@@ -16,9 +16,9 @@ from functools import partial
 import numpy as np
 
 from ptztrack.builders.episode import episode_world, make_policy, run_episode
-from ptztrack.builders.follow import follow_parameters, target_scenario, target_source
+from ptztrack.builders.follow import follow_parameters, refuse_unknown_people, target_scenario, target_source
 from ptztrack.camera.recorded import RecordedPTZ
-from ptztrack.config import Scenario
+from ptztrack.config import Scenario, ScenarioError
 from ptztrack.follow.evaluation import follow_metrics, one_pass_scores, target_in_views
 from ptztrack.geometry.calibration import load_calibration, standing_height_px
 from ptztrack.loop import Episode, StepObserver, World, episode_seeds
@@ -61,8 +61,12 @@ def annotated_people(scenario: Scenario) -> np.ndarray:
 
 
 def follow_cells(scenario: Scenario, trackers, targets=None, seed: int = 0) -> list[FollowCell]:
-    """Every tracker on every person (all annotated people by default, by id)."""
-    people = sorted(annotated_people(scenario).tolist()) if targets is None else list(targets)
+    """Every tracker on every person (all annotated people by default, by id); a person the recording
+    does not annotate is refused before any runs."""
+    annotated = annotated_people(scenario)
+    if targets is not None:
+        refuse_unknown_people(scenario.required_recording("the follow experiment").ground_truth, annotated, targets)
+    people = sorted(annotated.tolist()) if targets is None else list(targets)
     return [FollowCell(scenario, tracker, int(person), seed) for tracker in trackers for person in people]
 
 
@@ -151,9 +155,14 @@ class OnePassCell:
 
 
 def otb_cells(scenario: Scenario, trackers, tracks: int = OTB_TRACKS, seed: int = 0) -> list[OnePassCell]:
-    """Every tracker on the ``tracks`` longest annotated people."""
-    longest = annotated_people(scenario)[:tracks]
-    return [OnePassCell(scenario, tracker, int(person), seed) for tracker in trackers for person in longest]
+    """Every tracker on the ``tracks`` longest annotated people (from 1 to all of them)."""
+    people = annotated_people(scenario)
+    if not 1 <= tracks <= len(people):
+        ground_truth = scenario.required_recording("the one-pass benchmark").ground_truth
+        raise ScenarioError(
+            f"--otb-tracks {tracks}: expected 1 to {len(people)}, as {ground_truth} annotates {len(people)} people"
+        )
+    return [OnePassCell(scenario, tracker, int(person), seed) for tracker in trackers for person in people[:tracks]]
 
 
 def run_otb_cell(cell: OnePassCell) -> dict:
@@ -165,7 +174,9 @@ def run_otb_cell(cell: OnePassCell) -> dict:
     mine = annotations.frame[annotations.person_id == cell.target_id]
     frames = np.arange(mine.min(), mine.max() + 1)
     boxes = _boxes_by_frame(annotations, cell.target_id, frames)
-    video = RecordedVideo(cell.scenario.required_video("the one-pass benchmark"), recording.recorded_size_px)
+    video = RecordedVideo(
+        cell.scenario.required_video("the one-pass benchmark"), recording.recorded_size_px, int(frames[-1]) + 1
+    )
     rng = np.random.default_rng(episode_seeds(cell.seed)[4])
     source = target_source(cell.scenario, cell.tracker, rng)
     still = np.eye(3)

@@ -67,7 +67,9 @@ def registration_views(
             f"({LIVE_GAP_FRAMES} frames after the last reference view's)"
         )
     frames = np.sort(rng.integers(first_frame, last_frame + 1, views))
-    video = RecordedVideo(scenario.required_video("the registration experiment"), recording.recorded_size_px)
+    video = RecordedVideo(
+        scenario.required_video("the registration experiment"), recording.recorded_size_px, int(frames[-1]) + 1
+    )
     ground_m = np.c_[x.ravel(), y.ravel()]
     return registration_errors(virtual, index, video, poses, frames, ground_m, live_view_model(scenario), progress)
 

@@ -12,7 +12,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from ptztrack.files import InputError, read_text, read_xml_root, shown
+from ptztrack.files import InputError, read_text, read_xml_root, require_file, shown
 from ptztrack.scene.synthetic import GroundTruth
 
 MOT_COLUMNS = 10
@@ -159,8 +159,7 @@ def read_video(path: str | Path, expected_frames: int | None = None, expected_si
     expected_size_px : (width, height), e.g. from the calibration.
     """
     path = Path(path)
-    if not path.is_file():
-        raise DatasetError(f"{path}: no such video file")
+    require_file(path, "video", DatasetError)
     capture = cv2.VideoCapture(str(path))
     frames = []
     while True:
@@ -238,18 +237,33 @@ class RecordedVideo:
 
     def __init__(self, path: str | Path, expected_size_px=None, frames_needed: int | None = None):
         """Checks at once that the video is one OpenCV reads, of ``expected_size_px`` (width, height),
-        with at least ``frames_needed`` frames (by its header), so that a run fails before its first step."""
+        with at least ``frames_needed`` frames, so that a run fails before its first step.
+
+        ``frame_count`` is the header's count, which a truncated file keeps: the last frame needed is
+        read to know that it is there.
+        """
         self.path = Path(path)
-        if not self.path.is_file():
-            raise DatasetError(f"{self.path}: no such video file")
+        require_file(self.path, "video", DatasetError)
         self.expected_size_px = expected_size_px
         self._open()
         if not self._capture.isOpened():
             raise DatasetError(f"{self.path}: not a video OpenCV can read")
         self.frame(0)
         self.frame_count = int(self._capture.get(cv2.CAP_PROP_FRAME_COUNT))
-        if frames_needed is not None and self.frame_count < frames_needed:
-            raise DatasetError(f"{self.path}: {self.frame_count} frames, the run needs {frames_needed}")
+        if frames_needed is not None:
+            self._require_frame(frames_needed - 1)
+
+    def _require_frame(self, index: int) -> None:
+        if index >= self.frame_count:
+            raise DatasetError(f"{self.path}: {self.frame_count} frames, the run needs {index + 1}")
+        self._capture.set(cv2.CAP_PROP_POS_FRAMES, index)
+        if not self._capture.grab():
+            raise DatasetError(
+                f"{self.path}: the video cannot be read at frame {index}, which the run needs, though its header "
+                f"says {self.frame_count} frames (a truncated file?)"
+            )
+        self._capture.release()  # frames are read forwards from the start: a seek is not exact in every codec
+        self._open()
 
     def _open(self) -> None:
         self._capture = cv2.VideoCapture(str(self.path))
