@@ -168,6 +168,20 @@ def cases(scratch: Path | None) -> list[Case]:
     return [
         _scenario("binary scenario", b"\x89PNG\r\n\x1a\n\xff\xfe\x00\x01" * 40),
         _recording("binary ground truth", "--gt", "gt.txt", b"\xff\xfe\x00\x81" * 100),
+        _recording(
+            "ground truth 1000 m from its boxes' people",
+            "--gt",
+            "gt.txt",
+            _ground_truth([_with_field(row, 7, str(float(row.split(",")[7]) + 1000)) for row in GROUND_TRUTH_ROWS]),
+            says=("gt.txt: none of its", "lies in the image of"),
+        ),
+        Case(
+            "recording calibration with K halved",
+            ("run", "--scenario", "pets", *A_FEW_STEPS, "--calibration", "{dir}/c.json"),
+            {"c.json": _pinhole_with_k_scaled(0.5)},
+            exit_status=0,
+            says=("box heights from their boxes' feet in", "is this the view's calibration?"),
+        ),
         _scenario("people.count 1e20", "people: {count: 1e20}\n"),
         _scenario("people.count 1e6", "people: {count: 1000000}\n"),
         _scenario("frames 1e9", "frames: 1000000000\n"),

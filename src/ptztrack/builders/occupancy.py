@@ -36,6 +36,7 @@ from ptztrack.occupancy.plaza import PlazaLayout, plaza_stage, plaza_truth
 from ptztrack.occupancy.render import SceneRenderer
 from ptztrack.occupancy.room import RoomLayout, RoomRenderer, room_truth
 from ptztrack.scene.pets import (
+    FIT_BOX_HEIGHTS,
     Annotations,
     DatasetError,
     RecordedVideo,
@@ -63,10 +64,6 @@ DISC_BYTES_PER_CELL = 25.0
 FRAME_S_MAX = 2.0
 """The longest a frame's map and its modes may take: SciPy's filters and NumPy's sums see Ctrl-C only
 once they end, and a recording has hundreds of frames."""
-FIT_BOX_HEIGHTS = 0.5
-"""The median distance, in box heights, from a person's ground truth projected into a view to the
-nearest of the view's detections, beyond which the calibration is taken not to fit the view: PETS
-2009 S2.L1's seven views, 0.05 to 0.12 with their calibrations, 0.96 to 3.1 with K halved or doubled."""
 FIT_FRAMES = 100
 """The frames that check looks at: people enough for a median, at a cost that does not grow with the
 recording."""

@@ -1,5 +1,6 @@
 """The scene, the camera backend, the detector and the pose source of a scenario: its :class:`~ptztrack.loop.World`."""
 
+import logging
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
@@ -23,9 +24,18 @@ from ptztrack.geometry.ptz import PTZCamera, ground_footprint
 from ptztrack.loop import World
 from ptztrack.roles import CameraBackend, Detector, PoseSource
 from ptztrack.scene.parameters import Crowd
-from ptztrack.scene.pets import RecordedScene, RecordedVideo, load_mot_ground_truth, recorded_scene, refuse_rows_beyond
+from ptztrack.scene.pets import (
+    RecordedScene,
+    RecordedVideo,
+    load_mot_ground_truth,
+    recorded_scene,
+    refuse_annotations_off_the_view,
+    refuse_rows_beyond,
+)
 from ptztrack.scene.synthetic import walk_people
 from ptztrack.types import GroundTruth
+
+log = logging.getLogger(__name__)
 
 CameraSpec = str | CameraBackend | Callable[[Scenario, "BuiltScene"], CameraBackend]
 """A camera backend: a registered name, an object, or a factory ``(scenario, scene) -> backend``."""
@@ -98,6 +108,15 @@ def build_scene(scenario: Scenario, scene_rng: np.random.Generator) -> BuiltScen
         scenario.people.width_m,
         recording.frame_range,
     )
+    misfit = refuse_annotations_off_the_view(
+        recording.ground_truth,
+        annotations.select(np.isin(annotations.frame, scene.video_frame)),
+        calibration,
+        recording.recorded_size_px,
+        recording.calibration,
+    )
+    if misfit is not None:
+        log.warning(misfit)
     if recording.area_m is not None:
         area_polygon_m = np.asarray(recording.area_m, dtype=float)
     else:

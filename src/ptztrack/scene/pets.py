@@ -13,6 +13,7 @@ import cv2
 import numpy as np
 
 from ptztrack.files import InputError, read_text, read_xml_root, require_file, shown
+from ptztrack.geometry.calibration import PinholeCalibration, in_image, project_pinhole
 from ptztrack.scene.synthetic import GroundTruth
 
 MOT_COLUMNS = 10
@@ -54,6 +55,42 @@ def box_feet_px(boxes_px) -> np.ndarray:
     """Where the people of boxes (K, 4+) px (left, top, width, height, ...) stand: their bottom centres (K, 2) px."""
     boxes_px = np.asarray(boxes_px, dtype=float)
     return np.stack([boxes_px[:, 0] + boxes_px[:, 2] / 2, boxes_px[:, 1] + boxes_px[:, 3]], axis=-1)
+
+
+FIT_BOX_HEIGHTS = 0.5
+"""The median distance, in box heights, from annotated people's ground positions projected into a view
+to their boxes' feet beyond which the calibration is taken not to fit the view: PETS 2009 S2.L1's seven
+views, 0.05 to 0.12 with their calibrations, 0.96 to 3.1 with K halved or doubled."""
+
+
+def refuse_annotations_off_the_view(
+    path: str | Path, annotations: Annotations, calibration: PinholeCalibration, size_px, calibration_path
+) -> str | None:
+    """Check annotations whose rows carry both a box (K, 4) px and a ground position (K, 2) m against the
+    view's calibration (its image (width, height) px): raise :class:`DatasetError` if no ground position
+    projects into the image at all; return a warning line if the projected positions lie a median of
+    more than ``FIT_BOX_HEIGHTS`` box heights from their own boxes' feet (the calibration is most likely
+    not the view's, or the world coordinates not the boxes' people); else None."""
+    points_mm = np.c_[1000.0 * annotations.ground_m, np.zeros(len(annotations.frame))]
+    seen = in_image(calibration, size_px, points_mm)
+    if len(annotations.frame) and not seen.any():
+        x_m, y_m = annotations.ground_m[0]
+        raise DatasetError(
+            f"{path}: none of its {len(seen)} ground positions (columns 8-9) lies in the image of {calibration_path} "
+            f"({size_px[0]}x{size_px[1]} px; the first: ({x_m:g}, {y_m:g}) m); expected the boxes' people, in metres"
+        )
+    heights_px = annotations.box_px[seen, 3]
+    sized = heights_px > 0
+    if not sized.any():
+        return None
+    distance_px = np.linalg.norm(project_pinhole(calibration, points_mm[seen]) - annotations.feet_px[seen], axis=-1)
+    median = float(np.median(distance_px[sized] / heights_px[sized]))
+    if median <= FIT_BOX_HEIGHTS:
+        return None
+    return (
+        f"{path}: its people's ground positions project a median {median:.2g} box heights from their boxes' feet "
+        f"in {calibration_path} (expected under {FIT_BOX_HEIGHTS:g}): is this the view's calibration?"
+    )
 
 
 def load_mot_ground_truth(path: str | Path) -> Annotations:
