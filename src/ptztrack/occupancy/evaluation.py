@@ -121,12 +121,12 @@ def detect_frames(
     for frame in range(recording.frames):
         for index, (method, detectors) in enumerate(maps.items()):
             for detector, found in zip(detectors, found_by[method], strict=True):
-                occupancy, modes = detector.detect(frame)
+                occupancy, frame_modes = detector.detect(frame)
                 if index == 0 and detector is detectors[0]:
                     peak = occupancy.max(initial=0.0)
                     scaled = np.round(255 * occupancy / peak) if peak > 0 else np.zeros(occupancy.shape)
                     maps_u8.append(scaled.astype(np.uint8))
-                found.append(modes)
+                found.append(frame_modes)
         clusters.append(clustering.detect(frame))
         if progress is not None:
             progress(frame + 1, recording.frames)
@@ -168,17 +168,16 @@ def fitted_selection(
     kept: list = [None] * frames
     fitted = []
     recall = np.zeros(frames)
-    for (scored, fitting), scores_used, positions_used in zip(halves(frames), scores, positions, strict=True):
-        scores, positions = scores_used, positions_used
+    for (scored, fitting), pair_scores, pair_positions in zip(halves(frames), scores, positions, strict=True):
         figures = [
-            detection_metrics(truth_m[fitting], [positions[f][scores[f] >= choice] for f in fitting])
+            detection_metrics(truth_m[fitting], [pair_positions[f][pair_scores[f] >= choice] for f in fitting])
             for choice in choices
         ]
         best = int(np.nanargmax([figure["moda"] for figure in figures]))
         fitted.append(choices[best])
         recall[scored] = figures[best]["recall"]
         for frame in scored:
-            kept[frame] = scores[frame] >= choices[best]
+            kept[frame] = pair_scores[frame] >= choices[best]
     return kept, fitted, recall
 
 

@@ -76,8 +76,8 @@ def refuse_annotations_off_the_view(
     if len(annotations.frame) and not seen.any():
         x_m, y_m = annotations.ground_m[0]
         raise DatasetError(
-            f"{path}: none of its {len(seen)} ground positions (columns 8-9) lies in the image of {calibration_path} "
-            f"({size_px[0]}x{size_px[1]} px; the first: ({x_m:g}, {y_m:g}) m); expected the boxes' people, in metres"
+            f"{path}: none of its {len(seen)} ground positions (columns 8-9; the first ({x_m:g}, {y_m:g}) m) "
+            f"lies in the image of {Path(calibration_path).name}: expected its boxes' people, in metres"
         )
     heights_px = annotations.box_px[seen, 3]
     sized = heights_px > 0
@@ -89,7 +89,7 @@ def refuse_annotations_off_the_view(
         return None
     return (
         f"{path}: its people's ground positions project a median {median:.2g} box heights from their boxes' feet "
-        f"in {calibration_path} (expected under {FIT_BOX_HEIGHTS:g}): is this the view's calibration?"
+        f"in {Path(calibration_path).name} (expected under {FIT_BOX_HEIGHTS:g}): is this the view's calibration?"
     )
 
 
