@@ -15,6 +15,7 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from functools import partial
+from typing import Any
 
 import numpy as np
 
@@ -109,10 +110,15 @@ def command(grid: ActionGrid, choice: int | np.ndarray) -> tuple[int, np.ndarray
 def decide(policy: Policy, context: DecisionContext, grid: ActionGrid) -> tuple[int, np.ndarray, float]:
     """The policy's decision in ``context``: (flat action index or -1, the (3,) commanded pose, the wall
     seconds the policy took). The step both loops share after their tracker's update or prediction."""
-    started = time.perf_counter()
-    choice = policy.choose(context)
-    decision_s = time.perf_counter() - started
+    choice, decision_s = timed(policy.choose, context)
     return (*command(grid, choice), decision_s)
+
+
+def timed(choose: Callable[[Any], Any], context) -> tuple[Any, float]:
+    """``choose(context)`` and the wall seconds it took."""
+    started = time.perf_counter()
+    choice = choose(context)
+    return choice, time.perf_counter() - started
 
 
 def track(
