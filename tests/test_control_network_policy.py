@@ -6,7 +6,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from ptztrack.camera.actions import ActionGrid
-from ptztrack.control.information_gain import action_geometry, detection_weight_integral
+from ptztrack.control.information_gain import detection_weight_integral
 from ptztrack.control.information_policy import InformationGainPolicy
 from ptztrack.control.network_policy import NetworkCamera, NetworkInformationPolicy, expected_posterior
 from ptztrack.detect.parameters import DetectorPrior
