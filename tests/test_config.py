@@ -39,7 +39,7 @@ def test_the_default_grid_is_the_papers_280_actions():
         ("cameras: [{position_m: [0, 0, 3], detector: {kind: x}}]\n", "cameras.0.detector.kind: expected one of"),
         (
             "cameras: [{position_m: [0, 0, 3]}]\ntracker: {kind: particle}\n",
-            "cameras: a network's one belief is the 'ekf' tracker measured by the detector (got tracker.kind 'particle'",
+            "cameras: a network's one belief is the 'ekf' tracker measured by the detector (got tracker.kind",
         ),
     ],
 )
