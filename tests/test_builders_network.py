@@ -34,9 +34,7 @@ def test_each_camera_faces_the_area_with_its_own_lens_and_detector_and_a_fixed_o
     east = camera_scenario(scenario, scenario.cameras[1])
     assert east.camera.f_min_px == 250.0 and east.detector.kind == "ideal" and east.cameras == ()
     assert east.camera.image_size_px == scenario.camera.image_size_px
-    np.testing.assert_allclose(
-        (east.actions.pan_deg.start, east.actions.pan_deg.stop), (-90 - 45, -90 + 45), atol=1e-9
-    )
+    np.testing.assert_allclose((east.actions.pan_deg.start, east.actions.pan_deg.stop), (-90 - 45, -90 + 45), atol=1e-9)
     world = network_world(scenario, 1)
     for camera in world.cameras:
         assert camera.truth is world.truth
