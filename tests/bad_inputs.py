@@ -286,6 +286,13 @@ def cases(scratch: Path | None) -> list[Case]:
             ("experiment", "synthetic", "--sequences", "1", *A_FEW_STEPS, "--json", "{dir}/missing/x.json"),
         ),
         Case("--json names a folder", ("experiment", "synthetic", "--sequences", "1", *A_FEW_STEPS, "--json", "{dir}")),
+        _scenario("a camera network run as one camera", "cameras: [{position_m: [0, 0, 3]}]\n"),
+        Case("network: no setting", ("experiment", "network")),
+        Case("network: --max-ptz 0", ("experiment", "network", "synthetic", "--max-ptz", "0")),
+        Case(
+            "network: --json in a missing folder",
+            ("experiment", "network", "synthetic", "--sequences", "1", *A_FEW_STEPS, "--json", "{dir}/missing/x.json"),
+        ),
         Case("--plot in a missing folder", ("experiment", "msg", "--runs", "1", "--plot", "{dir}/missing/x.png")),
         Case("--trails in a missing folder", ("experiment", "msg", "--runs", "1", "--trails", "{dir}/missing/x.png")),
         Case(

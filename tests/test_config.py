@@ -33,6 +33,14 @@ def test_the_default_grid_is_the_papers_280_actions():
         ("camera: {live_view: {jpeg_quality: 0}}\n", "camera.live_view.jpeg_quality: Input should be greater than"),
         ("- 1\n- 2\n", "expected a mapping of scenario fields (got list)"),
         ("area_m: [1, 2\n", "not valid YAML at line"),
+        ("cameras: [{kind: pan, position_m: [0, 0, 3]}]\n", "cameras.0.kind: Input should be 'ptz' or 'fixed'"),
+        ("cameras: [{kind: ptz}]\n", "cameras.0.position_m: Field required"),
+        ("cameras: [{position_m: [0, 0, -3]}]\n", "cameras.0.position_m.2: Input should be greater than 0 (got -3)"),
+        ("cameras: [{position_m: [0, 0, 3], detector: {kind: x}}]\n", "cameras.0.detector.kind: expected one of"),
+        (
+            "cameras: [{position_m: [0, 0, 3]}]\ntracker: {kind: particle}\n",
+            "cameras: a network's one belief is the 'ekf' tracker measured by the detector (got tracker.kind",
+        ),
     ],
 )
 def test_bad_scenarios_get_one_line_naming_the_file_field_and_value(tmp_path, text, expected):
@@ -80,3 +88,13 @@ def test_the_scenario_chooses_the_search_and_refuses_a_falling_height_range():
         pets_scenario("hog", **{"detector.hog_person_height_m": (2.0, 1.5)})
     with pytest.raises(ScenarioError, match="hog_search"):
         pets_scenario("hog", **{"detector.hog_search": "sky"})
+
+
+def test_a_camera_network_needs_the_synthetic_scene_and_runs_as_a_network(excerpt_scenario, tmp_path):
+    from ptztrack.builders.episode import run_episode
+
+    with pytest.raises(ScenarioError, match="cameras: a network of cameras runs on the synthetic scene"):
+        excerpt_scenario(tmp_path, cameras=[{"position_m": (0.0, 0.0, 3.0)}])
+    network = scenario_from_dict({"cameras": [{"position_m": (0.0, 0.0, 3.0)}]})
+    with pytest.raises(ScenarioError, match="a camera network runs as one"):
+        run_episode(network, "fix", 0)

@@ -55,6 +55,9 @@ _HOME = {
     "build_world": ".builders.world",
     "episode_world": ".builders.episode",
     "run_episode": ".builders.episode",
+    "NetworkEpisode": ".network_loop",
+    "run_network_episode": ".builders.network",
+    "network_metrics": ".evaluate.metrics",
     "Cell": ".experiments.cells",
     "synthetic_cells": ".experiments.ptz_tables",
     "recording_cells": ".experiments.ptz_tables",
@@ -71,16 +74,18 @@ __all__ = ["__version__", *_HOME, *_RENAMED]
 
 if TYPE_CHECKING:
     from .builders.episode import episode_world, run_episode
+    from .builders.network import run_network_episode
     from .builders.world import BuiltScene, build_world
     from .camera.actions import ActionGrid
     from .config import Scenario, ScenarioError, load_scenario, pets_follow_scenario, pets_scenario, scenario_from_dict
     from .evaluate.executors import run_cells
-    from .evaluate.metrics import episode_metrics
+    from .evaluate.metrics import episode_metrics, network_metrics
     from .evaluate.report import write_outputs
     from .experiments.cells import Cell, run_cell
     from .experiments.ptz_tables import format_table, recording_cells, summarise, synthetic_cells
     from .geometry.ptz import PTZCamera
     from .loop import Episode, World, run_loop
+    from .network_loop import NetworkEpisode
     from .registry import names as registered_names
     from .registry import register
     from .roles import CameraBackend, Detector, Policy, Tracker

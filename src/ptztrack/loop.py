@@ -15,6 +15,7 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from functools import partial
+from typing import Any
 
 import numpy as np
 
@@ -23,7 +24,7 @@ from ptztrack.camera.parameters import LandingError
 from ptztrack.camera.pose_feedback import landed_pose
 from ptztrack.detect.detector_model import OnlineDetectorModel
 from ptztrack.geometry.ptz import PTZCamera
-from ptztrack.roles import CameraBackend, Detector, ImageSource, Policy, PoseSource, Tracker
+from ptztrack.roles import CameraBackend, Detector, ImageSource, Policy, PoseSource, Tracker, Updater
 from ptztrack.types import DecisionContext, Detections, GroundTruth, Tracks, TrackUpdate
 
 
@@ -109,14 +110,19 @@ def command(grid: ActionGrid, choice: int | np.ndarray) -> tuple[int, np.ndarray
 def decide(policy: Policy, context: DecisionContext, grid: ActionGrid) -> tuple[int, np.ndarray, float]:
     """The policy's decision in ``context``: (flat action index or -1, the (3,) commanded pose, the wall
     seconds the policy took). The step both loops share after their tracker's update or prediction."""
-    started = time.perf_counter()
-    choice = policy.choose(context)
-    decision_s = time.perf_counter() - started
+    choice, decision_s = timed(policy.choose, context)
     return (*command(grid, choice), decision_s)
 
 
+def timed(choose: Callable[[Any], Any], context) -> tuple[Any, float]:
+    """``choose(context)`` and the wall seconds it took."""
+    started = time.perf_counter()
+    choice = choose(context)
+    return choice, time.perf_counter() - started
+
+
 def track(
-    tracker: Tracker, detections: Detections | None, pose, image: ImageSource, pose_sd=None
+    tracker: Updater, detections: Detections | None, pose, image: ImageSource, pose_sd=None
 ) -> tuple[TrackUpdate, Detections | None]:
     """Update ``tracker`` with a picture's ``detections`` at ``pose`` (3,) (``pose_sd`` (3,) its
     uncertainty, None where exact); returns the update and the measurements it used (the detections,
@@ -138,6 +144,45 @@ def episode_seeds(seed: int) -> list[np.random.SeedSequence]:
     return np.random.SeedSequence(seed).spawn(6)
 
 
+def land(world: World, step: int, commanded, previous, pose, rng: np.random.Generator) -> np.ndarray:
+    """Where the camera of ``world`` is at ``step``: it lands anew (drawing from ``rng``) when the command
+    (3,) changed from ``previous`` (and at the first step), else it stays at ``pose``."""
+    if step == 0 or not np.array_equal(commanded, previous):
+        return landed_pose(commanded, world.landing_error, rng)
+    return pose
+
+
+def observe(world: World, tracker: Updater, step: int, commanded, pose, rng: np.random.Generator) -> dict:
+    """One camera's look at ``step``: the camera of ``world``, sent to ``commanded`` (3,) and at ``pose``
+    (3,), detects (drawing from ``rng``, the step's own stream) and ``tracker`` is updated; returns the
+    step's record of it: ``tracker_poses``, ``pose_known`` and ``detections``. The step both the one-camera
+    and the network loop share after the decision."""
+    believed = world.pose_source(step, commanded, pose)
+    tracker_pose = commanded if believed is None else believed
+    detections = None
+    if tracker.wants_detections(step):
+        detections = world.detector.detect(world.backend, step, pose, rng, believed_pose=tracker_pose)
+    _, measured = track(tracker, detections, tracker_pose, partial(world.backend.image, step, pose))
+    return {
+        "tracker_poses": tracker_pose,
+        "pose_known": believed is not None,
+        "detections": Detections.empty() if measured is None else measured,
+    }
+
+
+def episode_of(world: World, per_step: dict[str, list]) -> Episode:
+    """The :class:`Episode` of the camera of ``world`` from its steps' records ({PER_STEP name: list})."""
+    arrays = {name: np.asarray(per_step[name]) for name in PER_STEP if name not in ("tracks", "detections")}
+    return Episode(
+        world.truth,
+        world.camera,
+        world.area_polygon_m,
+        tracks=per_step["tracks"],
+        detections=per_step["detections"],
+        **arrays,
+    )
+
+
 def run_loop(
     world: World, policy: Policy, tracker: Tracker, seed: int, observer: StepObserver | None = None
 ) -> Episode:
@@ -154,6 +199,7 @@ def run_loop(
 
     grid = world.grid
     nearest, commanded = world.start_action, grid.poses[world.start_action]
+    pose = commanded
     per_step: dict[str, list] = {name: [] for name in PER_STEP}
     for step in range(steps):
         predicted = tracker.predict()
@@ -161,36 +207,18 @@ def run_loop(
         previous = commanded
         action, commanded, decision_s = decide(policy, context, grid)
         nearest = action if action >= 0 else grid.nearest(commanded)
-        if step == 0 or not np.array_equal(commanded, previous):
-            pose = landed_pose(commanded, world.landing_error, landing_rng)
-        believed = world.pose_source(step, commanded, pose)
-        tracker_pose = commanded if believed is None else believed
-        detections = None
-        if tracker.wants_detections(step):
-            detections = world.detector.detect(
-                world.backend, step, pose, np.random.default_rng(frame_seeds[step]), believed_pose=tracker_pose
-            )
-        _, measured = track(tracker, detections, tracker_pose, partial(world.backend.image, step, pose))
+        pose = land(world, step, commanded, previous, pose, landing_rng)
+        looked = observe(world, tracker, step, commanded, pose, np.random.default_rng(frame_seeds[step]))
         record = {
             "actions": action,
             "commanded": commanded,
             "poses": pose,
-            "tracker_poses": tracker_pose,
-            "pose_known": believed is not None,
             "decision_s": decision_s,
+            **looked,
             "tracks": tracker.reported(),
-            "detections": Detections.empty() if measured is None else measured,
         }
         for name, value in record.items():
             per_step[name].append(value)
         if observer is not None:
             observer(step, context, record)
-    arrays = {name: np.asarray(per_step[name]) for name in PER_STEP if name not in ("tracks", "detections")}
-    return Episode(
-        world.truth,
-        world.camera,
-        world.area_polygon_m,
-        tracks=per_step["tracks"],
-        detections=per_step["detections"],
-        **arrays,
-    )
+    return episode_of(world, per_step)

@@ -8,7 +8,7 @@ and nothing else changes; :mod:`ptztrack.registry` gives it a name that
 scenario files and the command line can use.
 """
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import Protocol
 
 import numpy as np
@@ -53,13 +53,8 @@ class Detector(Protocol):
         ...
 
 
-class Tracker(Protocol):
-    """Keeps beliefs about people on the ground plane, one step at a time."""
-
-    def predict(self, dt_s: float | None = None) -> Tracks:
-        """Advance every track by one step (``dt_s`` seconds; None: the tracker's own step); returns the
-        predicted tracks, which the policy plans with."""
-        ...
+class Updater(Protocol):
+    """What a loop's measurement step needs of a tracker: one camera's update of the belief."""
 
     def wants_detections(self, step: int) -> bool:
         """Whether the detector should run at ``step`` (a tracker may measure on its own in between)."""
@@ -70,6 +65,15 @@ class Tracker(Protocol):
     ) -> TrackUpdate:
         """Update with the step's detections (None where it did not ask for any), taken at ``pose``, known
         to within ``pose_sd`` (3,) standard deviations (None: exactly)."""
+        ...
+
+
+class Tracker(Updater, Protocol):
+    """Keeps beliefs about people on the ground plane, one step at a time."""
+
+    def predict(self, dt_s: float | None = None) -> Tracks:
+        """Advance every track by one step (``dt_s`` seconds; None: the tracker's own step); returns the
+        predicted tracks, which the policy plans with."""
         ...
 
     def reported(self) -> Tracks:
@@ -83,4 +87,29 @@ class Policy(Protocol):
     def choose(self, context: DecisionContext) -> int | np.ndarray:
         """The flat index of the next grid action, one of ``context.reachable``; or, for a policy that
         commands the camera continuously (and keeps to its mechanics itself), a (3,) pose."""
+        ...
+
+
+class NetworkTracker(Protocol):
+    """One ground belief that several cameras update in turn (:func:`ptztrack.network_loop.run_network_loop`)."""
+
+    def predict(self, dt_s: float | None = None) -> Tracks:
+        """Advance every track by one step, once for the whole network; returns the predicted tracks."""
+        ...
+
+    def updater(self, camera: int) -> Updater:
+        """The update of the belief by camera ``camera`` (an index into the network's cameras)."""
+        ...
+
+    def reported(self) -> Tracks:
+        """The tracks the network reports now (the metrics score these)."""
+        ...
+
+
+class NetworkPolicy(Protocol):
+    """Chooses where every camera of a network looks next, one choice per camera."""
+
+    def choose(self, contexts: Sequence[DecisionContext]) -> list[int | np.ndarray]:
+        """Per camera, in the order of ``contexts`` (one per camera, all with the same predicted tracks), what
+        :meth:`Policy.choose` would return for it: a flat action index of its grid, or a (3,) pose."""
         ...

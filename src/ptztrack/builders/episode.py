@@ -5,7 +5,7 @@ from collections.abc import Callable
 import numpy as np
 
 from ptztrack.builders.world import CameraSpec, DetectorSpec, build_world, resolve
-from ptztrack.config import Scenario
+from ptztrack.config import Scenario, ScenarioError
 from ptztrack.loop import Episode, StepObserver, World, episode_seeds, run_loop
 from ptztrack.roles import Policy, Tracker
 
@@ -19,6 +19,10 @@ def episode_world(
     scenario: Scenario, seed: int, camera: CameraSpec | None = None, detector: DetectorSpec | None = None
 ) -> World:
     """The world that ``run_episode(scenario, any_policy, seed)`` runs in: the same people."""
+    if scenario.cameras:
+        raise ScenarioError(
+            "the scenario lists cameras: a camera network runs as one (ptztrack.builders.network.run_network_episode)"
+        )
     streams = episode_seeds(seed)
     scene_rng = np.random.default_rng(streams[0])
     return build_world(scenario, scene_rng, camera, detector, tracker_seed=streams[4], model_seed=streams[5])

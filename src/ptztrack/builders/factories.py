@@ -78,7 +78,8 @@ def random_policy(scenario: Scenario, world: World) -> RandomPolicy:
     return RandomPolicy()
 
 
-def _information_policy(scenario: Scenario, world: World, method: Literal["intg", "smpl"]) -> InformationGainPolicy:
+def information_policy(scenario: Scenario, world: World, method: Literal["intg", "smpl"]) -> InformationGainPolicy:
+    """The information-gain policy ``method`` ('intg' or 'smpl') of the camera of ``world``."""
     control, recall = scenario.control, planning_model(scenario, world)
     exploration = None
     if control.beta > 0:
@@ -108,11 +109,11 @@ def _information_policy(scenario: Scenario, world: World, method: Literal["intg"
 
 
 def intg_policy(scenario: Scenario, world: World) -> InformationGainPolicy:
-    return _information_policy(scenario, world, "intg")
+    return information_policy(scenario, world, "intg")
 
 
 def smpl_policy(scenario: Scenario, world: World) -> InformationGainPolicy:
-    return _information_policy(scenario, world, "smpl")
+    return information_policy(scenario, world, "smpl")
 
 
 def _simulated_detector(scenario: Scenario, scene, recall: RecallModel):

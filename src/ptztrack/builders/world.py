@@ -220,7 +220,18 @@ def build_world(
     synthetic scene, 'virtual' for a recording); detector : by default ``detector.kind``;
     tracker_seed : the stream of a tracker that draws; model_seed : the detector model's draws.
     """
-    scene = build_scene(scenario, scene_rng)
+    return camera_world(scenario, build_scene(scenario, scene_rng), camera, detector, tracker_seed, model_seed)
+
+
+def camera_world(
+    scenario: Scenario,
+    scene: BuiltScene,
+    camera: CameraSpec | None = None,
+    detector: DetectorSpec | None = None,
+    tracker_seed: np.random.SeedSequence | None = None,
+    model_seed: np.random.SeedSequence | None = None,
+) -> World:
+    """The world of the camera of ``scene``: its backend, detector and pose source (see :func:`build_world`)."""
     default_backend = "virtual" if scenario.recording is not None else "simulated"
     backend = resolve("cameras", camera or scenario.camera.backend or default_backend, scenario, scene, "people")
     found_by = resolve("detectors", detector or scenario.detector.kind, scenario, scene, "detect")

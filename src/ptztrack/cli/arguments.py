@@ -67,7 +67,7 @@ def parser() -> argparse.ArgumentParser:
 
     experiment = commands.add_parser("experiment", help="run one of the papers' experiments and print its table")
     experiments = experiment.add_subparsers(
-        dest="name", required=True, metavar="{synthetic,pets,msg,registration,follow,occupancy}"
+        dest="name", required=True, metavar="{synthetic,pets,msg,registration,follow,occupancy,network}"
     )
 
     synthetic = experiments.add_parser("synthetic", help="the PTZ paper's Tables 1-2 on the synthetic scene")
@@ -152,6 +152,7 @@ def parser() -> argparse.ArgumentParser:
     registration.set_defaults(handler="ptztrack.cli.registration:registration_experiment_command")
     _add_follow_commands(commands, experiments)
     _add_occupancy_parser(experiments)
+    _add_network_parser(experiments, detectors)
     _add_camera_commands(commands, policies)
     return root
 
@@ -291,6 +292,23 @@ def _add_occupancy_parser(experiments) -> None:
     occupancy.add_argument("--json", type=Path, help="write one row per method (and people count) here")
     _add_quiet_argument(occupancy)
     occupancy.set_defaults(handler="ptztrack.cli.occupancy:occupancy_experiment_command")
+
+
+def _add_network_parser(experiments, detectors: list[str]) -> None:
+    network = experiments.add_parser(
+        "network", help="a camera network: PTZ cameras deciding jointly, each alone or fixed, with a wide fixed one"
+    )
+    network.add_argument("setting", choices=("synthetic",), help="synthetic: 1 to --max-ptz cameras around the area")
+    network.add_argument("--detector", choices=detectors, default="realistic")
+    _add_detector_model_arguments(network)
+    network.add_argument("--sequences", type=_positive_int, default=12)
+    network.add_argument("--frames", type=_positive_int, help="overrides the scenario's number of frames")
+    network.add_argument("--max-ptz", type=_positive_int, default=4, help="the most PTZ cameras in a configuration")
+    network.add_argument(
+        "--method", choices=("intg", "smpl"), default="intg", help="the PTZ cameras' expected information"
+    )
+    _add_executor_arguments(network, "one row per configuration")
+    network.set_defaults(handler="ptztrack.cli.network:network_experiment_command")
 
 
 def _strategies(policies: list[str]) -> list[str]:

@@ -249,6 +249,29 @@ class Recording(_Strict):
         return self
 
 
+class MountedCamera(_Strict):
+    """One camera of a network (the scenario's ``cameras``): where it is mounted, whether it turns, its
+    lens and its detector; every camera of a network is simulated, over the synthetic scene.
+
+    kind : 'ptz' (it chooses its pose on the action grid every step) or 'fixed' (it stays at its widest
+    view of the area, as the 'fix' policy does). position_m : its optical centre (x, y, z) in metres.
+    The action grid's pan values are offsets from the bearing of the area's centre seen from the camera
+    (the default camera, south of the area, faces it at pan 0), its tilts and zooms the scenario's.
+    image_size_px, f_min_px : its image and widest focal length (None: the ``camera`` section's).
+    detector : its detector (None: the scenario's ``detector``). The ``camera`` section's pose error
+    applies to every camera.
+    """
+
+    kind: Literal["ptz", "fixed"] = "ptz"
+    position_m: tuple[_Coordinate, _Coordinate, Annotated[PositiveFloat, at_most(10_000, "metres")]]
+    image_size_px: tuple[Pixels, Pixels] | None = None
+    f_min_px: Annotated[PositiveFloat, at_most(1e6, "pixels")] | None = None
+    detector: Detector | None = None
+
+
+_MAX_CAMERAS = 64
+
+
 _Side = Annotated[PositiveFloat, at_most(1000, "metres: the ground a PTZ camera can cover")]
 
 
@@ -269,6 +292,25 @@ class Scenario(_Strict):
     pose_feedback: PoseFeedback = PoseFeedback()
     follow: Follow = Follow()
     recording: Recording | None = None
+    cameras: Annotated[
+        tuple[MountedCamera, ...],
+        at_most_items(_MAX_CAMERAS, "time: every camera detects, updates the belief and decides every step"),
+    ] = ()
+
+    @model_validator(mode="after")
+    def _a_network_of_simulated_cameras(self):
+        if not self.cameras:
+            return self
+        if self.recording is not None:
+            raise ValueError("cameras: a network of cameras runs on the synthetic scene, not on a recording (yet)")
+        if self.tracker.kind != "ekf" or self.tracker.measurement_source != "detector":
+            raise ValueError(
+                "cameras: a network's one belief is the 'ekf' tracker measured by the detector "
+                f"(got tracker.kind {self.tracker.kind!r}, measurement_source {self.tracker.measurement_source!r})"
+            )
+        if self.camera.backend not in (None, "simulated"):
+            raise ValueError(f"cameras: a network's cameras are simulated (got camera.backend {self.camera.backend!r})")
+        return self
 
     @model_validator(mode="after")
     def _images_need_a_video(self):

@@ -6,10 +6,14 @@ allowed only within ``gate_m`` (1 m). Over several runs, the standard error of a
 figure's mean.
 """
 
+from collections.abc import Sequence
+
 import motmetrics as mm
 import numpy as np
 
 from ptztrack.loop import Episode
+from ptztrack.network_loop import NetworkEpisode
+from ptztrack.types import GroundTruth, Tracks
 
 GATE_M = 1.0
 # How each figure is shown in tables: label and format.
@@ -81,16 +85,31 @@ def episode_metrics(episode: Episode) -> dict:
     detections whose height is known (a simulated false positive has none); ``detections``, the number of detections the
     detector reported (false positives included); ``zoom``, the mean zoom.
     """
-    metrics = clear_metrics(
-        episode.truth.positions_m,
-        [tracks.ids for tracks in episode.tracks],
-        [tracks.mean[:, :2] for tracks in episode.tracks],
-    )
-    detected_heights_px = np.concatenate([d.height_px[np.isfinite(d.height_px)] for d in episode.detections])
-    metrics["height_px"] = float(np.mean(detected_heights_px)) if len(detected_heights_px) else float("nan")
-    metrics["detections"] = int(sum(len(d) for d in episode.detections))
-    metrics["zoom"] = float(np.mean(episode.poses[:, 2]))
-    return metrics
+    return {**tracking_metrics(episode.truth, episode.tracks), **looking_metrics([episode])}
+
+
+def network_metrics(episode: NetworkEpisode) -> dict:
+    """:func:`episode_metrics` of a camera network: the figures of its one set of tracks, and
+    ``height_px``, ``detections`` and ``zoom`` over every camera's detections and poses."""
+    return {**tracking_metrics(episode.truth, episode.tracks), **looking_metrics(episode.cameras)}
+
+
+def tracking_metrics(truth: GroundTruth, tracks: list[Tracks]) -> dict:
+    """:func:`clear_metrics` of the reported ``tracks`` of every step against ``truth``."""
+    return clear_metrics(truth.positions_m, [step.ids for step in tracks], [step.mean[:, :2] for step in tracks])
+
+
+def looking_metrics(cameras: Sequence[Episode]) -> dict:
+    """What the cameras saw, over all of them: ``height_px``, the mean pixel height of the detections whose
+    height is known (a simulated false positive has none); ``detections``, how many the detectors
+    reported (false positives included); ``zoom``, the mean zoom over cameras and steps."""
+    detections = [found for camera in cameras for found in camera.detections]
+    detected_heights_px = np.concatenate([d.height_px[np.isfinite(d.height_px)] for d in detections])
+    return {
+        "height_px": float(np.mean(detected_heights_px)) if len(detected_heights_px) else float("nan"),
+        "detections": int(sum(len(d) for d in detections)),
+        "zoom": float(np.mean(np.concatenate([camera.poses[:, 2] for camera in cameras]))),
+    }
 
 
 def standard_error(values) -> float:

@@ -1,0 +1,94 @@
+"""A camera network's episode: the scenario's ``cameras`` built into worlds, a joint or independent
+network policy and one shared belief, run by :func:`ptztrack.network_loop.run_network_loop`.
+
+Each camera is built as the one camera of a scenario of its own (:func:`camera_scenario`): its
+mount, lens and detector, and the action grid turned to face the area. The people are drawn once,
+from the episode's scene stream, so every camera sees the same walkers the one-camera run of the
+seed would. The first camera's detector model draws from the one-camera run's stream, every other
+camera's from a stream spawned after it.
+"""
+
+from dataclasses import replace
+from typing import Literal
+
+import numpy as np
+
+from ptztrack.builders.factories import ekf_tracker, information_policy
+from ptztrack.builders.world import BuiltScene, action_grid, build_scene, camera_world, ptz_camera
+from ptztrack.config import AxisRange, MountedCamera, Scenario, ScenarioError
+from ptztrack.control.network_policy import NetworkCamera, NetworkInformationPolicy
+from ptztrack.geometry.ptz import look_at
+from ptztrack.loop import episode_seeds
+from ptztrack.network_loop import NetworkEpisode, NetworkWorld, run_network_loop
+from ptztrack.track.shared_belief import SharedBelief
+from ptztrack.track.tracker import EkfTracker
+
+Coordination = Literal["joint", "independent"]
+
+
+def camera_scenario(scenario: Scenario, mounted: MountedCamera) -> Scenario:
+    """The scenario as its camera ``mounted`` alone would run it: its position, lens and detector (the
+    scenario's where it gives none), the action grid's pan turned by the bearing of the area's centre,
+    and no network."""
+    camera = scenario.camera.model_copy(
+        update={
+            "position_m": mounted.position_m,
+            "image_size_px": mounted.image_size_px or scenario.camera.image_size_px,
+            "f_min_px": mounted.f_min_px or scenario.camera.f_min_px,
+        }
+    )
+    alone = scenario.model_copy(
+        update={"camera": camera, "detector": mounted.detector or scenario.detector, "cameras": ()}
+    )
+    centre_m = np.asarray(scenario.area_m) / 2
+    bearing_deg = float(look_at(ptz_camera(alone), centre_m)[0])
+    pan = scenario.actions.pan_deg
+    turned = AxisRange(start=pan.start + bearing_deg, stop=pan.stop + bearing_deg, count=pan.count)
+    return alone.model_copy(update={"actions": scenario.actions.model_copy(update={"pan_deg": turned})})
+
+
+def network_world(scenario: Scenario, seed: int) -> NetworkWorld:
+    """Every camera's world for the episode of ``seed``: the same people, seen by each camera."""
+    if not scenario.cameras:
+        raise ScenarioError("a camera network needs the scenario's cameras (cameras: a list of at least one)")
+    streams = episode_seeds(seed)
+    views = [camera_scenario(scenario, mounted) for mounted in scenario.cameras]
+    first = build_scene(views[0], np.random.default_rng(streams[0]))
+    model_seeds = [streams[5], *streams[5].spawn(len(views) - 1)]
+    worlds = []
+    for view, model_seed in zip(views, model_seeds, strict=True):
+        scene: BuiltScene = replace(first, camera=ptz_camera(view), grid=action_grid(view))
+        worlds.append(camera_world(view, scene, model_seed=model_seed))
+    return NetworkWorld(tuple(worlds))
+
+
+def network_policy(
+    scenario: Scenario, world: NetworkWorld, coordination: Coordination, method: Literal["intg", "smpl"]
+) -> NetworkInformationPolicy:
+    """The network's policy: each PTZ camera's own information-gain policy ``method``, deciding
+    ``coordination`` ('joint' or 'independent'); each fixed camera at its widest view of the area."""
+    cameras = []
+    for mounted, camera in zip(scenario.cameras, world.cameras, strict=True):
+        policy = information_policy(camera_scenario(scenario, mounted), camera, method)
+        cameras.append(NetworkCamera(policy, camera.start_action if mounted.kind == "fixed" else None))
+    return NetworkInformationPolicy(tuple(cameras), joint=coordination == "joint")
+
+
+def network_tracker(scenario: Scenario, world: NetworkWorld) -> SharedBelief:
+    """One belief, updated by each camera's EKF tracker (the scenario's tracker section) in turn."""
+    trackers = []
+    for mounted, camera in zip(scenario.cameras, world.cameras, strict=True):
+        tracker = ekf_tracker(camera_scenario(scenario, mounted), camera)
+        # The scenario's validation keeps a network to the detector-measured EKF.
+        assert isinstance(tracker, EkfTracker)
+        trackers.append(tracker)
+    return SharedBelief(tuple(trackers))
+
+
+def run_network_episode(
+    scenario: Scenario, seed: int, coordination: Coordination = "joint", method: Literal["intg", "smpl"] = "intg"
+) -> NetworkEpisode:
+    """One closed-loop episode of the scenario's camera network (see the module's docstring)."""
+    world = network_world(scenario, seed)
+    policy = network_policy(scenario, world, coordination, method)
+    return run_network_loop(world, policy, network_tracker(scenario, world), seed)
