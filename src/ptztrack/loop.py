@@ -152,22 +152,48 @@ def land(world: World, step: int, commanded, previous, pose, rng: np.random.Gene
     return pose
 
 
-def observe(world: World, tracker: Updater, step: int, commanded, pose, rng: np.random.Generator) -> dict:
-    """One camera's look at ``step``: the camera of ``world``, sent to ``commanded`` (3,) and at ``pose``
-    (3,), detects (drawing from ``rng``, the step's own stream) and ``tracker`` is updated; returns the
-    step's record of it: ``tracker_poses``, ``pose_known`` and ``detections``. The step both the one-camera
-    and the network loop share after the decision."""
+@dataclass(frozen=True)
+class Look:
+    """A camera's side of a step, which needs no belief: where it is and what it found.
+
+    pose : (3,) the pose the camera took; tracker_pose : (3,) the pose the tracker is to map its detections
+    with; pose_known : whether the pose source gave that pose (else it is the commanded one);
+    detections : what the detector found, None where the tracker wanted none.
+    """
+
+    pose: np.ndarray
+    tracker_pose: np.ndarray
+    pose_known: bool
+    detections: Detections | None
+
+
+def look(world: World, step: int, commanded, pose, rng: np.random.Generator, wanted: bool) -> Look:
+    """The camera of ``world`` at ``step``, sent to ``commanded`` (3,) and at ``pose`` (3,): the pose the
+    tracker is to believe, and, where ``wanted``, the detections (drawing from ``rng``, the step's own
+    stream). Runs where the camera is: in this process, or in a camera's actor."""
     believed = world.pose_source(step, commanded, pose)
     tracker_pose = commanded if believed is None else believed
     detections = None
-    if tracker.wants_detections(step):
+    if wanted:
         detections = world.detector.detect(world.backend, step, pose, rng, believed_pose=tracker_pose)
-    _, measured = track(tracker, detections, tracker_pose, partial(world.backend.image, step, pose))
+    return Look(pose, tracker_pose, believed is not None, detections)
+
+
+def take_in(world: World, tracker: Updater, step: int, seen: Look) -> dict:
+    """``tracker`` updated with the camera of ``world``'s :class:`Look` at ``step``; returns the step's
+    record of it: ``tracker_poses``, ``pose_known`` and ``detections`` (the measurements it used)."""
+    _, measured = track(tracker, seen.detections, seen.tracker_pose, partial(world.backend.image, step, seen.pose))
     return {
-        "tracker_poses": tracker_pose,
-        "pose_known": believed is not None,
+        "tracker_poses": seen.tracker_pose,
+        "pose_known": seen.pose_known,
         "detections": Detections.empty() if measured is None else measured,
     }
+
+
+def observe(world: World, tracker: Updater, step: int, commanded, pose, rng: np.random.Generator) -> dict:
+    """One camera's look at ``step`` (:func:`look`) and ``tracker``'s update with it (:func:`take_in`);
+    returns the step's record of it. The step the one-camera loop takes after the decision."""
+    return take_in(world, tracker, step, look(world, step, commanded, pose, rng, tracker.wants_detections(step)))
 
 
 def episode_of(world: World, per_step: dict[str, list]) -> Episode:

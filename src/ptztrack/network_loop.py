@@ -5,7 +5,16 @@ Every step: one prediction of the shared belief
 together (:class:`ptztrack.roles.NetworkPolicy`: a fixed camera is one whose
 choice never changes); then, camera after camera in the network's order,
 each lands, detects and updates the belief (the same steps as the
-one-camera loop, :func:`ptztrack.loop.land` and :func:`ptztrack.loop.observe`).
+one-camera loop, :func:`ptztrack.loop.land`, :func:`ptztrack.loop.look` and
+:func:`ptztrack.loop.take_in`).
+
+Where the cameras work. A camera's landing and detection need no belief:
+each camera's :class:`CameraWorker` does them with its own streams, in this
+process (:class:`InProcessCameras`) or in an actor of its own on a Ray
+cluster (:class:`ptztrack.evaluate.camera_actors.RayCameras`), and returns
+its :class:`~ptztrack.loop.Look`; the belief, its updates and the decision
+stay in this process. The cameras' streams travel with their workers, so
+where they run does not change the episode.
 
 Streams. The first camera draws its detections and landings from the
 streams :func:`ptztrack.loop.run_loop` draws them from, so a network of one
@@ -15,11 +24,14 @@ cameras do. Configurations that share a camera at the same place in their
 list meet, there, the same detector luck (common random numbers).
 """
 
-from dataclasses import dataclass
+import time
+from collections.abc import Callable, Iterator, Sequence
+from dataclasses import dataclass, field
+from typing import Protocol
 
 import numpy as np
 
-from ptztrack.loop import PER_STEP, Episode, World, command, episode_of, episode_seeds, land, observe, timed
+from ptztrack.loop import PER_STEP, Episode, Look, World, command, episode_of, episode_seeds, land, look, take_in, timed
 from ptztrack.roles import NetworkPolicy, NetworkTracker
 from ptztrack.types import DecisionContext, GroundTruth, Tracks
 
@@ -49,6 +61,9 @@ class NetworkEpisode:
     decision_s : (T,) wall seconds the network policy took to choose every camera's action.
     cameras : each camera's :class:`~ptztrack.loop.Episode` (its ``tracks`` are the network's, its
         ``decision_s`` the network's decision's).
+    update_s : (T,) wall seconds of every camera's update of the belief, summed over the cameras (not
+        the waits for their looks).
+    step_s : (T,) wall seconds of each whole step: prediction, decision, looks and updates.
     """
 
     truth: GroundTruth
@@ -56,6 +71,8 @@ class NetworkEpisode:
     tracks: list[Tracks]
     decision_s: np.ndarray
     cameras: tuple[Episode, ...]
+    update_s: np.ndarray
+    step_s: np.ndarray
 
 
 def camera_streams(
@@ -70,47 +87,135 @@ def camera_streams(
     return frame_seeds, landing
 
 
-def run_network_loop(world: NetworkWorld, policy: NetworkPolicy, tracker: NetworkTracker, seed: int) -> NetworkEpisode:
-    """Run the network's closed loop for every frame of ``world.truth``, with the streams of ``seed``."""
-    _, detector_seed, policy_seed, landing_seed, _, _ = episode_seeds(seed)
+@dataclass
+class CameraWorker:
+    """One camera's own work every step, the part that needs no belief: it lands where it is sent,
+    drawing from its landing stream, and looks (:func:`~ptztrack.loop.look`) with the step's detector
+    stream. It reads ``world``'s backend, detector, pose source and landing error only.
+
+    frame_seeds : its per-step detector streams; landing_rng : its landing errors' generator.
+    commanded, pose : (3,) where it was last sent and where it is (before the first step: its start
+    action's pose, both).
+    """
+
+    world: World
+    frame_seeds: list[np.random.SeedSequence]
+    landing_rng: np.random.Generator
+    commanded: np.ndarray = field(init=False)
+    pose: np.ndarray = field(init=False)
+
+    def __post_init__(self):
+        self.commanded = self.pose = self.world.grid.poses[self.world.start_action]
+
+    def look(self, step: int, commanded, wanted: bool) -> Look:
+        """Sent to ``commanded`` (3,) at ``step``: it lands (anew only when the command changed) and
+        looks, detecting where ``wanted``."""
+        self.pose = land(self.world, step, commanded, self.commanded, self.pose, self.landing_rng)
+        self.commanded = commanded
+        return look(self.world, step, commanded, self.pose, np.random.default_rng(self.frame_seeds[step]), wanted)
+
+
+class CameraFleet(Protocol):
+    """Where the cameras' workers run (in this process, or as actors on a cluster)."""
+
+    def looks(self, step: int, commanded: Sequence[np.ndarray], wanted: Sequence[bool]) -> Iterator[Look]:
+        """Every camera's look at ``step`` (camera ``k`` sent to ``commanded[k]``, detecting where
+        ``wanted[k]``), in the network's order, each as soon as it is ready."""
+        ...
+
+    def close(self) -> None:
+        """Release what the fleet holds (actors); it is not used after."""
+        ...
+
+
+@dataclass
+class InProcessCameras:
+    """Every camera's worker in this process, each looking only when its look is asked for, so the
+    belief's update by one camera comes before the next camera's look."""
+
+    workers: list[CameraWorker]
+
+    def looks(self, step: int, commanded: Sequence[np.ndarray], wanted: Sequence[bool]) -> Iterator[Look]:
+        for worker, pose, wants in zip(self.workers, commanded, wanted, strict=True):
+            yield worker.look(step, pose, wants)
+
+    def close(self) -> None:
+        """Nothing to release."""
+
+
+def camera_workers(world: NetworkWorld, seed: int) -> list[CameraWorker]:
+    """Every camera's worker for the episode of ``seed``, with its streams (:func:`camera_streams`)."""
+    _, detector_seed, _, landing_seed, _, _ = episode_seeds(seed)
     steps = world.truth.positions_m.shape[0]
     frame_seeds, landing_rngs = camera_streams(detector_seed, landing_seed, len(world.cameras), steps)
+    return [
+        CameraWorker(camera, seeds, rng)
+        for camera, seeds, rng in zip(world.cameras, frame_seeds, landing_rngs, strict=True)
+    ]
+
+
+def run_network_loop(
+    world: NetworkWorld,
+    policy: NetworkPolicy,
+    tracker: NetworkTracker,
+    seed: int,
+    fleet: Callable[[list[CameraWorker]], CameraFleet] = InProcessCameras,
+) -> NetworkEpisode:
+    """Run the network's closed loop for every frame of ``world.truth``, with the streams of ``seed``.
+
+    fleet : runs the cameras' workers (:func:`camera_workers`): in this process by default; the
+    episode is the same wherever they run.
+    """
+    _, _, policy_seed, _, _, _ = episode_seeds(seed)
+    steps = world.truth.positions_m.shape[0]
     policy_rng = np.random.default_rng(policy_seed)
 
     nearest = [camera.start_action for camera in world.cameras]
     commanded = [camera.grid.poses[camera.start_action] for camera in world.cameras]
-    pose = list(commanded)
     per_camera: list[dict[str, list]] = [{name: [] for name in PER_STEP} for _ in world.cameras]
     reported: list[Tracks] = []
-    decision_times_s = []
-    for step in range(steps):
-        predicted = tracker.predict()
-        contexts = [
-            DecisionContext(step, nearest[k], camera.grid.reachable(nearest[k]), predicted, policy_rng, commanded[k])
-            for k, camera in enumerate(world.cameras)
-        ]
-        choices, decision_s = timed(policy.choose, contexts)
-        records = []
-        for k, (camera, choice) in enumerate(zip(world.cameras, choices, strict=True)):
-            previous = commanded[k]
-            action, commanded[k] = command(camera.grid, choice)
-            nearest[k] = action if action >= 0 else camera.grid.nearest(commanded[k])
-            pose[k] = land(camera, step, commanded[k], previous, pose[k], landing_rngs[k])
-            rng = np.random.default_rng(frame_seeds[k][step])
-            looked = observe(camera, tracker.updater(k), step, commanded[k], pose[k], rng)
-            records.append(
-                {"actions": action, "commanded": commanded[k], "poses": pose[k], "decision_s": decision_s, **looked}
-            )
-        tracks = tracker.reported()
-        reported.append(tracks)
-        decision_times_s.append(decision_s)
-        for record, history in zip(records, per_camera, strict=True):
-            for name, value in {**record, "tracks": tracks}.items():
-                history[name].append(value)
+    decision_times_s, update_times_s, step_times_s = [], [], []
+    cameras = fleet(camera_workers(world, seed))
+    try:
+        for step in range(steps):
+            step_started = time.perf_counter()
+            predicted = tracker.predict()
+            contexts = [
+                DecisionContext(step, here, camera.grid.reachable(here), predicted, policy_rng, sent)
+                for camera, here, sent in zip(world.cameras, nearest, commanded, strict=True)
+            ]
+            choices, decision_s = timed(policy.choose, contexts)
+            actions = []
+            for k, (camera, choice) in enumerate(zip(world.cameras, choices, strict=True)):
+                action, commanded[k] = command(camera.grid, choice)
+                nearest[k] = action if action >= 0 else camera.grid.nearest(commanded[k])
+                actions.append(action)
+            wanted = [tracker.updater(k).wants_detections(step) for k in range(len(world.cameras))]
+            records, update_s = [], 0.0
+            for k, seen in enumerate(cameras.looks(step, commanded, wanted)):
+                update_started = time.perf_counter()
+                looked = take_in(world.cameras[k], tracker.updater(k), step, seen)
+                update_s += time.perf_counter() - update_started
+                records.append(
+                    {"actions": actions[k], "commanded": commanded[k], "poses": seen.pose, "decision_s": decision_s}
+                    | looked
+                )
+            tracks = tracker.reported()
+            reported.append(tracks)
+            decision_times_s.append(decision_s)
+            update_times_s.append(update_s)
+            step_times_s.append(time.perf_counter() - step_started)
+            for record, history in zip(records, per_camera, strict=True):
+                for name, value in {**record, "tracks": tracks}.items():
+                    history[name].append(value)
+    finally:
+        cameras.close()
     return NetworkEpisode(
         world.truth,
         world.area_polygon_m,
         reported,
         np.asarray(decision_times_s),
         tuple(episode_of(camera, history) for camera, history in zip(world.cameras, per_camera, strict=True)),
+        np.asarray(update_times_s),
+        np.asarray(step_times_s),
     )
