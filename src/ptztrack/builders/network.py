@@ -9,6 +9,7 @@ camera's from a stream spawned after it.
 """
 
 from dataclasses import replace
+from functools import partial
 from typing import Literal
 
 import numpy as np
@@ -17,6 +18,7 @@ from ptztrack.builders.factories import ekf_tracker, information_policy
 from ptztrack.builders.world import BuiltScene, action_grid, build_scene, camera_world, ptz_camera
 from ptztrack.config import AxisRange, MountedCamera, Scenario, ScenarioError
 from ptztrack.control.network_policy import NetworkCamera, NetworkInformationPolicy
+from ptztrack.evaluate.camera_actors import RayCameras
 from ptztrack.geometry.ptz import look_at
 from ptztrack.loop import episode_seeds
 from ptztrack.network_loop import NetworkEpisode, NetworkWorld, run_network_loop
@@ -86,9 +88,23 @@ def network_tracker(scenario: Scenario, world: NetworkWorld) -> SharedBelief:
 
 
 def run_network_episode(
-    scenario: Scenario, seed: int, coordination: Coordination = "joint", method: Literal["intg", "smpl"] = "intg"
+    scenario: Scenario,
+    seed: int,
+    coordination: Coordination = "joint",
+    method: Literal["intg", "smpl"] = "intg",
+    cameras_on: Literal["serial", "ray"] = "serial",
+    cameras_per_actor: int = 1,
 ) -> NetworkEpisode:
-    """One closed-loop episode of the scenario's camera network (see the module's docstring)."""
+    """One closed-loop episode of the scenario's camera network (see the module's docstring).
+
+    cameras_on : where the cameras capture and detect: 'serial' in this process, 'ray' as actors on a Ray
+    cluster (:class:`~ptztrack.evaluate.camera_actors.RayCameras`, ``cameras_per_actor`` cameras to an
+    actor); the episode is the same.
+    """
     world = network_world(scenario, seed)
     policy = network_policy(scenario, world, coordination, method)
-    return run_network_loop(world, policy, network_tracker(scenario, world), seed)
+    tracker = network_tracker(scenario, world)
+    if cameras_on == "ray":
+        fleet = partial(RayCameras, cameras_per_actor=cameras_per_actor)
+        return run_network_loop(world, policy, tracker, seed, fleet)
+    return run_network_loop(world, policy, tracker, seed)

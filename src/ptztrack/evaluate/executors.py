@@ -130,8 +130,9 @@ def _environment(values: dict[str, str]) -> Iterator[None]:
         os.environ.update(saved)
 
 
-def _run_on_ray(tasks: list[list], run: Callable) -> Iterator[tuple[int, list]]:
-    """Run on the Ray cluster of ``RAY_ADDRESS`` or of an earlier ``ray.init()``; else start a local one.
+def connect_ray(num_cpus: int | None = None):
+    """Ray, connected to the cluster of ``RAY_ADDRESS`` or of an earlier ``ray.init()``; else to a local
+    cluster started here with ``num_cpus`` (None: every core). Returns the ``ray`` module.
 
     A local cluster is kept on the loopback interface only if Ray is first
     imported here: Ray reads its network settings when it is imported, and
@@ -145,15 +146,22 @@ def _run_on_ray(tasks: list[list], run: Callable) -> Iterator[tuple[int, list]]:
         except ImportError:
             raise RuntimeError("the ray executor needs Ray: pip install 'ptztrack[ray]'") from None
         if not ray.is_initialized():
-            if start_local_cluster:
+            if os.environ.get("RAY_ADDRESS"):
+                ray.init(log_to_driver=False)
+            else:
                 ray.init(
+                    num_cpus=num_cpus,
                     _node_ip_address="127.0.0.1",
                     include_dashboard=False,
                     logging_level=logging.ERROR,
                     log_to_driver=False,
                 )
-            else:
-                ray.init(log_to_driver=False)
+    return ray
+
+
+def _run_on_ray(tasks: list[list], run: Callable) -> Iterator[tuple[int, list]]:
+    """Run on the cluster :func:`connect_ray` connects to."""
+    ray = connect_ray()
     remote_task = ray.remote(_run_together)
     pending = {remote_task.remote(run, cells): task for task, cells in enumerate(tasks)}
     remaining = list(pending)
