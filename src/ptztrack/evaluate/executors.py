@@ -134,21 +134,20 @@ def connect_ray(num_cpus: int | None = None):
     """Ray, connected to the cluster of ``RAY_ADDRESS`` or of an earlier ``ray.init()``; else to a local
     cluster started here with ``num_cpus`` (None: every core). Returns the ``ray`` module.
 
-    A local cluster is kept on the loopback interface only if Ray is first
-    imported here: Ray reads its network settings when it is imported, and
-    the processes it starts inherit the environment. The environment is set
-    for the import and the start only, and restored after.
+    A local cluster started here names 127.0.0.1 as its node and has no
+    dashboard, and the environment above is set while Ray is imported and
+    started (the processes it starts inherit it), then restored. Ray reads
+    some network settings when it is first imported, so a local cluster is
+    on the loopback interface for sure only if Ray is first imported here.
     """
-    start_local_cluster = "ray" not in sys.modules and not os.environ.get("RAY_ADDRESS")
-    with _environment(LOOPBACK_RAY_ENVIRONMENT if start_local_cluster else {}):
+    local = not os.environ.get("RAY_ADDRESS")
+    with _environment(LOOPBACK_RAY_ENVIRONMENT if local else {}):
         try:
             import ray
         except ImportError:
             raise RuntimeError("the ray executor needs Ray: pip install 'ptztrack[ray]'") from None
         if not ray.is_initialized():
-            if os.environ.get("RAY_ADDRESS"):
-                ray.init(log_to_driver=False)
-            else:
+            if local:
                 ray.init(
                     num_cpus=num_cpus,
                     _node_ip_address="127.0.0.1",
@@ -156,6 +155,8 @@ def connect_ray(num_cpus: int | None = None):
                     logging_level=logging.ERROR,
                     log_to_driver=False,
                 )
+            else:
+                ray.init(log_to_driver=False)
     return ray
 
 
