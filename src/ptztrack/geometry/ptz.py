@@ -18,6 +18,7 @@ function broadcasts over leading axes: ``poses`` of shape ``(*P, 3)`` go with
 ground points of shape ``(*P, N, 2)`` (or anything that broadcasts to it).
 """
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -102,13 +103,33 @@ def intrinsics(camera: PTZCamera, zoom) -> np.ndarray:
 
 
 def projection_matrix(camera: PTZCamera, poses) -> np.ndarray:
-    """World-to-image projection ``P = K R [I | -C]``; shape ``(*P, 3, 4)``."""
+    """World-to-image projection ``P = K R [I | -C]``; shape ``(*P, 3, 4)``.
+
+    One pose's matrix is remembered (:func:`_pose_projection`, read-only): a tracker's update and a
+    simulated camera's look ask for the same pose's matrix a dozen times, and building it from the
+    angles cost more than the update's own arithmetic with a network's 64 cameras.
+    """
     poses = np.asarray(poses, dtype=float)
+    if poses.shape == (3,):
+        return _pose_projection(camera, float(poses[PAN]), float(poses[TILT]), float(poses[ZOOM]))
+    return _projection_matrix(camera, poses)
+
+
+def _projection_matrix(camera: PTZCamera, poses: np.ndarray) -> np.ndarray:
     R = rotation_world_to_camera(poses[..., PAN], poses[..., TILT])
     K = intrinsics(camera, poses[..., ZOOM])
     KR = K @ R
     translation = -KR @ camera.centre_m
     return np.concatenate([KR, translation[..., None]], axis=-1)
+
+
+# Enough for every pose of a step of a 64-camera network, and each camera's next few.
+@functools.lru_cache(maxsize=4096)
+def _pose_projection(camera: PTZCamera, pan_deg: float, tilt_deg: float, zoom: float) -> np.ndarray:
+    """:func:`_projection_matrix` of the one pose (3, 4), the same numbers, shared and so read-only."""
+    P = _projection_matrix(camera, np.array([pan_deg, tilt_deg, zoom]))
+    P.flags.writeable = False
+    return P
 
 
 def plane_homography(camera: PTZCamera, poses, height_m=0.0) -> np.ndarray:
