@@ -11,8 +11,8 @@ run once.
 Scoring. The annotations are View_001's: they hold the people View_001 shows, not those only the other
 views see. So the tracks are scored where the annotations are, inside the walkable area (the ground
 the recorded View_001 shows, the area the PTZ camera's policies plan over); ``mota_all_tracks`` scores
-every track, as ``experiment pets`` does (for ``ptz`` the two agree wherever its tracks stay in its
-own area).
+every track, as ``experiment pets`` does (for ``ptz`` it is that table's ``intg`` column of the same
+beta, seed by seed: ``mota_all_tracks_per_seed``).
 """
 
 from collections.abc import Sequence
@@ -75,7 +75,8 @@ def run_pets_network_cell(cell: PetsNetworkCell) -> dict:
 
 def summarise_pets_network(rows: Sequence[dict]) -> list[dict]:
     """One row per configuration, in order of first appearance: the means of :data:`SUMMARY_KEYS` and
-    ``zoom`` over its seeds, ``seeds``, ``mota_sd`` (over the seeds; 0 for one) and ``mota_per_seed``."""
+    ``zoom`` over its seeds, ``seeds``, ``mota_sd`` (over the seeds; 0 for one), ``mota_per_seed`` and
+    ``mota_all_tracks_per_seed``."""
     summary = []
     for label in dict.fromkeys(row["config"] for row in rows):
         mine = sorted((row for row in rows if row["config"] == label), key=lambda row: row["seed"])
@@ -88,6 +89,7 @@ def summarise_pets_network(rows: Sequence[dict]) -> list[dict]:
                 **{key: float(np.mean([row[key] for row in mine])) for key in (*SUMMARY_KEYS, "zoom")},
                 "mota_sd": float(np.std(mota, ddof=1)) if len(mota) > 1 else 0.0,
                 "mota_per_seed": mota,
+                "mota_all_tracks_per_seed": [row["mota_all_tracks"] for row in mine],
                 "objects": mine[0]["objects"],
             }
         )
