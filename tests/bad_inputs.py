@@ -290,6 +290,16 @@ def cases(scratch: Path | None) -> list[Case]:
         Case("network: no setting", ("experiment", "network")),
         Case("network: --max-ptz 0", ("experiment", "network", "synthetic", "--max-ptz", "0")),
         Case(
+            "network pets: the synthetic setting's option",
+            ("experiment", "network", "pets", "--max-ptz", "2", *A_FEW_STEPS),
+            says=("--max-ptz",),
+        ),
+        Case(
+            "network pets: a simulated detector on the recording",
+            ("experiment", "network", "pets", "--detector", "realistic", *A_FEW_STEPS),
+            says=("realistic",),
+        ),
+        Case(
             "network: --json in a missing folder",
             ("experiment", "network", "synthetic", "--sequences", "1", *A_FEW_STEPS, "--json", "{dir}/missing/x.json"),
         ),

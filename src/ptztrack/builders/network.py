@@ -8,6 +8,7 @@ seed would. The first camera's detector model draws from the one-camera run's st
 camera's from a stream spawned after it.
 """
 
+from collections.abc import Sequence
 from dataclasses import replace
 from functools import partial
 from typing import Literal
@@ -20,7 +21,7 @@ from ptztrack.config import AxisRange, MountedCamera, Scenario, ScenarioError
 from ptztrack.control.network_policy import NetworkCamera, NetworkInformationPolicy
 from ptztrack.evaluate.camera_actors import RayCameras
 from ptztrack.geometry.ptz import look_at
-from ptztrack.loop import episode_seeds
+from ptztrack.loop import World, episode_seeds
 from ptztrack.network_loop import NetworkEpisode, NetworkWorld, run_network_loop
 from ptztrack.track.shared_belief import SharedBelief
 from ptztrack.track.tracker import EkfTracker
@@ -69,18 +70,41 @@ def network_policy(
 ) -> NetworkInformationPolicy:
     """The network's policy: each PTZ camera's own information-gain policy ``method``, deciding
     ``coordination`` ('joint' or 'independent'); each fixed camera at its widest view of the area."""
-    cameras = []
-    for mounted, camera in zip(scenario.cameras, world.cameras, strict=True):
-        policy = information_policy(camera_scenario(scenario, mounted), camera, method)
-        cameras.append(NetworkCamera(policy, camera.start_action if mounted.kind == "fixed" else None))
+    members = [
+        (camera_scenario(scenario, mounted), camera, mounted.kind == "fixed")
+        for mounted, camera in zip(scenario.cameras, world.cameras, strict=True)
+    ]
+    return policy_of_cameras(members, coordination, method)
+
+
+def policy_of_cameras(
+    members: Sequence[tuple[Scenario, World, bool]], coordination: Coordination, method: Literal["intg", "smpl"]
+) -> NetworkInformationPolicy:
+    """The network policy of cameras given as (the scenario the camera alone runs, its world, whether it
+    is fixed): each camera's information-gain policy ``method`` (a fixed camera's scores its one view,
+    its world's start action), deciding ``coordination``."""
+    cameras = [
+        NetworkCamera(information_policy(alone, world, method), world.start_action if fixed else None)
+        for alone, world, fixed in members
+    ]
     return NetworkInformationPolicy(tuple(cameras), joint=coordination == "joint")
 
 
 def network_tracker(scenario: Scenario, world: NetworkWorld) -> SharedBelief:
     """One belief, updated by each camera's EKF tracker (the scenario's tracker section) in turn."""
+    members = [
+        (camera_scenario(scenario, mounted), camera)
+        for mounted, camera in zip(scenario.cameras, world.cameras, strict=True)
+    ]
+    return belief_of_cameras(members)
+
+
+def belief_of_cameras(members: Sequence[tuple[Scenario, World]]) -> SharedBelief:
+    """One belief, updated in turn by the EKF tracker of each camera given as (the scenario it alone
+    runs, its world)."""
     trackers = []
-    for mounted, camera in zip(scenario.cameras, world.cameras, strict=True):
-        tracker = ekf_tracker(camera_scenario(scenario, mounted), camera)
+    for alone, world in members:
+        tracker = ekf_tracker(alone, world)
         # The scenario's validation keeps a network to the detector-measured EKF.
         assert isinstance(tracker, EkfTracker)
         trackers.append(tracker)

@@ -296,14 +296,29 @@ def _add_occupancy_parser(experiments) -> None:
 
 def _add_network_parser(experiments, detectors: list[str]) -> None:
     network = experiments.add_parser(
-        "network", help="a camera network: PTZ cameras deciding jointly, each alone or fixed, with a wide fixed one"
+        "network",
+        help="a camera network: PTZ cameras deciding jointly, each alone or fixed, with a wide fixed one; or the "
+        "PETS PTZ camera with six views' published detections",
     )
-    network.add_argument("setting", choices=("synthetic",), help="synthetic: 1 to --max-ptz cameras around the area")
-    network.add_argument("--detector", choices=detectors, default="realistic")
+    network.add_argument(
+        "setting",
+        choices=("synthetic", "pets"),
+        help="synthetic: 1 to --max-ptz cameras around the area; pets: the virtual PTZ camera over View_001 and "
+        "the published detections of View_003-008 as fixed cameras",
+    )
+    network.add_argument(
+        "--detector",
+        choices=detectors,
+        help="the cameras' detector (synthetic: default realistic; pets, the PTZ camera's: hog or ideal, default hog)",
+    )
     _add_detector_model_arguments(network)
-    network.add_argument("--sequences", type=_positive_int, default=12)
+    network.add_argument("--sequences", type=_positive_int, help="synthetic: sequences (default 12)")
     network.add_argument("--frames", type=_positive_int, help="overrides the scenario's number of frames")
-    network.add_argument("--max-ptz", type=_positive_int, default=4, help="the most PTZ cameras in a configuration")
+    network.add_argument("--max-ptz", type=_positive_int, help="synthetic: the most PTZ cameras (default 4)")
+    network.add_argument("--seeds", type=_positive_int, help="pets: seeds of the runs with the PTZ camera (default 5)")
+    network.add_argument(
+        "--beta", type=_non_negative_float, help="pets: the PTZ camera's weight of the patrolling term (default 9)"
+    )
     network.add_argument(
         "--method", choices=("intg", "smpl"), default="intg", help="the PTZ cameras' expected information"
     )

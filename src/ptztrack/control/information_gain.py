@@ -168,7 +168,8 @@ def _alpha_closed_form(W, u, v, var_u, cov_uv, var_v, width_px, height_px, reali
         )
         if shifted > 0:
             value -= math.exp(log_scale + math.log(shifted))
-        value *= plateau
+    # A height-independent recall (not realistic) is the plateau at every height: 1 for the ideal detector.
+    value *= plateau
     return min(max(value, 0.0), 1.0)
 
 
@@ -247,7 +248,8 @@ def detection_weight_integral(
         alpha = plateau [P_rect(N(mu, S)) - exp(-Kd (d - r0) + b.mu + b.S.b / 2) P_rect(N(mu + S b, S))],
 
     with ``b = (0, -Kd D)``: an exponential times a Gaussian is a scaled
-    Gaussian. The ideal detector has recall 1 and ``alpha = P_rect(N(mu, S))``.
+    Gaussian. A recall that does not depend on the height (the ideal detector's 1, or a constant one)
+    gives ``alpha = plateau P_rect(N(mu, S))``.
 
     mean_m : (n, 2) predicted ground positions; position_cov_m2 : (n, 2, 2);
     V : (2, 2) pixel noise; actions : flat indices into ``geometry`` (L of them; None: all).
@@ -289,7 +291,7 @@ def _detection_weight_sampled(
                     continue
                 if not (0 <= feet_v <= height_px and 0 <= head_v <= height_px):
                     continue
-                p = plateau * realistic_recall(feet_v - head_v, kd, r0_px) if realistic else 1.0
+                p = plateau * realistic_recall(feet_v - head_v, kd, r0_px) if realistic else plateau
                 alpha[row, track] += p * visible_fraction[sample, track]
     return alpha / M
 

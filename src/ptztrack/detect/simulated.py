@@ -63,7 +63,8 @@ class RecallModel:
 
     kd_per_px, r0_px, plateau : ``recall(r) = plateau (1 - exp(-kd (r - r0)))`` for ``r >= r0``, else 0;
         the plateau (1 in the paper) is the share of people a detector finds however large they look.
-    perfect : recall 1 at every height (the ideal detector); kd, r0 and plateau are then not used.
+    perfect : recall does not depend on the height: the plateau at every height (1: the ideal detector;
+        :meth:`constant`); kd and r0 are then not used.
     """
 
     kd_per_px: float
@@ -74,8 +75,13 @@ class RecallModel:
     def __call__(self, height_px) -> np.ndarray:
         height_px = np.asarray(height_px, dtype=float)
         if self.perfect:
-            return np.ones_like(height_px)
+            return np.full_like(height_px, self.plateau)
         return self.plateau * realistic_recall(height_px, self.kd_per_px, self.r0_px)
+
+    @staticmethod
+    def constant(recall: float) -> "RecallModel":
+        """Recall ``recall`` for every person wholly in the image, whatever their size."""
+        return RecallModel(0.0, 0.0, perfect=True, plateau=recall)
 
 
 def detection_probability(people: PeopleInView, recall: RecallModel) -> np.ndarray:

@@ -11,6 +11,7 @@ from collections.abc import Sequence
 import motmetrics as mm
 import numpy as np
 
+from ptztrack.geometry.area import inside
 from ptztrack.loop import Episode
 from ptztrack.network_loop import NetworkEpisode
 from ptztrack.types import GroundTruth, Tracks
@@ -92,6 +93,12 @@ def network_metrics(episode: NetworkEpisode) -> dict:
     """:func:`episode_metrics` of a camera network: the figures of its one set of tracks, and
     ``height_px``, ``detections`` and ``zoom`` over every camera's detections and poses."""
     return {**tracking_metrics(episode.truth, episode.tracks), **looking_metrics(episode.cameras)}
+
+
+def tracks_within(tracks: list[Tracks], polygon_m) -> list[Tracks]:
+    """Each step's tracks whose ground position lies inside the polygon (K, 2) m: the ones a truth
+    annotated only there can score."""
+    return [step.select(inside(polygon_m, step.mean[:, :2])) if len(step) else step for step in tracks]
 
 
 def tracking_metrics(truth: GroundTruth, tracks: list[Tracks]) -> dict:

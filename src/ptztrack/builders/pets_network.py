@@ -1,0 +1,109 @@
+"""A camera network on PETS 2009 S2.L1: the virtual PTZ camera over View_001's video and the published
+detections of the six other calibrated views as fixed cameras, one shared belief.
+
+The PTZ camera is the one-camera PETS run's (:func:`ptztrack.builders.episode.episode_world`: the same
+scene, detector, detector model and streams), first in the network, so that a network of it alone is,
+step for step, that run. Each other view is a fixed camera backed by its published boxes
+(:class:`ptztrack.detect.published.PublishedDetections`): the virtual camera at its optical centre
+with the scenario's image (160 x 120 px) at the view's field of view, held at the pose that shows
+the recorded view; the scenario's pixel noise, tracker and policy settings; and, as its detector
+model, recall :data:`PUBLISHED_RECALL` for anybody wholly in its image, whatever their size (a curve
+kept, not learned). Boxes scored below the occupancy experiment's threshold for the same files
+(:attr:`ptztrack.occupancy.parameters.OccupancyParameters.min_box_score`) are not used. Every camera
+shares the PTZ camera's scene: its people (the annotations, scored) and its walkable area.
+"""
+
+from collections.abc import Sequence
+from typing import Literal
+
+import numpy as np
+
+from ptztrack.builders.network import Coordination, belief_of_cameras, policy_of_cameras
+from ptztrack.builders.occupancy import recording_from_dataset
+from ptztrack.builders.world import BuiltScene, build_scene, camera_world, detector_model
+from ptztrack.camera.actions import ActionGrid
+from ptztrack.camera.parameters import LandingError
+from ptztrack.camera.pose_feedback import commanded_pose
+from ptztrack.camera.virtual import virtual_ptz
+from ptztrack.config import Scenario, ScenarioError, pets_dataset
+from ptztrack.detect.published import PublishedDetections
+from ptztrack.detect.simulated import RecallModel
+from ptztrack.loop import World, episode_seeds
+from ptztrack.network_loop import NetworkEpisode, NetworkWorld, run_network_loop
+from ptztrack.occupancy.multiview import CameraView
+from ptztrack.occupancy.parameters import OccupancyParameters
+
+PUBLISHED_RECALL = 0.9
+"""The fixed cameras' detector model: the probability that the published detector finds a person wholly
+in the view's image, at any size (people hidden by other tracks count as missed in proportion, as for
+every camera). Fixed a priori, before any run on S2.L1: a round figure for a fine-tuned R-CNN person
+detector's recall of unoccluded people at its usual score threshold of 0.5; not measured on these files."""
+
+
+def published_views(scenario: Scenario) -> tuple[CameraView, ...]:
+    """The built-in PETS dataset's views other than the scenario's recorded one (View_003 to View_008):
+    their calibrations and published boxes (:func:`~ptztrack.builders.occupancy.recording_from_dataset`)."""
+    recording = scenario.required_recording("a PETS camera network")
+    others = [view.model_dump() for view in pets_dataset().views if view.name != recording.view]
+    return recording_from_dataset(pets_dataset(views=others)).views
+
+
+def published_camera_world(scenario: Scenario, scene: BuiltScene, view: CameraView) -> World:
+    """The fixed camera of ``view`` (its calibration and boxes) in the scene of ``scenario``'s recording
+    (see the module's docstring)."""
+    if view.boxes is None or view.image_size_px is None:
+        raise ScenarioError(f"{view.name}: a fixed camera of published detections needs its boxes and image size")
+    assert scene.recording is not None  # published_views asked for the recording
+    virtual, pose = virtual_ptz(view.calibration, view.image_size_px, scenario.camera.image_size_px)
+    grid = ActionGrid(pose[:1], pose[1:2], pose[2:])
+    published = PublishedDetections(
+        virtual.camera, view.calibration, view.boxes, scene.recording.video_frame, OccupancyParameters.min_box_score
+    )
+    return World(
+        camera=virtual.camera,
+        grid=grid,
+        truth=scene.truth,
+        backend=published,
+        detector=published,
+        area_polygon_m=scene.area_polygon_m,
+        start_action=0,
+        pose_source=commanded_pose,
+        landing_error=LandingError(),
+        detector_model=detector_model(scenario, virtual.camera, kept=RecallModel.constant(PUBLISHED_RECALL)),
+    )
+
+
+def pets_network_world(scenario: Scenario, seed: int, ptz: bool, views: Sequence[CameraView]) -> NetworkWorld:
+    """The network of the episode ``seed``: with ``ptz``, the PTZ camera first (the one-camera run's world),
+    then a fixed camera per published view of ``views``."""
+    if not ptz and not views:
+        raise ScenarioError("a PETS camera network needs the PTZ camera or a published view")
+    streams = episode_seeds(seed)
+    scene = build_scene(scenario, np.random.default_rng(streams[0]))
+    worlds = []
+    if ptz:
+        worlds.append(camera_world(scenario, scene, tracker_seed=streams[4], model_seed=streams[5]))
+    worlds += [published_camera_world(scenario, scene, view) for view in views]
+    return NetworkWorld(tuple(worlds))
+
+
+def run_pets_network_episode(
+    scenario: Scenario,
+    seed: int,
+    ptz: bool,
+    views: Sequence[CameraView],
+    coordination: Coordination = "joint",
+    method: Literal["intg", "smpl"] = "intg",
+) -> NetworkEpisode:
+    """One closed-loop episode of the PETS network (:func:`pets_network_world`): the PTZ camera's
+    information-gain policy ``method`` deciding ``coordination`` with the fixed views' expected
+    information, one belief updated by every camera in turn."""
+    world = pets_network_world(scenario, seed, ptz, views)
+    fixed = [index > 0 or not ptz for index in range(len(world.cameras))]
+    policy = policy_of_cameras(
+        [(scenario, camera, is_fixed) for camera, is_fixed in zip(world.cameras, fixed, strict=True)],
+        coordination,
+        method,
+    )
+    tracker = belief_of_cameras([(scenario, camera) for camera in world.cameras])
+    return run_network_loop(world, policy, tracker, seed)
