@@ -58,7 +58,6 @@ import importlib.util  # noqa: E402
 import math  # noqa: E402
 import time  # noqa: E402
 from collections.abc import Callable  # noqa: E402
-from dataclasses import replace  # noqa: E402
 from functools import partial  # noqa: E402
 from pathlib import Path  # noqa: E402
 from unittest import mock  # noqa: E402
@@ -113,15 +112,8 @@ def recomputed_posterior(tracks: Tracks, policy, action: int) -> Tracks:
     geometry = action_geometry(policy.camera, pose[None], policy.person_height_m)
     alpha = detection_weight_integral(policy.camera, geometry, policy.recall, mean_m, position_cov_m2, policy.V)[0]
     seen = np.flatnonzero(alpha > 0)
-    P = tracks.covariance[seen]
     C = observation_matrix(policy.camera, pose, tracks.mean[seen])
-    weight = alpha[seen, None, None]
-    S = weight * (C @ P @ np.swapaxes(C, -1, -2)) + policy.V
-    PCt = P @ np.swapaxes(C, -1, -2)
-    drop = weight * PCt @ np.linalg.solve(S, np.swapaxes(PCt, -1, -2))
-    covariance = tracks.covariance.copy()
-    covariance[seen] = P - 0.5 * (drop + np.swapaxes(drop, -1, -2))
-    return replace(tracks, covariance=covariance)
+    return conditioning.expected_update(tracks, seen, alpha[seen], C, policy.V)
 
 
 class RecordedPolicy:

@@ -91,12 +91,19 @@ def expected_posterior(tracks: Tracks, policy: InformationGainPolicy, action: in
         policy.camera, geometry, policy.recall, mean_m, position_cov_m2, policy.V, actions=[action]
     )[0]
     seen = np.flatnonzero(alpha > 0)
-    P = tracks.covariance[seen]
     # C = [dg/dx 0]: (k, 2, 4), the feet pixel's Jacobian at the predicted means, zero for the velocity.
     position_block = homography_jacobian(geometry.ground_to_image[action], mean_m[seen])
     C = np.concatenate([position_block, np.zeros_like(position_block)], axis=-1)
-    weight = alpha[seen, None, None]
-    S = weight * (C @ P @ np.swapaxes(C, -1, -2)) + policy.V
+    return expected_update(tracks, seen, alpha[seen], C, policy.V)
+
+
+def expected_update(tracks: Tracks, seen, alpha, C, V) -> Tracks:
+    """``tracks`` with the covariances of tracks ``seen`` (k,) updated by a measurement of noise ``V / alpha``:
+    ``P+ = P - alpha P C^T (alpha C P C^T + V)^-1 C P``, alpha (k,) the detection probabilities, C (k, 2, 4)
+    the measurement Jacobians, V (2, 2) px^2 the pixel noise."""
+    P = tracks.covariance[seen]
+    weight = np.asarray(alpha)[:, None, None]
+    S = weight * (C @ P @ np.swapaxes(C, -1, -2)) + V
     PCt = P @ np.swapaxes(C, -1, -2)
     drop = weight * PCt @ np.linalg.solve(S, np.swapaxes(PCt, -1, -2))
     covariance = tracks.covariance.copy()
