@@ -44,17 +44,15 @@ class PomParameters:
     """The probabilistic occupancy map (POM) of Fleuret, Berclaz, Lengagne and Fua (TPAMI 2008),
     :mod:`ptztrack.occupancy.pom`.
 
-    Model: prior is each cell's prior probability of being occupied (epsilon), 0.01, the default of the
-    authors' POM software (released with the paper); sigma scales the pseudo-distance Psi between a
-    foreground mask and a synthetic image, 0.01, that software's value too (there the spread of a
-    Gaussian on the same normalised distance, here its scale as in the paper's equation). A person at a
-    cell is a vertical cylinder height_m tall and width_m across, whose projection's bounding box is the
-    cell's rectangle: 1.75 m, the middle of OccupancyParameters' heights (1.6-1.9 m, the synthetic
-    room's people), and 0.5 m, OccupancyParameters.width_m (the cone model's widest diameter, the room's
-    person width). Grid: cell_m, 0.25 m, half a person's width; the prior is per cell, so it goes with
-    the cell: 0.01 at 0.25 m is 0.16 people per square metre a priori, a few in a room, whereas at
-    LPOM's 0.05 m it would be 4 per square metre and the expected synthetic image would cover most of
-    every view from the start.
+    Model: prior is each cell's prior probability of being occupied (epsilon), 0.01, the default of the authors' POM
+    software (released with the paper), where nothing fits it (the occupancy experiment fits it on annotated frames:
+    :func:`ptztrack.occupancy.evaluation.fitted_prior`); sigma scales the pseudo-distance Psi between a foreground
+    mask and a synthetic image, 0.01, that software's value too (there the spread of a Gaussian on the same
+    normalised distance, here its scale as in the paper's equation). A person at a cell is a vertical cylinder
+    height_m tall and width_m across, whose projection's bounding box is the cell's rectangle: 1.75 m, the middle of
+    OccupancyParameters' heights (1.6-1.9 m, the synthetic room's people), and 0.5 m, OccupancyParameters.width_m
+    (the cone model's widest diameter, the room's person width). Grid: cell_m, 0.25 m, half a person's width (the
+    prior is per cell, so it goes with the cell).
     Working resolution: the masks are averaged over block_px x block_px pixel blocks and the rectangles
     snapped to the blocks; 4 makes the room's 1024 x 768 views 256 x 192, near the 360 x 288 video of
     the paper's sequences.
