@@ -25,12 +25,19 @@ follows each picture the tracker takes. Before the first picture
 the stages are run once on copies (:func:`warm_up`), so that compiling and
 caching are done and the first decision is as fast as the others. Ctrl-C
 (or ``steps`` pictures used) ends the run with what was recorded.
+
+:func:`run_live_network` is the same loop for several cameras sharing one
+ground belief (:class:`ptztrack.roles.NetworkTracker`): a detector stage per
+camera, every picture updating the belief through its camera's updater, and
+one joint decision (:class:`ptztrack.roles.NetworkPolicy`) for every camera
+once no newer picture waits. :func:`run_live` is that loop with one camera.
 """
 
 import copy
 import queue
 import threading
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import partial
 from typing import Protocol
@@ -40,9 +47,9 @@ import numpy as np
 
 from ptztrack.camera.pose_timeline import PoseTimeline
 from ptztrack.camera.stream import LatestFrame
-from ptztrack.loop import StepObserver, World, decide, episode_seeds, track
-from ptztrack.roles import Policy, Tracker
-from ptztrack.types import DecisionContext, Detections, PeopleInView
+from ptztrack.loop import StepObserver, World, command, episode_seeds, timed, track
+from ptztrack.roles import NetworkPolicy, NetworkTracker, Policy, Tracker, Updater
+from ptztrack.types import DecisionContext, Detections, PeopleInView, Tracks
 
 # How long the detector waits for a pose sample after a picture's capture time before it looks the pose
 # up anyway (the camera's move-time model then carries it past the last sample).
@@ -175,38 +182,109 @@ def run_live(
     fields, its ``actions`` (flat index, -1 off the grid), ``poses`` and the picture as ``image``.
     keep_images : keep each picture used, as JPEG, in the episode (for its video).
     """
+    # A camera alone is a network of one: the same stages, the same order.
+    (episode,) = run_live_network(
+        (world,), _Alone(policy), _AloneTracker(tracker), [camera], steps, time_scale, seed,
+        observer, keep_images,
+    )  # fmt: skip
+    return episode
+
+
+@dataclass(frozen=True)
+class _Alone:
+    """One camera's policy as the policy of a network of it alone (:class:`ptztrack.roles.NetworkPolicy`)."""
+
+    policy: Policy
+
+    def choose(self, contexts: Sequence[DecisionContext]) -> list[int | np.ndarray]:
+        return [self.policy.choose(contexts[0])]
+
+
+@dataclass(frozen=True)
+class _AloneTracker:
+    """One camera's tracker as the belief of a network of it alone (:class:`ptztrack.roles.NetworkTracker`)."""
+
+    tracker: Tracker
+
+    def predict(self, dt_s: float | None = None) -> Tracks:
+        return self.tracker.predict(dt_s)
+
+    def updater(self, camera: int) -> Updater:
+        return self.tracker
+
+    def reported(self) -> Tracks:
+        return self.tracker.reported()
+
+
+def run_live_network(
+    worlds: Sequence[World],
+    policy: NetworkPolicy,
+    tracker: NetworkTracker,
+    cameras: Sequence[LiveCamera],
+    steps: int,
+    time_scale: float,
+    seed: int,
+    observer: StepObserver | None = None,
+    keep_images: bool = False,
+) -> tuple[LiveEpisode, ...]:
+    """Drive every camera of ``cameras``, each deciding in its world of ``worlds`` (in the same order; a
+    network's :attr:`ptztrack.network_loop.NetworkWorld.cameras`), with one ground belief: use at most
+    ``steps`` pictures in all; Ctrl-C ends the run early with what was recorded.
+
+    Each camera has its own detector stage (its own thread and detector stream; the first camera's is the
+    one-camera run's). Every detected picture, whichever camera took it, predicts ``tracker`` to its
+    capture time and updates it through that camera's updater; once no newer picture waits, ``policy``
+    decides for every camera together, each camera's context as :func:`run_live` makes it (a moving camera
+    is given its target only), and each is sent its choice.
+
+    Returns each camera's :class:`LiveEpisode`: the pictures it supplied, each with the belief's tracks
+    after its update, and its camera's command after it. observer : called after every decision with the
+    context and row of the camera whose picture led to it; the rest as :func:`run_live`.
+    """
     _, detector_seed, policy_seed, _, _, _ = episode_seeds(seed)
     policy_rng = np.random.default_rng(policy_seed)
-    grid = world.grid
-    nearest, commanded = world.start_action, grid.poses[world.start_action]
-    camera.send(commanded)
-    detected: queue.Queue = queue.Queue(maxsize=1)  # the detector is at most one picture ahead
+    # The first camera detects with the one-camera run's stream, every other with one spawned after it.
+    detector_seeds = [detector_seed, *detector_seed.spawn(len(cameras) - 1)]
+    grids = [camera_world.grid for camera_world in worlds]
+    actions = [camera_world.start_action for camera_world in worlds]
+    commanded = [grid.poses[action] for grid, action in zip(grids, actions, strict=True)]
+    for camera, pose in zip(cameras, commanded, strict=True):
+        camera.send(pose)
+    # Each detector is at most one picture ahead.
+    detected: queue.Queue = queue.Queue(maxsize=len(cameras))
     stopping = threading.Event()
-    detector = threading.Thread(
-        target=_detect_pictures,
-        args=(world, camera, detector_seed, detected, stopping),
-        name="live-detector",
-        daemon=True,
-    )
-    rows: list[dict] = []
+    detectors = [
+        threading.Thread(
+            target=_detect_pictures,
+            args=(index, camera_world, camera, seeds, detected, stopping),
+            name=f"live-detector-{index}",
+            daemon=True,
+        )
+        for index, (camera_world, camera, seeds) in enumerate(zip(worlds, cameras, detector_seeds, strict=True))
+    ]
+    rows: list[list[dict]] = [[] for _ in cameras]
+    used = 0
     started_s = time.time()
-    detector.start()
+    for detector in detectors:
+        detector.start()
     last_time_s: float | None = None
     last_decided_s: float | None = None
     try:
-        while len(rows) < steps:
+        while used < steps:
             try:
                 item = detected.get(timeout=IDLE_WAIT_S)
             except queue.Empty:
                 continue
             if isinstance(item, BaseException):
                 raise item
-            frame, at, detections, picked_s, detected_s = item
+            index, frame, at, detections, picked_s, detected_s = item
+            # Pictures of different cameras may come out of their capture order: the belief never goes back.
             dt_s = None if last_time_s is None else max(frame.time_s - last_time_s, 0.0) * time_scale
-            last_time_s = frame.time_s
+            last_time_s = frame.time_s if last_time_s is None else max(last_time_s, frame.time_s)
             tracker.predict(dt_s)
             view = _CapturedView(frame.image)
-            update, measured = track(tracker, detections, at.pose, partial(view.image, len(rows), at.pose), at.sd)
+            image = partial(view.image, used, at.pose)
+            update, measured = track(tracker.updater(index), detections, at.pose, image, at.sd)
             row = {
                 "capture_time_s": frame.time_s,
                 "picked_s": picked_s,
@@ -221,39 +299,60 @@ def run_live(
                 "detections": measured,
                 "images": _jpeg(frame.image) if keep_images else b"",
             }
-            action = nearest
             if detected.empty():  # decide on the newest picture only
                 decided_s = time.time()
-                now = camera.timeline.at(decided_s)
-                here = commanded if now is None else now.pose
-                nearest = grid.nearest(here)
-                if camera.timeline.moving():  # no new target while the camera moves
-                    nearest = grid.nearest(commanded)
-                    reachable = np.array([nearest])
-                else:
-                    reachable = grid.reachable(nearest)
                 since_s = None if last_decided_s is None else (decided_s - last_decided_s) * time_scale
                 last_decided_s = decided_s
-                context = DecisionContext(len(rows), nearest, reachable, update.tracks, policy_rng, here, since_s)
-                action, commanded, row["decision_s"] = decide(policy, context, grid)
-                row["sent"] = camera.send(commanded)
+                contexts = [
+                    _context(camera, grid, sent_to, used, update.tracks, policy_rng, decided_s, since_s)
+                    for camera, grid, sent_to in zip(cameras, grids, commanded, strict=True)
+                ]
+                choices, row["decision_s"] = timed(policy.choose, contexts)
+                for k, (camera, grid, choice) in enumerate(zip(cameras, grids, choices, strict=True)):
+                    actions[k], commanded[k] = command(grid, choice)
+                    sent = camera.send(commanded[k])
+                    row["sent"] = sent if k == index else row["sent"]
                 row["decided_s"] = time.time()
-            row["commanded"] = commanded
+            row["commanded"] = commanded[index]
             if observer is not None and np.isfinite(row["decided_s"]):
-                observer(len(rows), context, {**row, "actions": action, "image": frame.image})
-            rows.append(row)
+                observer(used, contexts[index], {**row, "actions": actions[index], "image": frame.image})
+            rows[index].append(row)
+            used += 1
     except KeyboardInterrupt:
         pass  # the rows recorded whole so far are the run
     finally:
         stopping.set()
-        detector.join()
-    return _episode(rows, camera.frames.latest.received, started_s, time.time())
+        for detector in detectors:
+            detector.join()
+    ended_s = time.time()
+    return tuple(
+        _episode(camera_rows, camera.frames.latest.received, started_s, ended_s)
+        for camera_rows, camera in zip(rows, cameras, strict=True)
+    )
 
 
-def _detect_pictures(world: World, camera: LiveCamera, seeds, detected: queue.Queue, stopping) -> None:
-    """The detector's stage: each newest picture not yet seen, at the pose of its capture, into ``detected``
-    as (frame, pose, detections, when it was picked, when detected); an exception goes there too, for the
-    tracker's stage to raise."""
+def _context(
+    camera: LiveCamera, grid, commanded, step: int, tracks: Tracks, rng, decided_s: float, since_s: float | None
+) -> DecisionContext:
+    """The decision context of ``camera`` at epoch ``decided_s``: where it is (the pose it was sent to,
+    ``commanded`` (3,), where no pose is known yet), the nearest grid action to that, and what it may reach:
+    while it moves, only the action nearest to its target (the paper's camera is sent no new decision while
+    it moves)."""
+    now = camera.timeline.at(decided_s)
+    here = commanded if now is None else now.pose
+    if camera.timeline.moving():
+        nearest = grid.nearest(commanded)
+        reachable = np.array([nearest])
+    else:
+        nearest = grid.nearest(here)
+        reachable = grid.reachable(nearest)
+    return DecisionContext(step, nearest, reachable, tracks, rng, here, since_s)
+
+
+def _detect_pictures(index: int, world: World, camera: LiveCamera, seeds, detected: queue.Queue, stopping) -> None:
+    """Camera ``index``'s detector stage: each newest picture not yet seen, at the pose of its capture, into
+    ``detected`` as (index, frame, pose, detections, when it was picked, when detected); an exception goes
+    there too, for the tracker's stage to raise."""
     try:
         number = 0
         while not stopping.is_set():
@@ -270,7 +369,7 @@ def _detect_pictures(world: World, camera: LiveCamera, seeds, detected: queue.Qu
             detected_s = time.time()
             while not stopping.is_set():
                 try:
-                    detected.put((frame, at, detections, picked_s, detected_s), timeout=IDLE_WAIT_S)
+                    detected.put((index, frame, at, detections, picked_s, detected_s), timeout=IDLE_WAIT_S)
                     break
                 except queue.Full:
                     continue
