@@ -11,7 +11,7 @@ each step taking the truth of the step its image showed.
 
 import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING
 
@@ -47,27 +47,33 @@ def camera_spaces(calibration: CameraCalibrationFile) -> CameraSpaces:
 @dataclass
 class RecordingFeed:
     """The pictures of the virtual ONVIF camera: ``world``'s view of its recording at a pose, the
-    recording's step advancing with the time since the first picture (``step_s`` apart, divided by
-    ``time_scale``), from its start again after its last step; a camera restarted with the same feed
-    goes on with the recording. ``log`` holds (epoch s, step, pan, tilt, zoom) per picture, and
-    ``thumbnails``, where it is a list, each picture's :func:`thumbnail` (to tell afterwards which picture
-    a client received)."""
+    recording's step advancing with the time since ``started_s`` (epoch seconds; the first picture's
+    when None), ``step_s`` apart divided by ``time_scale``, from its start again after its last step; a
+    camera restarted with the same feed goes on with the recording. ``log`` holds (epoch s, step, pan,
+    tilt, zoom) per picture, and ``thumbnails``, where it is a list, each picture's :func:`thumbnail` (to
+    tell afterwards which picture a client received).
+
+    Several cameras over one recording (:func:`virtual_onvif_cameras`) have a feed each, with the same
+    ``started_s`` (so they show the same step at the same moment) and the same ``render_lock`` (their
+    world's video is read by one camera at a time)."""
 
     world: World
     step_s: float
     time_scale: float = 1.0
     log: list[tuple[float, int, float, float, float]] = field(default_factory=list)
     thumbnails: list[np.ndarray] | None = None
+    started_s: float | None = None
+    render_lock: threading.Lock = field(default_factory=threading.Lock, repr=False)
     _lock: threading.Lock = field(default_factory=threading.Lock, repr=False)
-    _started_s: float | None = field(default=None, repr=False)
 
     def render(self, pose, elapsed_s: float) -> np.ndarray:
         """The picture at ``pose``; ``elapsed_s`` (the camera's own clock) is not used: the feed's is."""
         now_s = time.time()
-        self._started_s = now_s if self._started_s is None else self._started_s
+        self.started_s = now_s if self.started_s is None else self.started_s
         steps = self.world.truth.positions_m.shape[0]
-        step = int((now_s - self._started_s) * self.time_scale / self.step_s) % steps
-        image = self.world.backend.image(step, np.asarray(pose, dtype=float))
+        step = int((now_s - self.started_s) * self.time_scale / self.step_s) % steps
+        with self.render_lock:
+            image = self.world.backend.image(step, np.asarray(pose, dtype=float))
         if image is None:
             raise RuntimeError("the virtual ONVIF camera needs a recording with a video")
         small = None if self.thumbnails is None else thumbnail(image)
@@ -204,6 +210,26 @@ def virtual_onvif_camera(
         f_min_px=world.camera.f_min_px,
     )
     return camera, feed
+
+
+def virtual_onvif_cameras(
+    scenario: Scenario, time_scale: float, ports: Sequence[int], username: str = "", password: str = ""
+) -> list[tuple["VirtualONVIFCamera", RecordingFeed]]:
+    """Virtual ONVIF cameras over one play of ``scenario``'s recording (not started), one on each of
+    ``ports`` (0: any free port), each with the feed that logs its truth: they show the same recording
+    step at the same moment, each at its own pose, and move each by its own mechanics (as
+    :func:`virtual_onvif_camera`)."""
+    first_camera, first_feed = virtual_onvif_camera(scenario, time_scale, ports[0], username, password)
+    # The recording's clock starts now for every camera, not at each one's first picture.
+    first_feed.started_s = time.time()
+    cameras = [(first_camera, first_feed)]
+    for port in ports[1:]:
+        feed = RecordingFeed(
+            first_feed.world, first_feed.step_s, time_scale, started_s=first_feed.started_s,
+            render_lock=first_feed.render_lock,
+        )  # fmt: skip
+        cameras.append(virtual_onvif_camera(scenario, time_scale, port, username, password, feed))
+    return cameras
 
 
 def live_world(scenario: Scenario, calibration: CameraCalibrationFile, seed: int) -> World:

@@ -199,12 +199,17 @@ def _add_camera_commands(commands, policies: list[str]) -> None:
     calibrate.set_defaults(handler="ptztrack.cli.camera:calibrate_camera_command")
 
     serve = commands.add_parser("serve-camera", help="serve the PETS virtual PTZ camera over ONVIF on 127.0.0.1")
-    serve.add_argument("--port", type=_port, default=8080)
+    serve.add_argument("--port", type=_port, default=8080, help="the first camera's port (0: any free port each)")
+    serve.add_argument(
+        "--cameras", type=_positive_int, default=1, help="serve this many cameras, on --port and the ports after it"
+    )
     serve.add_argument("--scenario", default="pets", help="'pets' (built in) or a recording scenario YAML file")
     serve.add_argument("--time-scale", type=_positive_float, default=1.0, help="the recording's speed")
     serve.add_argument("--user", help=f"require this user (password: --credentials or ${PASSWORD_VARIABLE})")
     serve.add_argument("--credentials", type=Path, help="a YAML file with username and password to require")
-    serve.add_argument("--truth-log", type=Path, help="append every picture's time, step and pose here (CSV)")
+    serve.add_argument(
+        "--truth-log", type=Path, help="append every picture's time, step and pose here (CSV; the first camera's)"
+    )
     serve.set_defaults(handler="ptztrack.cli.camera:serve_camera_command")
 
 

@@ -16,7 +16,7 @@ from ptztrack.builders.live import (
     live_pictures,
     run_live_episode,
     virtual_calibration,
-    virtual_onvif_camera,
+    virtual_onvif_cameras,
 )
 from ptztrack.camera.move_timing import measure_image_delay, measure_move_times, timed_move
 from ptztrack.camera.onvif_client import ONVIFClient, camera_address
@@ -140,14 +140,23 @@ def serve_camera_command(args: argparse.Namespace) -> int:
             f"serve-camera: give a user and a password (--user with --credentials or ${PASSWORD_VARIABLE}), "
             "or neither for a camera without authentication"
         )
-    camera, feed = virtual_onvif_camera(scenario, args.time_scale, args.port, username, password)
+    # Camera k on the port after camera k - 1's; port 0 gives each camera any free port.
+    ports = [args.port + k if args.port else 0 for k in range(args.cameras)]
+    if ports[-1] > 65535:
+        raise ScenarioError(f"serve-camera: {args.cameras} cameras from port {args.port} go past port 65535")
+    cameras = virtual_onvif_cameras(scenario, args.time_scale, ports, username, password)
+    # The cameras share the recording's clock, so the first camera's log gives every camera's steps.
+    feed = cameras[0][1]
     log_file = None if args.truth_log is None else open(args.truth_log, "w", encoding="utf-8")  # noqa: SIM115
     written = 0
-    camera.start()
+    started = []
     try:
-        print(f"virtual ONVIF camera: onvif://127.0.0.1:{camera.onvif_port} (calibration: virtual)", flush=True)
-        if camera.rtsp_port is not None:
-            print(f"RTSP: rtsp://127.0.0.1:{camera.rtsp_port}/", flush=True)
+        for camera, _ in cameras:
+            camera.start()
+            started.append(camera)
+            print(f"virtual ONVIF camera: onvif://127.0.0.1:{camera.onvif_port} (calibration: virtual)", flush=True)
+            if camera.rtsp_port is not None:
+                print(f"RTSP: rtsp://127.0.0.1:{camera.rtsp_port}/", flush=True)
         print(f"the recording plays in a loop, {feed.duration_s:.0f} s a play at this time scale", flush=True)
         if log_file is not None:
             log_file.write(TRUTH_LOG_HEADER + "\n")
@@ -161,9 +170,10 @@ def serve_camera_command(args: argparse.Namespace) -> int:
                 log_file.flush()
                 written += len(rows)
     except KeyboardInterrupt:
-        print("virtual ONVIF camera stopped", file=sys.stderr)
+        print(f"virtual ONVIF camera{'s' if len(cameras) > 1 else ''} stopped", file=sys.stderr)
     finally:
-        camera.stop()
+        for camera in started:
+            camera.stop()
         if log_file is not None:
             log_file.close()
     return 0
