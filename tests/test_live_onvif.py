@@ -120,6 +120,43 @@ def test_the_run_goes_on_through_a_camera_that_goes_away_and_comes_back():
     assert set(before.ids) & set().union(*(set(tracks.ids) for tracks in after)), "tracks lost while away"
 
 
+def test_one_live_run_drives_two_virtual_cameras_of_one_serve_camera_with_one_belief(tmp_path):
+    """`ptztrack serve-camera --cameras 2` in a process of its own and `ptztrack live` with both: each
+    camera is sent a new target and turns or zooms to it, the tracks each camera's pictures report are
+    the one belief's (the same ids), and each camera's files are written."""
+    command = [sys.executable, "-m", "ptztrack.cli", "serve-camera", "--port", "0", "--cameras", "2"]
+    server = subprocess.Popen(
+        command,
+        stdout=subprocess.PIPE,
+        text=True,
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),  # as in the first test
+    )
+    out = tmp_path / "out"
+    try:
+        urls: list[str] = []
+        while len(urls) < 2:
+            line = server.stdout.readline()
+            assert line, "serve-camera ended before both cameras were up"
+            urls += re.findall(r"onvif://127\.0\.0\.1:\d+", line)
+        cameras = [argument for url in urls for argument in ("--camera", url)]
+        status = main(["live", *cameras, "--calibration", "virtual", "--steps", "30", "--out", str(out)])
+    finally:
+        server.send_signal(signal.SIGINT)
+        server.communicate(timeout=30)
+    assert status == 0 and server.returncode == 0
+    ids = []
+    for number in (1, 2):
+        steps = np.genfromtxt(out / f"camera-{number}" / "steps.csv", delimiter=",", names=True)
+        commanded = np.c_[steps["commanded_pan_deg"], steps["commanded_tilt_deg"], steps["commanded_zoom"]]
+        poses = np.c_[steps["pan_deg"], steps["tilt_deg"], steps["zoom"]]
+        assert len(np.unique(commanded, axis=0)) > 1, f"camera {number} was sent no new target"
+        assert np.any(np.abs(poses - poses[0]) > 1e-3), f"camera {number} did not move"
+        tracks = np.genfromtxt(out / f"camera-{number}" / "tracks.csv", delimiter=",", names=True)
+        ids.append(set(np.atleast_1d(tracks["id"]).astype(int)))
+        assert (out / f"camera-{number}" / "metrics.json").exists()
+    assert ids[0] and ids[1] and ids[0] & ids[1], "the cameras' pictures report no tracks of one belief"
+
+
 def test_a_refused_connection_exits_2_with_one_line(capsys):
     with socket.socket() as probe:  # a port nobody listens on
         probe.bind(("127.0.0.1", 0))

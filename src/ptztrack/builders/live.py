@@ -13,12 +13,13 @@ import threading
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Literal
 
 import cv2
 import numpy as np
 
 from ptztrack.builders.episode import episode_world, make_policy, make_tracker
+from ptztrack.builders.network import Coordination, belief_of_cameras, policy_of_cameras
 from ptztrack.builders.world import detector_model
 from ptztrack.camera.live_camera import LiveONVIFCamera
 from ptztrack.camera.onvif_client import CameraAddress, CameraError, ONVIFClient
@@ -29,7 +30,7 @@ from ptztrack.camera.stream import thumbnail
 from ptztrack.config import VIRTUAL_CAMERA_CALIBRATION, CameraCalibrationFile, Scenario
 from ptztrack.control.information_policy import InformationGainPolicy
 from ptztrack.evaluate.video import RenderView
-from ptztrack.live import LiveEpisode, run_live, warm_up
+from ptztrack.live import LiveEpisode, run_live, run_live_network, warm_up
 from ptztrack.loop import Episode, StepObserver, World, episode_seeds
 from ptztrack.roles import Policy
 from ptztrack.types import GroundTruth
@@ -232,16 +233,48 @@ def virtual_onvif_cameras(
     return cameras
 
 
-def live_world(scenario: Scenario, calibration: CameraCalibrationFile, seed: int) -> World:
+def live_world(
+    scenario: Scenario, calibration: CameraCalibrationFile, seed: int, model_seed: np.random.SeedSequence | None = None
+) -> World:
     """The world a live run decides in: the scenario's grid, detector and area, with the calibration's
-    camera position and focal length where it gives them."""
+    camera position and focal length where it gives them; its detector model draws from ``model_seed``
+    (default: the one-camera episode's stream)."""
     world = episode_world(scenario, seed)
     camera = world.camera
     if calibration.position_m is not None:
         camera = replace(camera, position_m=calibration.position_m)
     if calibration.f_min_px is not None:
         camera = replace(camera, f_min_px=calibration.f_min_px)
-    return replace(world, camera=camera, detector_model=detector_model(scenario, camera, episode_seeds(seed)[5]))
+    model_seed = episode_seeds(seed)[5] if model_seed is None else model_seed
+    return replace(world, camera=camera, detector_model=detector_model(scenario, camera, model_seed))
+
+
+def _time_moves(policy: Policy, scenario: Scenario, calibration: CameraCalibrationFile) -> None:
+    """Give an information-gain ``policy`` the camera's calibrated move times, so that it compares
+    information per second (the reward over a step plus the move); other policies need none."""
+    if isinstance(policy, InformationGainPolicy):
+        move_times = MoveTimes(calibration.move_times.pan, calibration.move_times.tilt, calibration.move_times.zoom)
+        policy.move_seconds, policy.step_s = move_times.seconds, 1.0 / scenario.frame_rate_hz
+
+
+def _live_camera(
+    address: CameraAddress, calibration: CameraCalibrationFile, timeout_s: float, transport: str
+) -> LiveONVIFCamera:
+    """The live ONVIF camera at ``address`` (not started), with the calibration's spaces, move times and
+    stream delay."""
+
+    def connect() -> ONVIFClient:
+        client = ONVIFClient(address, timeout_s)
+        try:
+            client.connect()
+        except CameraError:
+            client.close()
+            raise
+        return client
+
+    return LiveONVIFCamera(
+        connect, camera_spaces(calibration), pose_timeline(calibration), calibration.image_delay_s, transport
+    )
 
 
 def run_live_episode(
@@ -266,24 +299,10 @@ def run_live_episode(
     """
     world = live_world(scenario, calibration, seed)
     live_policy = make_policy(policy, scenario, world)
-    if isinstance(live_policy, InformationGainPolicy):
-        move_times = MoveTimes(calibration.move_times.pan, calibration.move_times.tilt, calibration.move_times.zoom)
-        live_policy.move_seconds, live_policy.step_s = move_times.seconds, 1.0 / scenario.frame_rate_hz
+    _time_moves(live_policy, scenario, calibration)
     tracker = make_tracker(None, scenario, world)
     warm_up(world, live_policy, tracker)
-
-    def connect() -> ONVIFClient:
-        client = ONVIFClient(address, timeout_s)
-        try:
-            client.connect()
-        except CameraError:
-            client.close()
-            raise
-        return client
-
-    camera = LiveONVIFCamera(
-        connect, camera_spaces(calibration), pose_timeline(calibration), calibration.image_delay_s, transport
-    )
+    camera = _live_camera(address, calibration, timeout_s, transport)
     try:
         camera.start()
         observer = None if observe is None else observe(world, live_policy)
@@ -291,6 +310,56 @@ def run_live_episode(
     finally:
         camera.close()
     return world, live
+
+
+def run_live_network_episode(
+    scenario: Scenario,
+    calibrations: Sequence[CameraCalibrationFile],
+    addresses: Sequence[CameraAddress],
+    method: Literal["intg", "smpl"],
+    steps: int,
+    time_scale: float,
+    seed: int,
+    coordination: Coordination = "joint",
+    timeout_s: float = 5.0,
+    transport: str = "tcp",
+    keep_images: bool = False,
+) -> tuple[list[World], tuple[LiveEpisode, ...]]:
+    """Connect to the cameras at ``addresses`` (each with its calibration of ``calibrations``, in the same
+    order; a :class:`CameraError` if one cannot be used) and run them on ``steps`` of their pictures in
+    all with one ground belief (:func:`ptztrack.live.run_live_network`): each camera's information-gain
+    policy ``method`` with its calibrated move times, deciding ``coordination`` (the network's policy,
+    :func:`ptztrack.builders.network.policy_of_cameras`), and each camera's EKF tracker updating the one
+    belief in turn (:func:`ptztrack.builders.network.belief_of_cameras`). The cameras are released at the
+    end (Ctrl-C included).
+
+    Returns every camera's world and its :class:`LiveEpisode` (each step's tracks are the belief's).
+    """
+    if len(calibrations) != len(addresses) or not addresses:
+        raise ValueError(f"{len(addresses)} camera addresses with {len(calibrations)} calibrations")
+    # The first camera's detector model draws from the one-camera run's stream, every other from its own.
+    model_seed = episode_seeds(seed)[5]
+    model_seeds = [model_seed, *model_seed.spawn(len(addresses) - 1)]
+    worlds = [
+        live_world(scenario, calibration, seed, camera_seed)
+        for calibration, camera_seed in zip(calibrations, model_seeds, strict=True)
+    ]
+    policy = policy_of_cameras([(scenario, world, False) for world in worlds], coordination, method)
+    tracker = belief_of_cameras([(scenario, world) for world in worlds])
+    for world, member, updater, calibration in zip(worlds, policy.cameras, tracker.cameras, calibrations, strict=True):
+        _time_moves(member.policy, scenario, calibration)
+        warm_up(world, member.policy, updater)
+    cameras: list[LiveONVIFCamera] = []
+    try:
+        # Each camera starts as soon as it is connected, so that one that cannot be is closed with the others.
+        for address, calibration in zip(addresses, calibrations, strict=True):
+            cameras.append(_live_camera(address, calibration, timeout_s, transport))
+            cameras[-1].start()
+        live = run_live_network(worlds, policy, tracker, cameras, steps, time_scale, seed, keep_images=keep_images)
+    finally:
+        for camera in cameras:
+            camera.close()
+    return worlds, live
 
 
 def offline_counterpart(scenario: Scenario, world: World, live: LiveEpisode, truth_log) -> Scenario:

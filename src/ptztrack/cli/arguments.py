@@ -160,10 +160,25 @@ def parser() -> argparse.ArgumentParser:
 def _add_camera_commands(commands, policies: list[str]) -> None:
     """``ptztrack live`` and ``ptztrack serve-camera``: real ONVIF cameras, and a virtual one to test with."""
     live = commands.add_parser("live", help="drive an ONVIF PTZ camera in real time: capture, detect, track, decide")
-    live.add_argument("--camera", required=True, help="onvif://[user[:password]@]host[:port]")
+    live.add_argument(
+        "--camera",
+        required=True,
+        action="append",
+        help="onvif://[user[:password]@]host[:port]; repeated: a network of cameras with one ground belief",
+    )
     live.add_argument("--credentials", type=Path, help="a YAML file with username and password")
     live.add_argument(
-        "--calibration", required=True, help="the camera's calibration YAML, or 'virtual' for ptztrack serve-camera"
+        "--calibration",
+        required=True,
+        action="append",
+        help="the camera's calibration YAML, or 'virtual' for ptztrack serve-camera; one for every camera, "
+        "or one per --camera in their order",
+    )
+    live.add_argument(
+        "--coordination",
+        choices=("joint", "independent"),
+        default="joint",
+        help="a network's decisions: joint (greedy, each camera on the views before it) or each camera alone",
     )
     live.add_argument("--policy", choices=policies, default="smpl")
     live.add_argument("--scenario", default="pets", help="'pets' (built in) or a scenario YAML file")

@@ -2,6 +2,7 @@
 times one's moves, ``ptztrack serve-camera`` serves the PETS virtual camera over ONVIF."""
 
 import argparse
+import contextlib
 import os
 import sys
 import time
@@ -15,6 +16,7 @@ from ptztrack.builders.live import (
     live_as_episode,
     live_pictures,
     run_live_episode,
+    run_live_network_episode,
     virtual_calibration,
     virtual_onvif_cameras,
 )
@@ -26,6 +28,7 @@ from ptztrack.cli.run import format_metrics
 from ptztrack.cli.scenario import build_scenario
 from ptztrack.cli.watch import Watch
 from ptztrack.config import (
+    CameraCalibrationFile,
     MoveTimesSection,
     ScenarioError,
     load_camera_calibration,
@@ -36,6 +39,7 @@ from ptztrack.evaluate.metrics import episode_metrics
 from ptztrack.evaluate.report import write_outputs
 from ptztrack.evaluate.view_state import ViewState
 from ptztrack.files import check_output_file, read_text, run_folder
+from ptztrack.live import LiveEpisode
 from ptztrack.names import PASSWORD_VARIABLE
 
 
@@ -51,25 +55,21 @@ def _credentials(args: argparse.Namespace) -> dict | None:
 
 def live_command(args: argparse.Namespace) -> int:
     scenario = build_scenario(args.scenario, args.detector, detector_model=args.detector_model)
-    calibration = virtual_calibration() if args.calibration == "virtual" else load_camera_calibration(args.calibration)
-    address = camera_address(args.camera, _credentials(args))
+    calibrations = _calibrations(args)
+    addresses = [camera_address(url, _credentials(args)) for url in args.camera]
     truth_log = None if args.truth is None else read_truth_log(args.truth)
     steps = args.steps or scenario.frames
-    print(f"live: {args.policy} on {address}, up to {steps} pictures, RTSP over {args.transport}")
+    if len(addresses) > 1:
+        return _live_network(args, scenario, calibrations, addresses, truth_log, steps)
+    print(f"live: {args.policy} on {addresses[0]}, up to {steps} pictures, RTSP over {args.transport}")
     label = f"live {args.policy}"
     with Watch(args.view, args.out is not None, lambda w, p: ViewState(w, p, steps, label, truth=False)) as watch:
         world, live = run_live_episode(
-            scenario, calibration, address, args.policy, steps, args.time_scale, args.seed, args.timeout_s,
+            scenario, calibrations[0], addresses[0], args.policy, steps, args.time_scale, args.seed, args.timeout_s,
             watch.observe, args.transport, keep_images=args.out is not None,
         )  # fmt: skip
     episode = live_as_episode(world, live, truth_log)
-    rates = live.rates()
-    print(
-        f"{len(live.capture_time_s)} pictures used ({rates['frames_used_per_s']:.2f} per second) of "
-        f"{live.frames_received} received, {int(np.isfinite(live.decided_s).sum())} decisions "
-        f"({rates['decisions_per_s']:.2f} per second, median {1e3 * rates['median_decision_s']:.1f} ms, "
-        f"95 % on a picture at most {rates['frame_age_s_p95']:.2f} s old), {int(live.sent.sum())} new targets sent"
-    )
+    _print_rates(live)
     metrics = episode_metrics(episode)
     if truth_log is not None:
         print(format_metrics(metrics))
@@ -80,6 +80,61 @@ def live_command(args: argparse.Namespace) -> int:
             watch.write(folder)
         print(f"wrote {', '.join(RUN_FOLDER_FILES)} into {args.out}")
     return 0
+
+
+def _calibrations(args: argparse.Namespace) -> list[CameraCalibrationFile]:
+    """Every camera's calibration: ``--calibration`` once for all, or once per ``--camera``."""
+    if len(args.calibration) not in (1, len(args.camera)):
+        raise ScenarioError(
+            f"live: {len(args.calibration)} --calibration for {len(args.camera)} --camera; give one for every "
+            "camera, or one per camera in their order"
+        )
+    names = args.calibration * len(args.camera) if len(args.calibration) == 1 else args.calibration
+    return [virtual_calibration() if name == "virtual" else load_camera_calibration(name) for name in names]
+
+
+def _live_network(args, scenario, calibrations, addresses, truth_log, steps: int) -> int:
+    """``ptztrack live`` with several cameras: one belief, the network's decisions; each camera's files
+    into ``--out``'s camera-K folder (K from 1, in the order of ``--camera``)."""
+    if args.policy not in ("intg", "smpl"):
+        raise ScenarioError(f"live: a network of cameras decides by intg or smpl, not {args.policy}")
+    if args.view is not None:
+        raise ScenarioError("live: --view shows one camera; a network's view is not there yet")
+    print(
+        f"live: {args.policy} ({args.coordination}) on {len(addresses)} cameras, up to {steps} pictures in all, "
+        f"RTSP over {args.transport}"
+    )
+    worlds, lives = run_live_network_episode(
+        scenario, calibrations, addresses, args.policy, steps, args.time_scale, args.seed, args.coordination,
+        args.timeout_s, args.transport, keep_images=args.out is not None,
+    )  # fmt: skip
+    # The cameras share the recording's clock: a virtual camera's truth log places every camera's pictures.
+    episodes = [live_as_episode(world, live, truth_log) for world, live in zip(worlds, lives, strict=True)]
+    with contextlib.ExitStack() as stack:
+        folder = None if args.out is None else stack.enter_context(run_folder(args.out, args.overwrite))
+        for number, (episode, live) in enumerate(zip(episodes, lives, strict=True), start=1):
+            print(f"camera {number}: ", end="")
+            _print_rates(live)
+            metrics = episode_metrics(episode)
+            if truth_log is not None:
+                print(format_metrics(metrics))
+            if folder is not None:
+                title = f"live {args.policy}, camera {number} of {len(lives)}: {len(live.capture_time_s)} pictures"
+                write_outputs(folder / f"camera-{number}", episode, metrics, title, live_pictures(live))
+    if args.out is not None:
+        print(f"wrote camera-1 to camera-{len(lives)} into {args.out}")
+    return 0
+
+
+def _print_rates(live: LiveEpisode) -> None:
+    """One line of a live run's pictures, decisions and their pace."""
+    rates = live.rates()
+    print(
+        f"{len(live.capture_time_s)} pictures used ({rates['frames_used_per_s']:.2f} per second) of "
+        f"{live.frames_received} received, {int(np.isfinite(live.decided_s).sum())} decisions "
+        f"({rates['decisions_per_s']:.2f} per second, median {1e3 * rates['median_decision_s']:.1f} ms, "
+        f"95 % on a picture at most {rates['frame_age_s_p95']:.2f} s old), {int(live.sent.sum())} new targets sent"
+    )
 
 
 def read_truth_log(path: Path) -> np.ndarray:
