@@ -3,6 +3,7 @@ network brings (a camera that goes and comes back, a refused connection, a wrong
 that stops answering)."""
 
 import http.server
+import json
 import os
 import re
 import signal
@@ -123,7 +124,8 @@ def test_the_run_goes_on_through_a_camera_that_goes_away_and_comes_back():
 def test_one_live_run_drives_two_virtual_cameras_of_one_serve_camera_with_one_belief(tmp_path):
     """`ptztrack serve-camera --cameras 2` in a process of its own and `ptztrack live` with both: each
     camera is sent a new target and turns or zooms to it, the tracks each camera's pictures report are
-    the one belief's (the same ids), and each camera's files are written."""
+    the one belief's (the same ids), each camera's files are written, and the view's states show both
+    cameras' pictures."""
     command = [sys.executable, "-m", "ptztrack.cli", "serve-camera", "--port", "0", "--cameras", "2"]
     server = subprocess.Popen(
         command,
@@ -155,6 +157,10 @@ def test_one_live_run_drives_two_virtual_cameras_of_one_serve_camera_with_one_be
         ids.append(set(np.atleast_1d(tracks["id"]).astype(int)))
         assert (out / f"camera-{number}" / "metrics.json").exists()
     assert ids[0] and ids[1] and ids[0] & ids[1], "the cameras' pictures report no tracks of one belief"
+    # The view's states: every camera's latest picture beside the one map, from the last decision on.
+    last = json.loads((out / "view_states.jsonl").read_text().splitlines()[-1])
+    assert [camera["camera"] for camera in last["cameras"]] == [0, 1]
+    assert all(camera["image_jpeg"] and len(camera["footprint_m"]) > 2 for camera in last["cameras"])
 
 
 def test_a_refused_connection_exits_2_with_one_line(capsys):

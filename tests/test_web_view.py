@@ -21,7 +21,7 @@ from ptztrack.builders.episode import episode_world, make_policy, run_episode
 from ptztrack.cli import main
 from ptztrack.config import scenario_from_dict
 from ptztrack.evaluate.video import view_renderer
-from ptztrack.evaluate.view_state import ViewState
+from ptztrack.evaluate.view_state import NetworkViewState, ViewState
 from ptztrack.evaluate.web_view import ViewHub, ViewServer
 from ptztrack.names import VIEW_STATES_FILE
 
@@ -295,4 +295,40 @@ def test_a_browser_follows_the_follow_camera(chromium, tmp_path):
         assert page.locator("#heatmaps .cell").count() == 0 and page.locator("#no-grid").is_visible()
         _screenshot(page, tmp_path / "web_view_follow.png")
     assert follow.returncode == 0
+    assert problems == []
+
+
+@pytest.mark.browser
+def test_a_browser_draws_every_camera_of_a_network_beside_the_one_map(chromium, tmp_path):
+    """A network's states (:class:`NetworkViewState`), replayed: every camera's picture in a panel of its
+    own, the deciding camera's marked, each camera's field of view on the one map, and the decision's
+    reward map. Two cameras of one synthetic run stand in for a live network's (the page draws what the
+    states say; tests/test_live_onvif.py checks a live network's states)."""
+    frames = 6
+    scenario = scenario_from_dict({"frames": frames})
+    world = episode_world(scenario, 0)
+    policy = make_policy("smpl", scenario, world)
+    network = NetworkViewState([ViewState(world, policy, frames, "network", view_renderer(world)) for _ in range(2)])
+    kept: list = []
+    observe = network.observer(keep=kept)
+    # The cameras take turns: camera k's pictures are the run's steps k, k + 2, ...
+    run_episode(scenario, policy, 0, world, observer=lambda step, context, record: observe(
+        step, context, {**record, "camera": step % 2}
+    ))  # fmt: skip
+    out = tmp_path / "network"
+    out.mkdir()
+    network.write(out / VIEW_STATES_FILE, kept)
+    command = [sys.executable, "-m", "ptztrack.cli", "view", str(out), "--steps-per-s", "5"]
+    with _served(command) as (address, replay), _page(chromium) as (page, problems):
+        page.goto(address)
+        _wait_until_finished(page)
+        replay.communicate()
+        assert page.locator("#camera-panel").is_hidden()
+        assert page.locator(".network-camera").count() == 2
+        assert page.locator(".network-camera image").count() == 2
+        assert page.locator(".network-camera.deciding").count() == 1
+        assert page.locator("#map .footprint").count() == 2
+        assert page.locator("#heatmaps .cell").count() == world.grid.size
+        _screenshot(page, tmp_path / "web_view_network.png")
+    assert replay.returncode == 0
     assert problems == []

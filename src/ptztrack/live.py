@@ -239,7 +239,8 @@ def run_live_network(
 
     Returns each camera's :class:`LiveEpisode`: the pictures it supplied, each with the belief's tracks
     after its update, and its camera's command after it. observer : called after every decision with the
-    context and row of the camera whose picture led to it; the rest as :func:`run_live`.
+    context and row of the camera whose picture led to it, the row's ``camera`` its index; the rest as
+    :func:`run_live`.
     """
     _, detector_seed, policy_seed, _, _, _ = episode_seeds(seed)
     policy_rng = np.random.default_rng(policy_seed)
@@ -315,7 +316,9 @@ def run_live_network(
                 row["decided_s"] = time.time()
             row["commanded"] = commanded[index]
             if observer is not None and np.isfinite(row["decided_s"]):
-                observer(used, contexts[index], {**row, "actions": actions[index], "image": frame.image})
+                observer(
+                    used, contexts[index], {**row, "actions": actions[index], "image": frame.image, "camera": index}
+                )
             rows[index].append(row)
             used += 1
     except KeyboardInterrupt:

@@ -29,6 +29,7 @@ from ptztrack.camera.recorded import RecordedPTZ
 from ptztrack.camera.stream import thumbnail
 from ptztrack.config import VIRTUAL_CAMERA_CALIBRATION, CameraCalibrationFile, Scenario
 from ptztrack.control.information_policy import InformationGainPolicy
+from ptztrack.control.network_policy import NetworkInformationPolicy
 from ptztrack.evaluate.video import RenderView
 from ptztrack.live import LiveEpisode, run_live, run_live_network, warm_up
 from ptztrack.loop import Episode, StepObserver, World, episode_seeds
@@ -324,6 +325,7 @@ def run_live_network_episode(
     timeout_s: float = 5.0,
     transport: str = "tcp",
     keep_images: bool = False,
+    observe: Callable[[list[World], NetworkInformationPolicy], StepObserver | None] | None = None,
 ) -> tuple[list[World], tuple[LiveEpisode, ...]]:
     """Connect to the cameras at ``addresses`` (each with its calibration of ``calibrations``, in the same
     order; a :class:`CameraError` if one cannot be used) and run them on ``steps`` of their pictures in
@@ -333,6 +335,7 @@ def run_live_network_episode(
     belief in turn (:func:`ptztrack.builders.network.belief_of_cameras`). The cameras are released at the
     end (Ctrl-C included).
 
+    observe : ``observe(worlds, policy)`` gives the run's step observer (a live view, say).
     Returns every camera's world and its :class:`LiveEpisode` (each step's tracks are the belief's).
     """
     if len(calibrations) != len(addresses) or not addresses:
@@ -355,7 +358,8 @@ def run_live_network_episode(
         for address, calibration in zip(addresses, calibrations, strict=True):
             cameras.append(_live_camera(address, calibration, timeout_s, transport))
             cameras[-1].start()
-        live = run_live_network(worlds, policy, tracker, cameras, steps, time_scale, seed, keep_images=keep_images)
+        observer = None if observe is None else observe(worlds, policy)
+        live = run_live_network(worlds, policy, tracker, cameras, steps, time_scale, seed, observer, keep_images)
     finally:
         for camera in cameras:
             camera.close()

@@ -37,10 +37,10 @@ from ptztrack.config import (
 )
 from ptztrack.evaluate.metrics import episode_metrics
 from ptztrack.evaluate.report import write_outputs
-from ptztrack.evaluate.view_state import ViewState
+from ptztrack.evaluate.view_state import NetworkViewState, ViewState
 from ptztrack.files import check_output_file, read_text, run_folder
 from ptztrack.live import LiveEpisode
-from ptztrack.names import PASSWORD_VARIABLE
+from ptztrack.names import PASSWORD_VARIABLE, VIEW_STATES_FILE
 
 
 def _credentials(args: argparse.Namespace) -> dict | None:
@@ -95,19 +95,29 @@ def _calibrations(args: argparse.Namespace) -> list[CameraCalibrationFile]:
 
 def _live_network(args, scenario, calibrations, addresses, truth_log, steps: int) -> int:
     """``ptztrack live`` with several cameras: one belief, the network's decisions; each camera's files
-    into ``--out``'s camera-K folder (K from 1, in the order of ``--camera``)."""
+    into ``--out``'s camera-K folder (K from 1, in the order of ``--camera``), and the network's view
+    states (every camera's picture beside the one map) into ``--out`` itself."""
     if args.policy not in ("intg", "smpl"):
         raise ScenarioError(f"live: a network of cameras decides by intg or smpl, not {args.policy}")
-    if args.view is not None:
-        raise ScenarioError("live: --view shows one camera; a network's view is not there yet")
     print(
         f"live: {args.policy} ({args.coordination}) on {len(addresses)} cameras, up to {steps} pictures in all, "
         f"RTSP over {args.transport}"
     )
-    worlds, lives = run_live_network_episode(
-        scenario, calibrations, addresses, args.policy, steps, args.time_scale, args.seed, args.coordination,
-        args.timeout_s, args.transport, keep_images=args.out is not None,
-    )  # fmt: skip
+    label = f"live {args.policy} ({args.coordination})"
+
+    def view(worlds, policy) -> NetworkViewState:
+        return NetworkViewState(
+            [
+                ViewState(world, member.policy, steps, f"{label}, camera {number}", truth=False)
+                for number, (world, member) in enumerate(zip(worlds, policy.cameras, strict=True), start=1)
+            ]
+        )
+
+    with Watch(args.view, args.out is not None, view) as watch:
+        worlds, lives = run_live_network_episode(
+            scenario, calibrations, addresses, args.policy, steps, args.time_scale, args.seed, args.coordination,
+            args.timeout_s, args.transport, keep_images=args.out is not None, observe=watch.observe,
+        )  # fmt: skip
     # The cameras share the recording's clock: a virtual camera's truth log places every camera's pictures.
     episodes = [live_as_episode(world, live, truth_log) for world, live in zip(worlds, lives, strict=True)]
     with contextlib.ExitStack() as stack:
@@ -121,8 +131,10 @@ def _live_network(args, scenario, calibrations, addresses, truth_log, steps: int
             if folder is not None:
                 title = f"live {args.policy}, camera {number} of {len(lives)}: {len(live.capture_time_s)} pictures"
                 write_outputs(folder / f"camera-{number}", episode, metrics, title, live_pictures(live))
+        if folder is not None:
+            watch.write(folder)
     if args.out is not None:
-        print(f"wrote camera-1 to camera-{len(lives)} into {args.out}")
+        print(f"wrote camera-1 to camera-{len(lives)} and {VIEW_STATES_FILE} into {args.out}")
     return 0
 
 

@@ -17,7 +17,7 @@ import base64
 import json
 import time
 from collections import deque
-from collections.abc import Iterable, Iterator
+from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -163,6 +163,28 @@ class ViewState:
 
     def state_json(self, view: StepView) -> str:
         """The state of ``view`` as one line of JSON (the image encoded here where it is still BGR)."""
+        return self.scene_appended(json.dumps(self.state(view), allow_nan=False))
+
+    def scene_appended(self, state_json: str) -> str:
+        """A state's JSON object with the run's ``scene`` (encoded once) as its last member."""
+        return f'{state_json[:-1]}, "scene": {self._scene_json}}}'
+
+    def camera_state(self, view: StepView) -> dict:
+        """What the page draws of one camera of a network beside the one map: its picture, pose,
+        detections, the tracks in its image, its field of view on the ground, where it stands (m) and
+        its image's size (px)."""
+        state = self.state(view)
+        camera = self.world.camera
+        return {
+            **{name: state[name] for name in ("step", "pose", "commanded", "image_jpeg", "detections_px")},
+            "tracks": [{"id": track["id"], "image": track["image"]} for track in state["tracks"]],
+            "footprint_m": state["footprint_m"],
+            "camera_m": _rounded(camera.centre_m[:2], 3),
+            "image_size_px": [camera.image_width_px, camera.image_height_px],
+        }
+
+    def state(self, view: StepView) -> dict:
+        """The state of ``view`` as a JSON-ready dict, without the scene (:meth:`state_json`)."""
         camera, pose, tracks = self.world.camera, view.pose, view.tracks
         position_m, covariance_m2 = tracks.mean[:, :2], tracks.covariance[:, :2, :2]
         ground_axes_m, ground_angle_deg = ellipse_axes(covariance_m2)
@@ -206,8 +228,7 @@ class ViewState:
             },
             "metrics": view.figures,
         }
-        text = json.dumps(state, allow_nan=False)
-        return f'{text[:-1]}, "scene": {self._scene_json}}}'
+        return state
 
     def lines(self, views: Iterable[StepView]) -> Iterator[str]:
         """Each view's state, its image drawn by :attr:`render` where there is one."""
@@ -218,6 +239,80 @@ class ViewState:
     def write(self, path: Path, views: Iterable[StepView]) -> None:
         """The states of ``views`` into ``path`` (``view_states.jsonl``: a line of JSON per step), atomically."""
         write_atomically(Path(path), "".join(line + "\n" for line in self.lines(views)).encode())
+
+
+@dataclass(frozen=True)
+class NetworkStepView:
+    """What one decision's state of a camera network is made of: ``camera``, the index of the camera whose
+    picture led to it, and ``views``, every camera's latest :class:`StepView` (None before its first)."""
+
+    camera: int
+    views: tuple[StepView | None, ...]
+
+
+class NetworkViewState:
+    """Each decision's state for a network of cameras with one belief (a live network run): the state of
+    the camera whose picture led to the decision, as its :class:`ViewState` makes it (its image, the map
+    and its reward map), with ``cameras``: every camera's latest picture and field of view
+    (:meth:`ViewState.camera_state`), drawn beside the one map.
+
+    cameras : each camera's :class:`ViewState`, in the network's order; the records the observer is
+    given carry their camera's index as ``camera``.
+    """
+
+    def __init__(self, cameras: Sequence[ViewState]):
+        self.cameras = tuple(cameras)
+        self.steps = self.cameras[0].steps
+        # Each camera's latest step, context and record: taken into a view only when a state is due.
+        self._latest: list[tuple[int, DecisionContext, dict] | None] = [None] * len(self.cameras)
+
+    def observer(self, publish=None, keep: list[NetworkStepView] | None = None) -> StepObserver:
+        """The loop's observer, as :meth:`ViewState.observer`'s, over every camera's latest step."""
+
+        def observe(step: int, context: DecisionContext, record: dict) -> None:
+            camera = int(record["camera"])
+            self.cameras[camera].count(record)
+            self._latest[camera] = (step, context, record)
+            kept = None
+            if keep is not None:
+                kept = self._take(camera)
+                keep.append(kept)
+            if publish is not None:
+
+                def take():
+                    view = kept if kept is not None else self._take(camera)
+                    return lambda: self.state_json(view)
+
+                publish(step, step == self.steps - 1, take)
+
+        return observe
+
+    def _take(self, camera: int) -> NetworkStepView:
+        """Every camera's latest view, on the run's thread (a recording's reader is not shared), the
+        deciding ``camera``'s with it."""
+        views = []
+        for view_state, latest in zip(self.cameras, self._latest, strict=True):
+            view = None if latest is None else view_state.take(*latest)
+            if view is not None and view_state.render is not None:
+                view = replace(view, image=view_state.render(view.step, view.pose))
+            views.append(view)
+        return NetworkStepView(camera, tuple(views))
+
+    def state_json(self, view: NetworkStepView) -> str:
+        """The state of ``view`` as one line of JSON: the deciding camera's state and ``cameras``."""
+        deciding = self.cameras[view.camera]
+        own = view.views[view.camera]
+        assert own is not None, "the deciding camera's step is the latest it has"
+        state = deciding.state(own)
+        state["cameras"] = [
+            None if camera_view is None else {"camera": index, **view_state.camera_state(camera_view)}
+            for index, (view_state, camera_view) in enumerate(zip(self.cameras, view.views, strict=True))
+        ]
+        return deciding.scene_appended(json.dumps(state, allow_nan=False))
+
+    def write(self, path: Path, views: Iterable[NetworkStepView]) -> None:
+        """The states of ``views`` into ``path`` (``view_states.jsonl``), atomically."""
+        write_atomically(Path(path), "".join(self.state_json(view) + "\n" for view in views).encode())
 
 
 def read_view_states(folder: Path) -> list[str]:
