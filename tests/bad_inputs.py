@@ -471,7 +471,23 @@ def cases(scratch: Path | None) -> list[Case]:
             ("live", "--camera", "127.0.0.1:9", "--calibration", "{dir}/c.yaml"),
             {"c.yaml": "pan_deg: [-90, 90]\ntilt_deg: [-45, 45]\nzoom_curve: [[0, 4], [1, 1]]\n"},
         ),
+        Case(
+            "live: two cameras, three calibrations",
+            ("live", "--camera", "127.0.0.1:9", "--camera", "127.0.0.1:10", *("--calibration", "virtual") * 3),
+            says=("3 --calibration for 2 --camera",),
+        ),
+        Case(
+            "live: a network deciding by fix",
+            ("live", "--camera", "127.0.0.1:9", "--camera", "127.0.0.1:10", "--calibration", "virtual")
+            + ("--policy", "fix"),
+            says=("intg or smpl", "fix"),
+        ),
         Case("serve-camera: a user without a password", ("serve-camera", "--port", "0", "--user", "op")),
+        Case(
+            "serve-camera: cameras past the last port",
+            ("serve-camera", "--port", "65535", "--cameras", "2"),
+            says=("past port 65535",),
+        ),
         Case("view: a folder without view states", ("view", "{dir}")),
         Case("view: a file, not a folder", ("view", "{dir}/f"), {"f": "keep me\n"}),
         Case("view: a line that is not a state", ("view", "{dir}/run"), {"run/view_states.jsonl": '{"step": 0}\n'}),
