@@ -13,7 +13,7 @@ from ptztrack.builders.episode import episode_world, make_policy, make_tracker
 from ptztrack.camera.pose_timeline import PoseTimeline
 from ptztrack.camera.stream import LatestFrame
 from ptztrack.config import scenario_from_dict
-from ptztrack.live import run_live, warm_up
+from ptztrack.live import run_live, run_live_network, warm_up
 from ptztrack.types import Detections
 
 PICTURE_S = 0.02
@@ -128,3 +128,52 @@ def test_warming_up_leaves_the_policy_and_the_tracker_as_they_were(world):
     policy, tracker = make_policy("smpl", scenario, built), make_tracker(None, scenario, built)
     warm_up(built, policy, tracker)
     assert len(tracker.tracks) == 0 and policy.last_terms is None
+
+
+class RecordingBelief:
+    """A network's belief over the scenario's tracker: the time of each prediction and which camera's
+    updater took each picture."""
+
+    def __init__(self, tracker):
+        self.tracker, self.dt_s, self.updaters = tracker, [], []
+
+    def predict(self, dt_s=None):
+        self.dt_s.append(dt_s)
+        return self.tracker.predict(dt_s)
+
+    def updater(self, camera):
+        self.updaters.append(camera)
+        return self.tracker
+
+    def reported(self):
+        return self.tracker.reported()
+
+
+class EveryCameraLast:
+    """A network policy that sends every camera to the last action it may reach, keeping each decision's
+    contexts."""
+
+    def __init__(self):
+        self.contexts = []
+
+    def choose(self, contexts):
+        self.contexts.append(contexts)
+        return [int(context.reachable[-1]) for context in contexts]
+
+
+def test_a_network_updates_one_belief_with_every_cameras_pictures_and_decides_for_all(world):
+    """Two cameras, one moving all the time: each picture, whichever camera took it, updates the one
+    belief through its camera's updater, predicted forward only; every decision has both cameras'
+    contexts, the moving camera's with its target alone, and only the still camera is sent anywhere new."""
+    scenario, built = world
+    belief, policy = RecordingBelief(make_tracker(None, scenario, built)), EveryCameraLast()
+    with PictureCamera(built, moving=True) as moving, PictureCamera(built) as still:
+        lives = run_live_network([built, built], policy, belief, [moving, still], 16, 1.0, 0)
+    pictures = [len(live.capture_time_s) for live in lives]
+    assert sum(pictures) == 16 and min(pictures) > 0
+    assert sorted(belief.updaters) == [0] * pictures[0] + [1] * pictures[1]
+    assert belief.dt_s[0] is None and min(belief.dt_s[1:]) >= 0.0
+    assert policy.contexts and all(len(contexts) == 2 for contexts in policy.contexts)
+    assert all(len(contexts[0].reachable) == 1 for contexts in policy.contexts)
+    assert len(policy.contexts[0][1].reachable) > 1
+    assert len(moving.sent) == 1 and len(still.sent) > 1
