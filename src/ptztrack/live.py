@@ -244,7 +244,8 @@ def run_live_network(
     """
     _, detector_seed, policy_seed, _, _, _ = episode_seeds(seed)
     policy_rng = np.random.default_rng(policy_seed)
-    # The first camera detects with the one-camera run's stream, every other with one spawned after it.
+    # The first camera detects with the episode's detector stream (alone: the one-camera run's), every other
+    # with a stream spawned from it.
     detector_seeds = [detector_seed, *detector_seed.spawn(len(cameras) - 1)]
     grids = [camera_world.grid for camera_world in worlds]
     actions = [camera_world.start_action for camera_world in worlds]
@@ -309,10 +310,11 @@ def run_live_network(
                     for camera, grid, sent_to in zip(cameras, grids, commanded, strict=True)
                 ]
                 choices, row["decision_s"] = timed(policy.choose, contexts)
+                sent = []
                 for k, (camera, grid, choice) in enumerate(zip(cameras, grids, choices, strict=True)):
                     actions[k], commanded[k] = command(grid, choice)
-                    sent = camera.send(commanded[k])
-                    row["sent"] = sent if k == index else row["sent"]
+                    sent.append(camera.send(commanded[k]))
+                row["sent"] = sent[index]  # the row is its camera's
                 row["decided_s"] = time.time()
             row["commanded"] = commanded[index]
             if observer is not None and np.isfinite(row["decided_s"]):
