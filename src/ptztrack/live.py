@@ -231,11 +231,11 @@ def run_live_network(
     network's :attr:`ptztrack.network_loop.NetworkWorld.cameras`), with one ground belief: use at most
     ``steps`` pictures in all; Ctrl-C ends the run early with what was recorded.
 
-    Each camera has its own detector stage (its own thread and detector stream; the first camera's is the
-    one-camera run's). Every detected picture, whichever camera took it, predicts ``tracker`` to its
-    capture time and updates it through that camera's updater; once no newer picture waits, ``policy``
-    decides for every camera together, each camera's context as :func:`run_live` makes it (a moving camera
-    is given its target only), and each is sent its choice.
+    Each camera has its own detector stage (its own thread and detector stream: the first camera's is the
+    episode's, as a camera alone has it, every other's spawned from it). Every detected picture, whichever
+    camera took it, predicts ``tracker`` to its capture time and updates it through that camera's updater;
+    once no newer picture waits, ``policy`` decides for every camera together, each camera's context as
+    :func:`run_live` makes it (a moving camera is given its target only), and each is sent its choice.
 
     Returns each camera's :class:`LiveEpisode`: the pictures it supplied, each with the belief's tracks
     after its update, and its camera's command after it. observer : called after every decision with the
