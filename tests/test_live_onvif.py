@@ -17,7 +17,7 @@ import numpy as np
 import psutil
 import pytest
 
-from ptztrack.builders.episode import run_episode
+from ptztrack.builders.episode import episode_world, run_episode
 from ptztrack.builders.live import (
     camera_spaces,
     live_as_episode,
@@ -146,13 +146,16 @@ def test_one_live_run_drives_two_virtual_cameras_of_one_serve_camera_with_one_be
         server.send_signal(signal.SIGINT)
         server.communicate(timeout=30)
     assert status == 0 and server.returncode == 0
+    world = episode_world(pets_scenario("hog"), 0)
+    start = world.grid.poses[world.start_action]
     ids = []
     for number in (1, 2):
         steps = np.genfromtxt(out / f"camera-{number}" / "steps.csv", delimiter=",", names=True)
         commanded = np.c_[steps["commanded_pan_deg"], steps["commanded_tilt_deg"], steps["commanded_zoom"]]
         poses = np.c_[steps["pan_deg"], steps["tilt_deg"], steps["zoom"]]
-        assert len(np.unique(commanded, axis=0)) > 1, f"camera {number} was sent no new target"
-        assert np.any(np.abs(poses - poses[0]) > 1e-3), f"camera {number} did not move"
+        # A camera may be sent its first new target before its first picture is used: against the start.
+        assert np.any(np.abs(commanded - start) > 1e-3), f"camera {number} was sent no new target"
+        assert np.any(np.abs(poses - start) > 1e-3), f"camera {number} did not move"
         tracks = np.genfromtxt(out / f"camera-{number}" / "tracks.csv", delimiter=",", names=True)
         ids.append(set(np.atleast_1d(tracks["id"]).astype(int)))
         assert (out / f"camera-{number}" / "metrics.json").exists()
