@@ -121,7 +121,7 @@ def stopped() -> int:
     # so) as never handled, and ``python -m`` then ends the process by SIGINT, not with the status
     # returned; the next exec() of a string clears the mark.
     exec("")
-    # The interpreter's last collections walk every object Numba and SciPy made (0.5 to 1.2 s
-    # measured); nothing left needs them, and the memory goes back with the process.
+    # The interpreter's last collections would walk every object Numba and SciPy made, past the two
+    # seconds Ctrl-C may take; nothing left needs them, and the memory goes back with the process.
     gc.freeze()
     return INTERRUPTED_STATUS

@@ -80,8 +80,7 @@ def expected_posterior(tracks: Tracks, policy: InformationGainPolicy, action: in
     module's approximation), alpha (n,) the closed-form probability of detecting each track there.
 
     The view's homographies are the policy's, computed once for its grid
-    (:attr:`InformationGainPolicy.geometry`): recomputing them for one pose was two thirds of a
-    64-camera decision, and gives the same numbers bit for bit.
+    (:attr:`InformationGainPolicy.geometry`), not recomputed for the one pose.
     """
     if len(tracks) == 0:
         return tracks

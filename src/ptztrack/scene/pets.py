@@ -59,8 +59,8 @@ def box_feet_px(boxes_px) -> np.ndarray:
 
 FIT_BOX_HEIGHTS = 0.5
 """The median distance, in box heights, from annotated people's ground positions projected into a view
-to their boxes' feet beyond which the calibration is taken not to fit the view: PETS 2009 S2.L1's seven
-views, 0.05 to 0.12 with their calibrations, 0.96 to 3.1 with K halved or doubled."""
+to their boxes' feet beyond which the calibration is taken not to fit the view: half a person's height
+(the measured values on PETS are on the bad-inputs page)."""
 
 
 def refuse_annotations_off_the_view(
