@@ -24,6 +24,9 @@ def test_the_ring_starts_at_the_scenarios_camera_and_keeps_its_distance_and_heig
     network = network_scenario(scenario, 2, fixed=True, wide=True)
     assert [camera.kind for camera in network.cameras] == ["fixed"] * 3
     assert network.cameras[-1].position_m == WIDE_CAMERA_POSITION_M
+    mast = network_scenario(scenario, 3, fixed=False, wide=False, placement="mast")
+    assert [camera.kind for camera in mast.cameras] == ["ptz"] * 3
+    assert {camera.position_m for camera in mast.cameras} == {scenario.camera.position_m}
 
 
 def test_every_configuration_pairs_with_the_joint_one_of_the_same_cameras():
@@ -40,6 +43,8 @@ def test_every_configuration_pairs_with_the_joint_one_of_the_same_cameras():
         "2ptz-independent+wide": "2ptz-joint+wide",
         "2fixed+wide": "2ptz-joint+wide",
         "wide": None,
+        "2ptz-joint-mast": None,
+        "2ptz-independent-mast": "2ptz-joint-mast",
     }
 
 

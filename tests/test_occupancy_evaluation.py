@@ -10,7 +10,15 @@ from ptztrack.cli import main
 from ptztrack.config import dataset_from_dict, load_dataset, pets_dataset
 from ptztrack.experiments.occupancy import format_occupancy_table
 from ptztrack.geometry.calibration import project_pinhole
-from ptztrack.occupancy.evaluation import detection_metrics, fitted_prior, fitted_selection, halves, track_on_ground
+from ptztrack.occupancy.evaluation import (
+    detection_metrics,
+    fitted_prior,
+    fitted_selection,
+    fitted_variant_selection,
+    halves,
+    suppressed_scores,
+    track_on_ground,
+)
 from ptztrack.occupancy.lpom import Modes
 from ptztrack.occupancy.room import RoomLayout, RoomRenderer, room_truth
 from test_track_ground import PARAMETERS as GROUND_TRACKER
@@ -68,6 +76,30 @@ def test_each_half_is_scored_with_the_threshold_fitted_on_the_other():
         ([0, 1], [2, 3, 4]),
         ([2, 3, 4], [0, 1]),
     ]
+
+
+def test_non_maximum_suppression_keeps_a_mode_unless_a_kept_stronger_one_is_within_the_radius():
+    # Strongest first: b is 0.6 m from a; c is 0.6 m from b (suppressed) and 1.2 m from a.
+    modes = Modes(np.array([[0.0, 0.0], [0.6, 0.0], [1.2, 0.0]]), np.zeros((3, 2, 2)), np.array([0.9, 0.8, 0.7]))
+    np.testing.assert_array_equal(suppressed_scores(modes, 0.5), [0.9, 0.8, 0.7])
+    np.testing.assert_array_equal(suppressed_scores(modes, 1.0), [0.9, -np.inf, 0.7])
+    np.testing.assert_array_equal(suppressed_scores(modes, 1.5), [0.9, -np.inf, -np.inf])
+    assert len(suppressed_scores(Modes.empty(), 1.0)) == 0
+
+
+def test_the_merging_radius_and_threshold_are_fitted_together_on_the_other_half():
+    """Two frames per half. In the first half one person is lit twice (0.6 m apart), in the second two
+    people stand 0.6 m apart: merging over 1 m is best on the first half and so scores the second
+    (losing a person), keeping both is best on the second and so scores the first (a false positive)."""
+    one = np.array([[[0.0, 0.0], [NAN, NAN]]] * 2)
+    two = np.array([[[0.0, 0.0], [0.6, 0.0]]] * 2)
+    truth = np.concatenate([one, two])
+    modes = Modes(np.array([[0.0, 0.0], [0.6, 0.0]]), np.zeros((2, 2, 2)), np.array([0.9, 0.8]))
+    variants = [[[suppressed_scores(modes, radius_m)] * 4] * 2 for radius_m in (0.375, 1.0)]
+    kept, fitted, recall = fitted_variant_selection(truth, variants, [[modes.position_m] * 4] * 2, (0.1, 0.5))
+    assert fitted == [(0, 0.1), (1, 0.1)]
+    assert [k.tolist() for k in kept] == [[True, True]] * 2 + [[True, False]] * 2
+    np.testing.assert_array_equal(recall, [1.0, 1.0, 1.0, 1.0])
 
 
 def write_room_dataset(directory: Path, frames: int = 8, seed: int = 5) -> Path:

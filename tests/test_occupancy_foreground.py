@@ -1,3 +1,5 @@
+import functools
+
 import cv2
 import numpy as np
 import pytest
@@ -121,6 +123,23 @@ def test_the_same_frames_give_the_same_masks_whatever_the_order_and_the_thread_c
             np.testing.assert_array_equal(jumping.edges(frame), silhouette_edges(expected[frame]))
     finally:
         cv2.setNumThreads(threads)
+
+
+def test_a_lead_in_is_learned_before_the_first_frame_and_frame_0_has_silhouettes():
+    """Frames -L..-1 of a recording with a lead-in are what frames 0..L-1 are to a recording without one."""
+    layout = RoomLayout(image_size_px=(256, 192), focal_px=125.0)
+    renderer = RoomRenderer(layout, room_truth(layout, 3, 30, 1), 1)
+    lead_in = 20
+
+    def from_the_lead_in(frame: int) -> np.ndarray:
+        return renderer.image(0, frame + lead_in)
+
+    with_lead_in = ViewForeground(from_the_lead_in, ForegroundParameters(), first_frame=-lead_in)
+    without = ViewForeground(functools.partial(renderer.image, 0), ForegroundParameters())
+    for frame in (0, 5, 2):  # in order, then back (learned again from the lead-in's first frame)
+        np.testing.assert_array_equal(with_lead_in.silhouettes(frame), without.silhouettes(frame + lead_in))
+    assert with_lead_in.silhouettes(0).sum() > 100
+    assert not ViewForeground(from_the_lead_in, ForegroundParameters()).silhouettes(0).any()
 
 
 def test_lpom_from_the_silhouettes_finds_the_rooms_people_within_a_quarter_metre():

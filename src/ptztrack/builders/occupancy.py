@@ -4,7 +4,7 @@
 import functools
 import logging
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -31,7 +31,7 @@ from ptztrack.occupancy.multiview import (
     mot_truth,
     outside_area,
 )
-from ptztrack.occupancy.parameters import OccupancyParameters
+from ptztrack.occupancy.parameters import ForegroundParameters, OccupancyParameters
 from ptztrack.occupancy.plaza import PlazaLayout, plaza_stage, plaza_truth
 from ptztrack.occupancy.render import SceneRenderer
 from ptztrack.occupancy.room import RoomLayout, RoomRenderer, room_truth
@@ -75,6 +75,9 @@ AREA_SAMPLES = 256
 PLAZA_WALKED_PERCENT = 90.0
 """The share of S2.L1's annotated positions, along each axis, inside the plaza's area (a priori: the
 band people walk in, without the few positions in the corners)."""
+PLAZA_LEAD_IN_FRAMES = ForegroundParameters().history // 2
+"""The plaza's lead-in, rendered before its first frame for the background models alone (a priori: the
+frames after which MOG2's learning rate, ``1 / min(2 n, history)``, has reached its steady ``1 / history``)."""
 # 20 s at 15 Hz per sequence (the paper's were 3.5 and 7 minutes long).
 ROOM = RoomLayout()
 
@@ -476,28 +479,39 @@ def plaza_renderer(people: int, frames: int, seed: int) -> SceneRenderer:
 
 def plaza_recording(people: int, frames: int, seed: int) -> MultiViewRecording:
     """The synthetic plaza with ``people`` walking for ``frames`` frames at PETS's frame rate over its
-    area, rendered on demand (:func:`plaza_renderer`); every view has frames and no detector's boxes."""
+    area, rendered on demand (:func:`plaza_renderer`); every view has frames and no detector's boxes.
+
+    The walk starts :data:`PLAZA_LEAD_IN_FRAMES` frames before the first frame: the recording's lead-in,
+    which the background models learn and nothing scores (a fixed camera has watched its scene before
+    any frame a table counts)."""
     layout = plaza_layout()
     names = [view.name for view in pets_dataset().views]
-    renderer = plaza_renderer(people, frames, seed)
-    return rendered_recording(f"plaza-{people}", names, renderer, layout.area_m, layout.frame_rate_hz)
+    renderer = plaza_renderer(people, PLAZA_LEAD_IN_FRAMES + frames, seed)
+    return rendered_recording(
+        f"plaza-{people}", names, renderer, layout.area_m, layout.frame_rate_hz, PLAZA_LEAD_IN_FRAMES
+    )
 
 
 def rendered_recording(
-    name: str, view_names: list[str], renderer: SceneRenderer, area_m, frame_rate_hz: float
+    name: str, view_names: list[str], renderer: SceneRenderer, area_m, frame_rate_hz: float, lead_in_frames: int = 0
 ) -> MultiViewRecording:
     """The recording of a renderer's views (named ``view_names``), its frames rendered on demand, every
-    frame of its truth; area_m : [[x0, y0], [x1, y1]] the ground scored."""
+    frame of its truth after the first ``lead_in_frames`` (the recording's lead-in: its frames -lead_in_frames
+    to -1); area_m : [[x0, y0], [x1, y1]] the ground scored."""
     views = tuple(
-        CameraView(view_name, camera, size_px, _view_frames(renderer, index), None)
+        CameraView(view_name, camera, size_px, _view_frames(renderer, index, lead_in_frames), None)
         for index, (view_name, camera, size_px) in enumerate(
             zip(view_names, renderer.cameras, renderer.image_sizes_px, strict=True)
         )
     )
-    frames = renderer.truth.positions_m.shape[0]
-    return MultiViewRecording(name, views, frames, frame_rate_hz, np.asarray(area_m), renderer.truth)
+    truth = replace(renderer.truth, positions_m=renderer.truth.positions_m[lead_in_frames:])
+    return MultiViewRecording(
+        name, views, truth.positions_m.shape[0], frame_rate_hz, np.asarray(area_m), truth, lead_in_frames
+    )
 
 
-def _view_frames(renderer: SceneRenderer, view: int) -> Callable[[int], np.ndarray]:
-    """The view's frames, the last two kept: both detectors ask for each frame, LPOM for the one before too."""
-    return functools.lru_cache(maxsize=2)(functools.partial(renderer.image, view))
+def _view_frames(renderer: SceneRenderer, view: int, lead_in_frames: int) -> Callable[[int], np.ndarray]:
+    """The view's frames from ``-lead_in_frames``, the last two kept: both detectors ask for each frame, LPOM
+    for the one before too."""
+    image = functools.lru_cache(maxsize=2)(functools.partial(renderer.image, view))
+    return lambda frame: image(frame + lead_in_frames)

@@ -9,13 +9,18 @@ north, four look in from the middle of each side. The wide fixed camera is
 mounted 5 m up on a mast 2 m outside the south-west corner, with the
 scenario's lens (its widest view, about 89 degrees across), and stays at its
 widest view of the area; it has the scenario's detector like the others.
+On a mast, ``N`` PTZ cameras all stand where the scenario's camera stands
+(domes sharing one pole or one building's corner, as sites often mount
+them): they see the same people from the same place, so what one camera
+looks at is exactly what the others would also gain by.
 
 Configurations, for ``N`` = 1 to ``max_ptz``: ``Nptz-joint`` (the PTZ cameras
 choose greedily, each on what the views before it are expected to leave:
 :mod:`ptztrack.control.network_policy`), ``Nptz-independent`` (each as if
 alone), ``Nfixed`` (the same cameras, each at its widest view); for one
 camera joint and independent are the same run, ``1ptz``. With the wide
-camera, the same with ``+wide``, and ``wide`` alone.
+camera, the same with ``+wide``, and ``wide`` alone. On the mast, for
+``N`` >= 2, ``Nptz-joint-mast`` and ``Nptz-independent-mast``.
 
 Every configuration runs the same sequences (seeds 0 .. n-1): the same
 people and, for a camera at the same place in the list (the wide one comes
@@ -44,15 +49,17 @@ SUMMARY_KEYS = ("mota", "motp_m", "idf1", "detections", "zoom")
 
 @dataclass(frozen=True)
 class Configuration:
-    """One row of the table: ``ptz`` ring cameras deciding ``mode`` ('joint', 'independent' or, all of
-    them, 'fixed'), with or without the ``wide`` camera; ``pairs_with``: the joint configuration of the
-    same cameras (None for a joint one and for the wide camera alone)."""
+    """One row of the table: ``ptz`` cameras on the ring or the mast (``placement``) deciding ``mode``
+    ('joint', 'independent' or, all of them, 'fixed'), with or without the ``wide`` camera;
+    ``pairs_with``: the joint configuration of the same cameras (None for a joint one and for the wide
+    camera alone)."""
 
     label: str
     ptz: int
     mode: Literal["joint", "independent", "fixed"]
     wide: bool
     pairs_with: str | None
+    placement: Literal["ring", "mast"] = "ring"
 
 
 @dataclass(frozen=True)
@@ -81,11 +88,14 @@ def ring_positions_m(scenario: Scenario, count: int) -> list[tuple[float, float,
     return positions
 
 
-def network_scenario(scenario: Scenario, ptz: int, fixed: bool, wide: bool) -> Scenario:
-    """``scenario`` with ``ptz`` ring cameras (PTZ, or all fixed with ``fixed``) and, with ``wide``, the
-    wide fixed camera after them (alone for ``ptz`` 0)."""
+def network_scenario(
+    scenario: Scenario, ptz: int, fixed: bool, wide: bool, placement: Literal["ring", "mast"] = "ring"
+) -> Scenario:
+    """``scenario`` with ``ptz`` cameras (PTZ, or all fixed with ``fixed``) on the ring or on the mast at
+    the scenario's camera and, with ``wide``, the wide fixed camera after them (alone for ``ptz`` 0)."""
     kind = "fixed" if fixed else "ptz"
-    cameras = [{"kind": kind, "position_m": position} for position in ring_positions_m(scenario, ptz)]
+    positions = ring_positions_m(scenario, ptz) if placement == "ring" else [scenario.camera.position_m] * ptz
+    cameras = [{"kind": kind, "position_m": position} for position in positions]
     if wide:
         cameras.append({"kind": "fixed", "position_m": WIDE_CAMERA_POSITION_M})
     return Scenario.model_validate({**scenario.model_dump(), "cameras": cameras})
@@ -103,6 +113,10 @@ def configurations(max_ptz: int) -> list[Configuration]:
                 rows.append(Configuration(f"{count}ptz-independent{suffix}", count, "independent", wide, joint))
             rows.append(Configuration(f"{count}fixed{suffix}", count, "fixed", wide, joint))
     rows.append(Configuration("wide", 0, "fixed", True, None))
+    for count in range(2, max_ptz + 1):
+        joint = f"{count}ptz-joint-mast"
+        rows.append(Configuration(joint, count, "joint", False, None, "mast"))
+        rows.append(Configuration(f"{count}ptz-independent-mast", count, "independent", False, joint, "mast"))
     return rows
 
 
@@ -112,7 +126,9 @@ def network_cells(
     """Every configuration (:func:`configurations`) on the sequences 0 .. ``sequences`` - 1."""
     cells = []
     for configuration in configurations(max_ptz):
-        network = network_scenario(scenario, configuration.ptz, configuration.mode == "fixed", configuration.wide)
+        network = network_scenario(
+            scenario, configuration.ptz, configuration.mode == "fixed", configuration.wide, configuration.placement
+        )
         coordination: Coordination = "independent" if configuration.mode == "independent" else "joint"
         cells += [NetworkCell(network, coordination, method, seed, configuration) for seed in range(sequences)]
     return cells

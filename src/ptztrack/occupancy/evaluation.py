@@ -45,6 +45,13 @@ from ptztrack.types import Tracks
 
 MATCH_RADIUS_M = 0.5
 STRENGTH_CHOICES = tuple(np.round(np.arange(0.05, 1.0, 0.05), 2))
+# POM's candidates are cells' local maxima over a cell's neighbours (:class:`~ptztrack.occupancy.parameters.
+# PomParameters`): where views disagree on where a person stands, one person lights two cells. How far
+# apart depends on the views' calibrations, so the radius over which weaker candidates are merged into
+# stronger ones is fitted with the threshold, among the neighbours' radius, LPOM's separation, the
+# clustering baseline's linkage and the midpoint of the two.
+MERGED_METHODS = ("pom",)
+MERGE_RADIUS_CHOICES_M = (0.375, 0.5, 0.75, 1.0)
 UNMATCHED_COST = 1e6
 
 
@@ -164,21 +171,49 @@ def fitted_selection(
     was fitted on (what the tracker may assume of the detector: it is not measured on the frames it
     is used for).
     """
+    kept, fitted, recall = fitted_variant_selection(truth_m, [scores], positions, choices)
+    return kept, [threshold for _, threshold in fitted], recall
+
+
+def fitted_variant_selection(
+    truth_m, variants: Sequence[Sequence[list[np.ndarray]]], positions: Sequence[list[np.ndarray]], choices
+) -> tuple[list, list[tuple[int, float]], np.ndarray]:
+    """:func:`fitted_selection` with a second parameter fitted with the threshold: ``variants[v]`` are the
+    detections' scores under the v-th setting of it (``-inf`` where that setting drops a detection), per
+    pair and per frame as ``scores`` there. Each half gets the (variant, threshold) with the best MODA on
+    the other half (the first of the best, variants before thresholds); returns the kept detections per
+    frame, the fitted (variant, threshold) of each half and the recall per frame (T,) as there."""
     frames = len(truth_m)
     kept: list = [None] * frames
-    fitted = []
+    fitted: list[tuple[int, float]] = []
     recall = np.zeros(frames)
-    for (scored, fitting), pair_scores, pair_positions in zip(halves(frames), scores, positions, strict=True):
+    for pair, ((scored, fitting), pair_positions) in enumerate(zip(halves(frames), positions, strict=True)):
         figures = [
-            detection_metrics(truth_m[fitting], [pair_positions[f][pair_scores[f] >= choice] for f in fitting])
+            (
+                detection_metrics(truth_m[fitting], [pair_positions[f][variant[pair][f] >= choice] for f in fitting]),
+                index,
+                choice,
+            )
+            for index, variant in enumerate(variants)
             for choice in choices
         ]
-        best = int(np.nanargmax([figure["moda"] for figure in figures]))
-        fitted.append(choices[best])
-        recall[scored] = figures[best]["recall"]
+        best = int(np.nanargmax([figure["moda"] for figure, _, _ in figures]))
+        figure, variant_index, threshold = figures[best]
+        fitted.append((variant_index, threshold))
+        recall[scored] = figure["recall"]
         for frame in scored:
-            kept[frame] = pair_scores[frame] >= choices[best]
+            kept[frame] = variants[variant_index][pair][frame] >= threshold
     return kept, fitted, recall
+
+
+def suppressed_scores(modes: Modes, radius_m: float) -> np.ndarray:
+    """The modes' strengths (K,) with ``-inf`` for each mode within ``radius_m`` of a stronger mode that is
+    itself kept (greedy non-maximum suppression on the ground, strongest first as :class:`Modes` are)."""
+    distance_m = cdist(modes.position_m, modes.position_m)
+    kept = np.zeros(len(modes), bool)
+    for index in range(len(modes)):
+        kept[index] = not np.any(distance_m[index, :index][kept[:index]] < radius_m)
+    return np.where(kept, modes.strength, -np.inf)
 
 
 def track_on_ground(
@@ -251,12 +286,15 @@ def score_recording(
     common = {"dataset": recording.name, **(label or {}), "frames": recording.frames, "views": len(recording.views)}
     rows, kept, tracks = [], {}, {}
     for method, modes_by_pair in frames.modes.items():
-        kept_modes, strengths, recall = fitted_selection(
+        radii_m = MERGE_RADIUS_CHOICES_M if method in MERGED_METHODS else (0.0,)
+        kept_modes, fitted, recall = fitted_variant_selection(
             truth_m,
-            [[m.strength for m in modes] for modes in modes_by_pair],
+            [[[suppressed_scores(m, radius_m) for m in modes] for modes in modes_by_pair] for radius_m in radii_m],
             [[m.position_m for m in modes] for modes in modes_by_pair],
             STRENGTH_CHOICES,
         )
+        strengths = [threshold for _, threshold in fitted]
+        merged = {"fitted_merge_radius_m": [radii_m[index] for index, _ in fitted]} if method in MERGED_METHODS else {}
         used = _used_modes(modes_by_pair, truth_m.shape[0])
         kept[method] = [found.select(keep) for found, keep in zip(used, kept_modes, strict=True)]
         tracks[method] = track_on_ground(kept[method], recall, separation_m, recording.frame_rate_hz, tracker)
@@ -267,6 +305,7 @@ def score_recording(
                 **common,
                 **detection_metrics(truth_m, [m.position_m for m in kept[method]]),
                 "fitted_min_strength": [float(value) for value in strengths],
+                **merged,
                 "mota": tracking["mota"],
                 "motp_m": tracking["motp_m"],
                 "idf1": tracking["idf1"],

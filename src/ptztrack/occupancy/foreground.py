@@ -25,14 +25,15 @@ ray grazes a person, which is what the locus's touch constraint assumes
 
 The model is online: a frame's silhouettes come from a model that learned
 only the frames before it, in order, from the recording's first
-(:class:`ViewForeground`). No frame's background is learned from the frame
-itself or from a later one, so the experiment's halves (each scored with a
-threshold fitted on the other, :func:`ptztrack.occupancy.evaluation.halves`)
-see only what a live camera would have seen by then, and the model needs
-no frames set aside for it. The price is the recording's first frames: the
-model has no background on the first (its silhouettes are empty) and
-learns fast at first (the schedule above), so that people present from the
-start are partly taken into the background until they move off.
+(:class:`ViewForeground`), its lead-in frames included where it has some
+(frames before the first that nothing scores). No frame's background is
+learned from the frame itself or from a later one, so the experiment's
+halves (each scored with a threshold fitted on the other,
+:func:`ptztrack.occupancy.evaluation.halves`) see only what a live camera
+would have seen by then. Without a lead-in the price is the recording's
+first frames: the model has no background on the first (its silhouettes are
+empty) and learns fast at first (the schedule above), so that people present
+from the start are partly taken into the background until they move off.
 
 The masks are deterministic: the same frames give the same masks whatever
 OpenCV's thread count, since MOG2 updates each pixel from that pixel's own
@@ -116,37 +117,40 @@ def silhouette_edges(silhouettes) -> np.ndarray:
 class ViewForeground:
     """The silhouettes and their edges of one fixed view, frame by frame, from a model of its past frames.
 
-    ``silhouettes(t)`` is the mask of frame t against the model that learned frames 0, ..., t - 1 in
-    order (MOG2 classifies each pixel of t against the components it has, then learns t). Asked for
-    frames in order, each frame is learned once; a frame ahead of the next one is reached by learning
-    the frames between, and an earlier frame by learning again from frame 0, so that the masks depend
-    on the frame alone, not on the order they were asked in. The last frame's masks are kept.
+    ``silhouettes(t)`` is the mask of frame t against the model that learned frames ``first_frame``,
+    ..., t - 1 in order (MOG2 classifies each pixel of t against the components it has, then learns
+    t). Asked for frames in order, each frame is learned once; a frame ahead of the next one is
+    reached by learning the frames between, and an earlier frame by learning again from
+    ``first_frame``, so that the masks depend on the frame alone, not on the order they were asked
+    in. The last frame's masks are kept.
 
     Parameters
     ----------
-    frames : the view's images, ``frames(t)`` (height, width, 3) uint8 BGR.
+    frames : the view's images, ``frames(t)`` (height, width, 3) uint8 BGR, from ``t = first_frame``.
     parameters : the model and its clean-up.
+    first_frame : the first frame the model learns: 0, or minus the recording's lead-in frames.
     """
 
-    def __init__(self, frames: FrameSource, parameters: ForegroundParameters):
-        self.frames, self.parameters = frames, parameters
+    def __init__(self, frames: FrameSource, parameters: ForegroundParameters, first_frame: int = 0):
+        self.frames, self.parameters, self.first_frame = frames, parameters, first_frame
         self._subtractor = background_subtractor(parameters)
-        self._learned = 0  # frames 0, ..., _learned - 1 are in the model
+        self._learned = first_frame  # frames first_frame, ..., _learned - 1 are in the model
         self._last: tuple[int, np.ndarray] | None = None
 
     def silhouettes(self, frame: int) -> np.ndarray:
-        """The silhouettes of ``frame`` (height, width) bool; none on frame 0 (no background yet)."""
+        """The silhouettes of ``frame`` (height, width) bool; none on ``first_frame`` (no background yet)."""
         if self._last is not None and self._last[0] == frame:
             return self._last[1]
         if frame < self._learned:
-            self._subtractor, self._learned = background_subtractor(self.parameters), 0
+            self._subtractor, self._learned = background_subtractor(self.parameters), self.first_frame
         while self._learned < frame:
             self._subtractor.apply(self.frames(self._learned))
             self._learned += 1
         mask_u8 = self._subtractor.apply(self.frames(frame))
         self._learned = frame + 1
         # MOG2 has no component yet on its first frame: whatever it marks there is not foreground.
-        silhouettes = clean_silhouettes(mask_u8, self.parameters) if frame > 0 else np.zeros(mask_u8.shape, bool)
+        first = frame == self.first_frame
+        silhouettes = np.zeros(mask_u8.shape, bool) if first else clean_silhouettes(mask_u8, self.parameters)
         self._last = (frame, silhouettes)
         return silhouettes
 
@@ -157,9 +161,10 @@ class ViewForeground:
 
 def view_foregrounds(recording: MultiViewRecording, parameters: ForegroundParameters) -> dict[int, ViewForeground]:
     """A background model per view of ``recording`` that has video, by view index: one set that every
-    method reading silhouettes shares (each frame's masks are made once and kept)."""
+    method reading silhouettes shares (each frame's masks are made once and kept), learning from the
+    recording's first lead-in frame."""
     return {
-        index: ViewForeground(view.frames, parameters)
+        index: ViewForeground(view.frames, parameters, -recording.lead_in_frames)
         for index, view in enumerate(recording.views)
         if view.frames is not None
     }

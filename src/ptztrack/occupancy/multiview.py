@@ -55,7 +55,10 @@ class MultiViewRecording:
 
     views : the cameras; frames : how many frames (0-based indices below this);
     frame_rate_hz : frames per second; area_m : [[x0, y0], [x1, y1]] the ground the map covers
-    (people outside it are not scored); truth : the people, positions (frames, N, 2) m, or None.
+    (people outside it are not scored); truth : the people, positions (frames, N, 2) m, or None;
+    lead_in_frames : frames before frame 0 that the views' frame sources also give (indices -lead_in_frames
+    to -1), for the background models to learn before the first frame; no detector sees them, nothing
+    scores them.
     """
 
     name: str
@@ -64,6 +67,7 @@ class MultiViewRecording:
     frame_rate_hz: float
     area_m: np.ndarray
     truth: GroundTruth | None
+    lead_in_frames: int = 0
 
 
 def outside_area(points_m, area_m) -> np.ndarray:
