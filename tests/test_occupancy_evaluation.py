@@ -16,7 +16,7 @@ from ptztrack.occupancy.evaluation import (
     fitted_selection,
     fitted_variant_selection,
     halves,
-    suppressed_scores,
+    merged_scores,
     track_on_ground,
 )
 from ptztrack.occupancy.lpom import Modes
@@ -78,13 +78,17 @@ def test_each_half_is_scored_with_the_threshold_fitted_on_the_other():
     ]
 
 
-def test_non_maximum_suppression_keeps_a_mode_unless_a_kept_stronger_one_is_within_the_radius():
+def test_a_mode_is_kept_unless_too_few_views_see_it_or_a_kept_stronger_one_is_within_the_radius():
     # Strongest first: b is 0.6 m from a; c is 0.6 m from b (suppressed) and 1.2 m from a.
     modes = Modes(np.array([[0.0, 0.0], [0.6, 0.0], [1.2, 0.0]]), np.zeros((3, 2, 2)), np.array([0.9, 0.8, 0.7]))
-    np.testing.assert_array_equal(suppressed_scores(modes, 0.5), [0.9, 0.8, 0.7])
-    np.testing.assert_array_equal(suppressed_scores(modes, 1.0), [0.9, -np.inf, 0.7])
-    np.testing.assert_array_equal(suppressed_scores(modes, 1.5), [0.9, -np.inf, -np.inf])
-    assert len(suppressed_scores(Modes.empty(), 1.0)) == 0
+    np.testing.assert_array_equal(merged_scores(modes, 0.5), [0.9, 0.8, 0.7])
+    np.testing.assert_array_equal(merged_scores(modes, 1.0), [0.9, -np.inf, 0.7])
+    np.testing.assert_array_equal(merged_scores(modes, 1.5), [0.9, -np.inf, -np.inf])
+    assert len(merged_scores(Modes.empty(), 1.0)) == 0
+    # a needs 3 views and has 2: dropped, so it suppresses nobody and b is kept.
+    seen = Modes(modes.position_m, modes.covariance_m2, modes.strength, np.array([2, 3, 5]))
+    np.testing.assert_array_equal(merged_scores(seen, 1.0, min_views=3), [-np.inf, 0.8, -np.inf])
+    np.testing.assert_array_equal(merged_scores(seen, 1.0, min_views=2), [0.9, -np.inf, 0.7])
 
 
 def test_the_merging_radius_and_threshold_are_fitted_together_on_the_other_half():
@@ -95,7 +99,7 @@ def test_the_merging_radius_and_threshold_are_fitted_together_on_the_other_half(
     two = np.array([[[0.0, 0.0], [0.6, 0.0]]] * 2)
     truth = np.concatenate([one, two])
     modes = Modes(np.array([[0.0, 0.0], [0.6, 0.0]]), np.zeros((2, 2, 2)), np.array([0.9, 0.8]))
-    variants = [[[suppressed_scores(modes, radius_m)] * 4] * 2 for radius_m in (0.375, 1.0)]
+    variants = [[[merged_scores(modes, radius_m)] * 4] * 2 for radius_m in (0.375, 1.0)]
     kept, fitted, recall = fitted_variant_selection(truth, variants, [[modes.position_m] * 4] * 2, (0.1, 0.5))
     assert fitted == [(0, 0.1), (1, 0.1)]
     assert [k.tolist() for k in kept] == [[True, True]] * 2 + [[True, False]] * 2

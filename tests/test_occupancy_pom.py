@@ -260,6 +260,10 @@ def test_the_strongest_cell_within_the_separation_is_a_candidate_with_its_q():
     np.testing.assert_allclose(modes.strength, [0.9, 0.6])
     np.testing.assert_allclose(modes.position_m, [grid.centre_of(2, 3), grid.centre_of(6, 9)])
     assert len(pom_modes(q_map, grid, 0.5, 0.1, min_probability=0.95)) == 0
+    assert modes.views is None
+    view_counts = np.arange(grid.cells)  # cell k seen by k views
+    seen = pom_modes(q_map, grid, 0.5, 0.1, min_probability=0.02, view_counts=view_counts)
+    np.testing.assert_array_equal(seen.views, [2 * grid.shape[1] + 3, 6 * grid.shape[1] + 9])
 
 
 def room_detector(layout: RoomLayout, truth, boxes=None) -> PomDetector:

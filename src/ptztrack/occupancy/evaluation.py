@@ -25,6 +25,7 @@ by MOTA, MOTP and IDF1 (:func:`ptztrack.evaluate.metrics.clear_metrics`,
 1 m gate).
 """
 
+import itertools
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Protocol
@@ -49,7 +50,9 @@ STRENGTH_CHOICES = tuple(np.round(np.arange(0.05, 1.0, 0.05), 2))
 # PomParameters`): where views disagree on where a person stands, one person lights two cells. How far
 # apart depends on the views' calibrations, so the radius over which weaker candidates are merged into
 # stronger ones is fitted with the threshold, among the neighbours' radius, LPOM's separation, the
-# clustering baseline's linkage and the midpoint of the two.
+# clustering baseline's linkage and the midpoint of the two. A cell few views see is pinned down by
+# few rectangles (one view's box explains a whole ray of them), so the views a candidate's cell needs
+# are fitted too, as the baseline's views a cluster needs are.
 MERGED_METHODS = ("pom",)
 MERGE_RADIUS_CHOICES_M = (0.375, 0.5, 0.75, 1.0)
 UNMATCHED_COST = 1e6
@@ -206,13 +209,16 @@ def fitted_variant_selection(
     return kept, fitted, recall
 
 
-def suppressed_scores(modes: Modes, radius_m: float) -> np.ndarray:
-    """The modes' strengths (K,) with ``-inf`` for each mode within ``radius_m`` of a stronger mode that is
-    itself kept (greedy non-maximum suppression on the ground, strongest first as :class:`Modes` are)."""
+def merged_scores(modes: Modes, radius_m: float, min_views: int = 0) -> np.ndarray:
+    """The modes' strengths (K,) with ``-inf`` for each mode that is dropped: one whose cell fewer than
+    ``min_views`` views see (where the modes say: :attr:`Modes.views`), and one within ``radius_m`` of a
+    stronger mode that is itself kept (greedy non-maximum suppression on the ground, strongest first as
+    :class:`Modes` are)."""
+    eligible = np.ones(len(modes), bool) if modes.views is None else modes.views >= min_views
     distance_m = cdist(modes.position_m, modes.position_m)
     kept = np.zeros(len(modes), bool)
     for index in range(len(modes)):
-        kept[index] = not np.any(distance_m[index, :index][kept[:index]] < radius_m)
+        kept[index] = eligible[index] and not np.any(distance_m[index, :index][kept[:index]] < radius_m)
     return np.where(kept, modes.strength, -np.inf)
 
 
@@ -285,16 +291,28 @@ def score_recording(
     truth_m = scored_truth(recording)
     common = {"dataset": recording.name, **(label or {}), "frames": recording.frames, "views": len(recording.views)}
     rows, kept, tracks = [], {}, {}
+    views = tuple(range(1, len(recording.views) + 1))
     for method, modes_by_pair in frames.modes.items():
-        radii_m = MERGE_RADIUS_CHOICES_M if method in MERGED_METHODS else (0.0,)
+        merged = method in MERGED_METHODS
+        settings = list(itertools.product(MERGE_RADIUS_CHOICES_M, views)) if merged else [(0.0, 1)]
         kept_modes, fitted, recall = fitted_variant_selection(
             truth_m,
-            [[[suppressed_scores(m, radius_m) for m in modes] for modes in modes_by_pair] for radius_m in radii_m],
+            [
+                [[merged_scores(m, radius_m, min_views) for m in modes] for modes in modes_by_pair]
+                for radius_m, min_views in settings
+            ],
             [[m.position_m for m in modes] for modes in modes_by_pair],
             STRENGTH_CHOICES,
         )
         strengths = [threshold for _, threshold in fitted]
-        merged = {"fitted_merge_radius_m": [radii_m[index] for index, _ in fitted]} if method in MERGED_METHODS else {}
+        merging = (
+            {
+                "fitted_merge_radius_m": [settings[index][0] for index, _ in fitted],
+                "fitted_min_views": [settings[index][1] for index, _ in fitted],
+            }
+            if merged
+            else {}
+        )
         used = _used_modes(modes_by_pair, truth_m.shape[0])
         kept[method] = [found.select(keep) for found, keep in zip(used, kept_modes, strict=True)]
         tracks[method] = track_on_ground(kept[method], recall, separation_m, recording.frame_rate_hz, tracker)
@@ -305,14 +323,13 @@ def score_recording(
                 **common,
                 **detection_metrics(truth_m, [m.position_m for m in kept[method]]),
                 "fitted_min_strength": [float(value) for value in strengths],
-                **merged,
+                **merging,
                 "mota": tracking["mota"],
                 "motp_m": tracking["motp_m"],
                 "idf1": tracking["idf1"],
                 "switches": tracking["switches"],
             }
         )
-    views = tuple(range(1, len(recording.views) + 1))
     pairs = len(halves(recording.frames))
     kept_clusters, min_views, _ = fitted_selection(
         truth_m, [[c.views for c in frames.clusters]] * pairs, [[c.position_m for c in frames.clusters]] * pairs, views

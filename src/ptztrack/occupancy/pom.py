@@ -342,19 +342,26 @@ def pom_posterior(boxes: PersonBoxes, masks: Sequence[np.ndarray | None], parame
     return PomSolver(boxes).posterior(masks, parameters)
 
 
-def pom_modes(q_map, grid: GroundGrid, separation_m: float, window_m: float, min_probability: float) -> Modes:
+def pom_modes(
+    q_map, grid: GroundGrid, separation_m: float, window_m: float, min_probability: float, view_counts=None
+) -> Modes:
     """The candidates of a POM ``q_map`` (rows, columns): cells whose q is the largest within
     ``separation_m`` and at least ``min_probability``, strongest first.
 
     Positions and covariances as :func:`ptztrack.occupancy.lpom.map_modes` (the q-weighted mean and
     spread over the disc of ``window_m``); the strength is the cell's q itself (a probability, not
-    relative to the frame's largest).
+    relative to the frame's largest); with ``view_counts`` (cells,), the views that see each cell, a
+    candidate's ``views`` are those of the cell its position lies in.
     """
     peak = float(np.max(q_map, initial=0.0))
     if peak < min_probability or peak <= 0:
         return Modes.empty()
     modes = map_modes(q_map, grid, separation_m, window_m, min_probability / peak)
-    return Modes(modes.position_m, modes.covariance_m2, modes.strength * peak)
+    views = None
+    if view_counts is not None:
+        cells, on_grid = grid.cell_of(modes.position_m)
+        views = np.where(on_grid, np.asarray(view_counts)[cells], 0)
+    return Modes(modes.position_m, modes.covariance_m2, modes.strength * peak, views)
 
 
 class PomDetector:
@@ -421,7 +428,12 @@ class PomDetector:
         self.last = self.solver.posterior(self.view_masks(frame, masks), parameters)
         q_map = self.last.q.reshape(self.grid.shape)
         modes = pom_modes(
-            q_map, self.grid, parameters.separation_m, parameters.window_m, parameters.candidate_probability
+            q_map,
+            self.grid,
+            parameters.separation_m,
+            parameters.window_m,
+            parameters.candidate_probability,
+            self.boxes.visible.sum(axis=0),
         )
         return q_map, modes
 
