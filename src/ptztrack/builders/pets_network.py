@@ -32,12 +32,22 @@ from ptztrack.loop import World, episode_seeds
 from ptztrack.network_loop import NetworkEpisode, NetworkWorld, run_network_loop
 from ptztrack.occupancy.multiview import CameraView
 from ptztrack.occupancy.parameters import OccupancyParameters
+from ptztrack.track.adaptive_noise import AdaptiveNoise
+from ptztrack.track.association import student_t_gate
+from ptztrack.track.tracker import EkfTracker
 
 PUBLISHED_RECALL = 0.9
 """The fixed cameras' detector model: the probability that the published detector finds a person wholly
 in the view's image, at any size (people hidden by other tracks count as missed in proportion, as for
 every camera). Fixed a priori, before any run on S2.L1: a round figure for a fine-tuned R-CNN person
 detector's recall of unoccluded people at its usual score threshold of 0.5; not measured on these files."""
+
+
+NOISE_GATE_DOF = 4.0
+"""The gate a fixed camera learns its pixel noise within: as wide as the association's gate probability under
+Student-t innovations of 4 degrees of freedom, the value Lange, Little & Taylor (JASA 1989, "Robust
+statistical modeling using the t distribution") recommend where it is not estimated; wider than the
+association's own gate, so that innovations the a-priori noise leaves outside it show."""
 
 
 def published_views(scenario: Scenario) -> tuple[CameraView, ...]:
@@ -106,4 +116,15 @@ def run_pets_network_episode(
         method,
     )
     tracker = belief_of_cameras([(scenario, camera) for camera in world.cameras])
+    for camera, is_fixed in zip(tracker.cameras, fixed, strict=True):
+        if is_fixed:
+            camera.noise = learned_noise(camera)
     return run_network_loop(world, policy, tracker, seed)
+
+
+def learned_noise(tracker: EkfTracker) -> AdaptiveNoise:
+    """A fixed camera's pixel noise, learned from its innovations from the scenario's a-priori noise on (its
+    calibration's error is unknown), within the gate of :data:`NOISE_GATE_DOF`."""
+    parameters = tracker.parameters
+    gate = student_t_gate(parameters.gate_probability, NOISE_GATE_DOF)
+    return AdaptiveNoise(tracker.V, parameters.noise_prior_detections, gate)

@@ -23,6 +23,10 @@ class TrackerParameters:
         reports no false positives.
     existence_update : 'bayes' (see :mod:`ptztrack.track.tracker`) or 'fixed'; existence_to_report :
         the existence from which a track is reported.
+    noise_prior_detections : where a camera's pixel noise is learned (:mod:`ptztrack.track.adaptive_noise`),
+        the a-priori noise's weight in detections: 1, the inverse-Wishart prior on a 2 x 2 covariance
+        with the fewest degrees of freedom whose mean exists (``d + 2 = 4``; Gelman et al., Bayesian Data
+        Analysis, 3rd ed., section 3.6), its mean the a-priori noise.
     """
 
     acceleration_sigma_m_s2: float = 1.5
@@ -38,3 +42,4 @@ class TrackerParameters:
     clutter_density_per_px2: float = 0.0
     existence_update: Literal["bayes", "fixed"] = "bayes"
     existence_to_report: float = 0.5
+    noise_prior_detections: float = 1.0

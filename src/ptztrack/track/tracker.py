@@ -53,6 +53,7 @@ from ptztrack.geometry.ptz import (
 )
 from ptztrack.roles import ImageSource
 from ptztrack.track import jpdaf, kalman
+from ptztrack.track.adaptive_noise import AdaptiveNoise
 from ptztrack.track.association import assign_gated, associate, gated_innovations
 from ptztrack.track.parameters import TrackerParameters
 from ptztrack.types import Detections, TrackerEvidence, Tracks, TrackUpdate
@@ -362,6 +363,18 @@ def update_own_tracks(
     return updated.select(updated.position_sigma_m <= max_position_sigma_m)
 
 
+def gated_pairs(tracks: Tracks, feet_px, camera: PTZCamera, pose, V, gate_probability: float):
+    """The innovations ``nu = z - h(x-)`` (k, 2) px of the detections ``feet_px`` (K, 2) the Hungarian
+    assignment pairs with the predicted ``tracks`` within the chi-square gate ``gate_probability``, under
+    the noise ``V`` (2, 2) px^2, and those tracks' predicted spreads ``C P- C^T`` (k, 2, 2) px^2."""
+    feet_px = np.asarray(feet_px, dtype=float).reshape(-1, 2)
+    predicted_px, in_front = predicted_feet_px(camera, pose, tracks.mean)
+    C = observation_matrix(camera, pose, tracks.mean)
+    spread_px2 = C @ tracks.covariance @ np.swapaxes(C, -1, -2)
+    track_index, detection_index = associate(predicted_px, in_front, spread_px2 + V, feet_px, gate_probability)
+    return feet_px[detection_index] - predicted_px[track_index], spread_px2[track_index]
+
+
 def tracker_evidence(
     tracks: Tracks, update: TrackUpdate, feet_px, camera: PTZCamera, pose, detectable, parameters: TrackerParameters
 ) -> TrackerEvidence:
@@ -401,6 +414,7 @@ class EkfTracker:
         learns from it, say; None: nobody).
     clutter_per_view : the false detections expected in a view, read every step (a learned model's
         estimate); its density over the image replaces ``parameters.clutter_density_per_px2``.
+    noise : the detections' noise learned from their innovations, in place of ``V`` (None: ``V`` kept).
     """
 
     camera: PTZCamera
@@ -411,6 +425,7 @@ class EkfTracker:
     tracks: Tracks = field(default_factory=Tracks.empty)
     learner: Callable[[TrackerEvidence], None] | None = None
     clutter_per_view: Callable[[], float] | None = None
+    noise: AdaptiveNoise | None = None
 
     def predict(self, dt_s: float | None = None) -> Tracks:
         dt_s = self.step_s if dt_s is None else dt_s
@@ -434,9 +449,14 @@ class EkfTracker:
         if self.clutter_per_view is not None:
             image_area_px2 = self.camera.image_width_px * self.camera.image_height_px
             parameters = replace(parameters, clutter_density_per_px2=self.clutter_per_view() / image_area_px2)
-        V = self.V + pose_noise
+        V = (self.V if self.noise is None else self.noise.covariance()) + pose_noise
+        if self.noise is not None:
+            learned_from = gated_pairs(tracks, detections.feet_px, self.camera, pose, V, self.noise.gate_probability)
         update = update_tracks(tracks, detections.feet_px, self.camera, pose, V, parameters, detectable)
         self.tracks = update.tracks
+        if self.noise is not None:
+            innovation_px, spread_px2 = learned_from
+            self.noise.observe(innovation_px, spread_px2 + pose_noise)
         if self.learner is not None:
             evidence = tracker_evidence(tracks, update, detections.feet_px, self.camera, pose, detectable, parameters)
             self.learner(replace(evidence, excess_px2=evidence.excess_px2 - np.trace(pose_noise)))
