@@ -6,14 +6,22 @@ scene, detector, detector model and streams), first in the network, so that a ne
 step for step, that run. Each other view is a fixed camera backed by its published boxes
 (:class:`ptztrack.detect.published.PublishedDetections`): the virtual camera at its optical centre
 with the scenario's image (160 x 120 px) at the view's field of view, held at the pose that shows
-the recorded view; the scenario's pixel noise, tracker and policy settings; and, as its detector
+the recorded view; the scenario's pixel noise, tracker and policy settings but for two, below; and, as its detector
 model, recall :data:`PUBLISHED_RECALL` for anybody wholly in its image, whatever their size (a curve
-kept, not learned). Boxes scored below the occupancy experiment's threshold for the same files
+kept, not learned); and, in the tracker, the scenario's pixel noise as the scale of a Student-t
+noise of :data:`PUBLISHED_NOISE_DOF` degrees of freedom, and new tracks only from detections in the
+gate of no track. Each view's calibration puts a person's feet on the ground somewhere else than the
+other views do, by an error that is unknown and, now and then, far larger than the pixel noise: under
+Gaussian noise such a detection falls outside the gate of the track the other cameras made certain,
+starts a second track of the same person, and keeps it. A heavy-tailed noise gates it wider and lets it
+move the track less, and a detection another track could explain is not taken for a new person.
+Boxes scored below the occupancy experiment's threshold for the same files
 (:attr:`ptztrack.occupancy.parameters.OccupancyParameters.min_box_score`) are not used. Every camera
 shares the PTZ camera's scene: its people (the annotations, scored) and its walkable area.
 """
 
 from collections.abc import Sequence
+from dataclasses import replace
 from typing import Literal
 
 import numpy as np
@@ -32,9 +40,6 @@ from ptztrack.loop import World, episode_seeds
 from ptztrack.network_loop import NetworkEpisode, NetworkWorld, run_network_loop
 from ptztrack.occupancy.multiview import CameraView
 from ptztrack.occupancy.parameters import OccupancyParameters
-from ptztrack.track.adaptive_noise import AdaptiveNoise
-from ptztrack.track.association import student_t_gate
-from ptztrack.track.tracker import EkfTracker
 
 PUBLISHED_RECALL = 0.9
 """The fixed cameras' detector model: the probability that the published detector finds a person wholly
@@ -43,11 +48,9 @@ every camera). Fixed a priori, before any run on S2.L1: a round figure for a fin
 detector's recall of unoccluded people at its usual score threshold of 0.5; not measured on these files."""
 
 
-NOISE_GATE_DOF = 4.0
-"""The gate a fixed camera learns its pixel noise within: as wide as the association's gate probability under
-Student-t innovations of 4 degrees of freedom, the value Lange, Little & Taylor (JASA 1989, "Robust
-statistical modeling using the t distribution") recommend where it is not estimated; wider than the
-association's own gate, so that innovations the a-priori noise leaves outside it show."""
+PUBLISHED_NOISE_DOF = 4.0
+"""The fixed cameras' feet-pixel noise: Student-t with 4 degrees of freedom, the value Lange, Little & Taylor
+(JASA 1989, "Robust statistical modeling using the t distribution") recommend where it is not estimated."""
 
 
 def published_views(scenario: Scenario) -> tuple[CameraView, ...]:
@@ -107,7 +110,8 @@ def run_pets_network_episode(
 ) -> NetworkEpisode:
     """One closed-loop episode of the PETS network (:func:`pets_network_world`): the PTZ camera's
     information-gain policy ``method`` deciding ``coordination`` with the fixed views' expected
-    information, one belief updated by every camera in turn."""
+    information, one belief updated by every camera in turn (the fixed cameras' trackers as the module's
+    docstring says; the PTZ camera's the one-camera run's)."""
     world = pets_network_world(scenario, seed, ptz, views)
     fixed = [index > 0 or not ptz for index in range(len(world.cameras))]
     policy = policy_of_cameras(
@@ -118,13 +122,5 @@ def run_pets_network_episode(
     tracker = belief_of_cameras([(scenario, camera) for camera in world.cameras])
     for camera, is_fixed in zip(tracker.cameras, fixed, strict=True):
         if is_fixed:
-            camera.noise = learned_noise(camera)
+            camera.parameters = replace(camera.parameters, noise_dof=PUBLISHED_NOISE_DOF, birth="outside_gates")
     return run_network_loop(world, policy, tracker, seed)
-
-
-def learned_noise(tracker: EkfTracker) -> AdaptiveNoise:
-    """A fixed camera's pixel noise, learned from its innovations from the scenario's a-priori noise on (its
-    calibration's error is unknown), within the gate of :data:`NOISE_GATE_DOF`."""
-    parameters = tracker.parameters
-    gate = student_t_gate(parameters.gate_probability, NOISE_GATE_DOF)
-    return AdaptiveNoise(tracker.V, parameters.noise_prior_detections, gate)

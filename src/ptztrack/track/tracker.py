@@ -53,8 +53,7 @@ from ptztrack.geometry.ptz import (
 )
 from ptztrack.roles import ImageSource
 from ptztrack.track import jpdaf, kalman
-from ptztrack.track.adaptive_noise import AdaptiveNoise
-from ptztrack.track.association import assign_gated, associate, gated_innovations
+from ptztrack.track.association import assign_gated, associate, gated_innovations, student_t_gate
 from ptztrack.track.parameters import TrackerParameters
 from ptztrack.types import Detections, TrackerEvidence, Tracks, TrackUpdate
 
@@ -170,7 +169,11 @@ def update_tracks(
     predicted_px, in_front = predicted_feet_px(camera, pose, tracks.mean)
     C = observation_matrix(camera, pose, tracks.mean)
     S = kalman.innovation_covariance(tracks.covariance, C, V)
-    track_index, detection_index = associate(predicted_px, in_front, S, feet_px, parameters.gate_probability)
+    gate = student_t_gate(parameters.gate_probability, parameters.noise_dof)
+    track_index, detection_index = associate(predicted_px, in_front, S, feet_px, gate)
+    innovation_px = feet_px[detection_index] - predicted_px[track_index]
+    if parameters.association == "cjpdaf" and not np.isinf(parameters.noise_dof):
+        raise ValueError("the CJPDAF assumes Gaussian pixel noise (noise_dof inf)")
     if parameters.association == "cjpdaf":
         innovation, distance2, gated = gated_innovations(
             predicted_px, in_front, S, feet_px, parameters.gate_probability
@@ -189,22 +192,23 @@ def update_tracks(
         mean[track_index], covariance[track_index] = kalman.update(
             tracks.mean[track_index],
             tracks.covariance[track_index],
-            feet_px[detection_index] - predicted_px[track_index],
+            innovation_px,
             C[track_index],
-            V,
+            student_t_noise(V, innovation_px, S[track_index], parameters.noise_dof),
         )
         updated_index = track_index
     if detectable is None:
         detectable = (in_front & inside_image(camera, predicted_px)).astype(float)
     likelihood_px2 = np.zeros(len(tracks))
-    likelihood_px2[track_index] = innovation_likelihood(
-        feet_px[detection_index] - predicted_px[track_index], S[track_index]
-    )
+    likelihood_px2[track_index] = innovation_likelihood(innovation_px, S[track_index], parameters.noise_dof)
     survivors, keep = _after_update(tracks, mean, covariance, updated_index, detectable, parameters, likelihood_px2)
     if parameters.association == "cjpdaf":
         unmatched = np.flatnonzero(~gated[keep].any(axis=0))
     else:
         unmatched = np.setdiff1d(np.arange(len(feet_px)), detection_index)
+        if parameters.birth == "outside_gates":
+            _, _, gated = gated_innovations(predicted_px, in_front, S, feet_px, gate)
+            unmatched = np.intersect1d(unmatched, np.flatnonzero(~gated[keep].any(axis=0)))
     _, on_ground = ground_points(feet_px[unmatched], camera, pose)
     starting = unmatched[on_ground]
     born = start_tracks(
@@ -284,14 +288,31 @@ def _with_births(tracks: Tracks, survivors: Tracks, keep, born: Tracks, track_in
     )
 
 
-def innovation_likelihood(innovation, S) -> np.ndarray:
-    """``N(nu; 0, S)`` for innovations (k, d) of covariances (k, d, d), in the inverse units of ``S``'s
-    determinant's square root (1/px^2 for feet pixels); (k,)."""
+def innovation_likelihood(innovation, S, noise_dof: float = np.inf) -> np.ndarray:
+    """The density of innovations (k, d) of covariances (k, d, d), in the inverse units of ``S``'s
+    determinant's square root (1/px^2 for feet pixels); (k,). Gaussian, ``N(nu; 0, S)``, for ``noise_dof``
+    inf; else the Student-t of scale ``S`` (d = 2 only): ``(1 + d2 / nu) ^ -(nu / 2 + 1) / (2 pi sqrt|S|)``,
+    ``d2 = nu^T S^-1 nu``."""
     innovation, S = np.asarray(innovation, dtype=float), np.asarray(S, dtype=float)
     if len(innovation) == 0:
         return np.zeros(0)
     d2 = np.einsum("ki,kij,kj->k", innovation, np.linalg.inv(S), innovation)
-    return np.exp(-0.5 * d2) / np.sqrt(np.linalg.det(2 * np.pi * S))
+    if np.isinf(noise_dof):
+        return np.exp(-0.5 * d2) / np.sqrt(np.linalg.det(2 * np.pi * S))
+    return (1 + d2 / noise_dof) ** -(noise_dof / 2 + 1) / np.sqrt(np.linalg.det(2 * np.pi * S))
+
+
+def student_t_noise(V, innovation, S, noise_dof: float) -> np.ndarray:
+    """The noise each detection updates its track with under Student-t pixel noise of ``noise_dof`` degrees
+    of freedom and scale ``V`` (2, 2) px^2: ``V (nu + d2) / (nu + 2)`` (k, 2, 2), ``d2 = nu^T S^-1 nu`` the
+    squared Mahalanobis distance of its innovation (k, 2) px of covariance ``S`` (k, 2, 2) px^2, the
+    expected precision scale of the variational Student-t filter (Piche, Sarkka & Hartikainen, MLSP 2012)
+    at the predicted state. A detection far from its track updates it less. ``V`` itself for Gaussian
+    noise (``noise_dof`` inf)."""
+    if np.isinf(noise_dof):
+        return V
+    d2 = np.einsum("ki,kij,kj->k", innovation, np.linalg.inv(S), innovation)
+    return V * ((noise_dof + d2) / (noise_dof + 2))[:, None, None]
 
 
 def existence_after_detection(existence, detectable, likelihood, clutter_density, cap: float) -> np.ndarray:
@@ -363,18 +384,6 @@ def update_own_tracks(
     return updated.select(updated.position_sigma_m <= max_position_sigma_m)
 
 
-def gated_pairs(tracks: Tracks, feet_px, camera: PTZCamera, pose, V, gate_probability: float):
-    """The innovations ``nu = z - h(x-)`` (k, 2) px of the detections ``feet_px`` (K, 2) the Hungarian
-    assignment pairs with the predicted ``tracks`` within the chi-square gate ``gate_probability``, under
-    the noise ``V`` (2, 2) px^2, and those tracks' predicted spreads ``C P- C^T`` (k, 2, 2) px^2."""
-    feet_px = np.asarray(feet_px, dtype=float).reshape(-1, 2)
-    predicted_px, in_front = predicted_feet_px(camera, pose, tracks.mean)
-    C = observation_matrix(camera, pose, tracks.mean)
-    spread_px2 = C @ tracks.covariance @ np.swapaxes(C, -1, -2)
-    track_index, detection_index = associate(predicted_px, in_front, spread_px2 + V, feet_px, gate_probability)
-    return feet_px[detection_index] - predicted_px[track_index], spread_px2[track_index]
-
-
 def tracker_evidence(
     tracks: Tracks, update: TrackUpdate, feet_px, camera: PTZCamera, pose, detectable, parameters: TrackerParameters
 ) -> TrackerEvidence:
@@ -414,7 +423,6 @@ class EkfTracker:
         learns from it, say; None: nobody).
     clutter_per_view : the false detections expected in a view, read every step (a learned model's
         estimate); its density over the image replaces ``parameters.clutter_density_per_px2``.
-    noise : the detections' noise learned from their innovations, in place of ``V`` (None: ``V`` kept).
     """
 
     camera: PTZCamera
@@ -425,7 +433,6 @@ class EkfTracker:
     tracks: Tracks = field(default_factory=Tracks.empty)
     learner: Callable[[TrackerEvidence], None] | None = None
     clutter_per_view: Callable[[], float] | None = None
-    noise: AdaptiveNoise | None = None
 
     def predict(self, dt_s: float | None = None) -> Tracks:
         dt_s = self.step_s if dt_s is None else dt_s
@@ -449,14 +456,9 @@ class EkfTracker:
         if self.clutter_per_view is not None:
             image_area_px2 = self.camera.image_width_px * self.camera.image_height_px
             parameters = replace(parameters, clutter_density_per_px2=self.clutter_per_view() / image_area_px2)
-        V = (self.V if self.noise is None else self.noise.covariance()) + pose_noise
-        if self.noise is not None:
-            learned_from = gated_pairs(tracks, detections.feet_px, self.camera, pose, V, self.noise.gate_probability)
+        V = self.V + pose_noise
         update = update_tracks(tracks, detections.feet_px, self.camera, pose, V, parameters, detectable)
         self.tracks = update.tracks
-        if self.noise is not None:
-            innovation_px, spread_px2 = learned_from
-            self.noise.observe(innovation_px, spread_px2 + pose_noise)
         if self.learner is not None:
             evidence = tracker_evidence(tracks, update, detections.feet_px, self.camera, pose, detectable, parameters)
             self.learner(replace(evidence, excess_px2=evidence.excess_px2 - np.trace(pose_noise)))
