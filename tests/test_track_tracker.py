@@ -9,6 +9,7 @@ from ptztrack.track import kalman
 from ptztrack.track.association import student_t_gate
 from ptztrack.track.kalman import constant_velocity_model
 from ptztrack.track.parameters import TrackerParameters
+from ptztrack.track.sensor_bias import PixelBias
 from ptztrack.track.tracker import (
     EkfTracker,
     existence_after_detection,
@@ -282,6 +283,28 @@ def test_a_second_detection_in_a_tracks_gate_starts_a_track_only_when_births_are
     predicted = predict_tracks(tracks, F, U)
     detections = feet_px([[7.5, 6.0], [7.55, 6.0]])
     assert len(update_tracks(predicted, detections, CAMERA, POSE, V, config).tracks) == tracks_after
+
+
+def test_a_camera_with_a_bias_learns_it_from_a_sure_track_and_takes_it_off_its_detections():
+    config = parameters(noise_dof=4.0)
+    tracks, F, U = detected_track(config)
+    tracker = EkfTracker(CAMERA, 0.2, V, config, lambda mean, cov, pose: np.ones(len(mean)), tracks)
+    tracker.bias = PixelBias.centred(V)
+    predicted = tracker.predict()
+    shift = np.array([3.0, -2.0])
+    C = observation_matrix(CAMERA, POSE, predicted.mean)
+    S = kalman.innovation_covariance(predicted.covariance, C, V)[0]
+    innovation = feet_px(predicted.mean[:, :2])[0] + shift - feet_px(predicted.mean[:, :2])[0]
+    weight = 6 / (4 + innovation @ np.linalg.solve(S, innovation))
+    tracker.update(Detections(feet_px([[7.5, 6.0]]) + shift, np.array([80.0]), np.array([-1])), POSE, None)
+    expected = np.linalg.solve(np.linalg.inv(V) + weight * np.linalg.inv(S), weight * np.linalg.solve(S, innovation))
+    np.testing.assert_allclose(tracker.bias.estimate(), expected)
+    # The next detection at the same place is taken as the shifted feet minus that bias.
+    before = tracker.predict()
+    corrected = feet_px([[7.5, 6.0]]) + shift - expected
+    tracker.update(Detections(feet_px([[7.5, 6.0]]) + shift, np.array([80.0]), np.array([-1])), POSE, None)
+    alone = update_tracks(before, corrected, CAMERA, POSE, V, config)
+    np.testing.assert_allclose(tracker.tracks.mean, alone.tracks.mean)
 
 
 def test_a_detection_raises_existence_by_its_likelihood_against_the_clutter():

@@ -6,18 +6,21 @@ scene, detector, detector model and streams), first in the network, so that a ne
 step for step, that run. Each other view is a fixed camera backed by its published boxes
 (:class:`ptztrack.detect.published.PublishedDetections`): the virtual camera at its optical centre
 with the scenario's image (160 x 120 px) at the view's field of view, held at the pose that shows
-the recorded view; the scenario's pixel noise, tracker and policy settings but for two, below; and, as its detector
+the recorded view; the scenario's pixel noise, tracker and policy settings; and, as its detector
 model, recall :data:`PUBLISHED_RECALL` for anybody wholly in its image, whatever their size (a curve
-kept, not learned); and, in the tracker, the scenario's pixel noise as the scale of a Student-t
-noise of :data:`PUBLISHED_NOISE_DOF` degrees of freedom, and new tracks only from detections in the
-gate of no track. Each view's calibration puts a person's feet on the ground somewhere else than the
-other views do, by an error that is unknown and, now and then, far larger than the pixel noise: under
-Gaussian noise such a detection falls outside the gate of the track the other cameras made certain,
-starts a second track of the same person, and keeps it. A heavy-tailed noise gates it wider and lets it
-move the track less, and a detection another track could explain is not taken for a new person.
-Boxes scored below the occupancy experiment's threshold for the same files
+kept, not learned). Boxes scored below the occupancy experiment's threshold for the same files
 (:attr:`ptztrack.occupancy.parameters.OccupancyParameters.min_box_score`) are not used. Every camera
 shares the PTZ camera's scene: its people (the annotations, scored) and its walkable area.
+
+The fixed cameras' tracker differs in three ways. Each view's calibration puts a person's feet on the
+ground somewhere else than the other views do, by an error that is unknown and, now and then, far
+larger than the pixel noise: under Gaussian noise such a detection falls outside the gate of the track
+the other cameras made certain, starts a second track of the same person, and keeps it. So the
+scenario's pixel noise is the scale of a Student-t noise of :data:`PUBLISHED_NOISE_DOF` degrees of
+freedom, which gates a far detection and lets it move its track less; a detection in the gate of a
+track starts no track (``TrackerParameters.birth`` 'outside_gates'); and what part of the error is
+common to a view's detections, its bias, is estimated as the run goes and taken off them
+(:mod:`ptztrack.track.sensor_bias`).
 """
 
 from collections.abc import Sequence
@@ -40,6 +43,7 @@ from ptztrack.loop import World, episode_seeds
 from ptztrack.network_loop import NetworkEpisode, NetworkWorld, run_network_loop
 from ptztrack.occupancy.multiview import CameraView
 from ptztrack.occupancy.parameters import OccupancyParameters
+from ptztrack.track.sensor_bias import PixelBias
 
 PUBLISHED_RECALL = 0.9
 """The fixed cameras' detector model: the probability that the published detector finds a person wholly
@@ -123,4 +127,5 @@ def run_pets_network_episode(
     for camera, is_fixed in zip(tracker.cameras, fixed, strict=True):
         if is_fixed:
             camera.parameters = replace(camera.parameters, noise_dof=PUBLISHED_NOISE_DOF, birth="outside_gates")
+            camera.bias = PixelBias.centred(camera.V)
     return run_network_loop(world, policy, tracker, seed)
