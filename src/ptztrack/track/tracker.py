@@ -297,7 +297,7 @@ def innovation_likelihood(innovation, S, noise_dof: float = np.inf) -> np.ndarra
     innovation, S = np.asarray(innovation, dtype=float), np.asarray(S, dtype=float)
     if len(innovation) == 0:
         return np.zeros(0)
-    d2 = np.einsum("ki,kij,kj->k", innovation, np.linalg.inv(S), innovation)
+    d2 = squared_distances(innovation, S)
     if np.isinf(noise_dof):
         return np.exp(-0.5 * d2) / np.sqrt(np.linalg.det(2 * np.pi * S))
     return (1 + d2 / noise_dof) ** -(noise_dof / 2 + 1) / np.sqrt(np.linalg.det(2 * np.pi * S))
@@ -491,15 +491,16 @@ class EkfTracker:
             image_area_px2 = self.camera.image_width_px * self.camera.image_height_px
             parameters = replace(parameters, clutter_density_per_px2=self.clutter_per_view() / image_area_px2)
         V = self.V + pose_noise
-        bias_px = None if self.bias is None else self.bias.estimate()
-        if bias_px is not None:
+        bias = self.bias
+        if bias is not None:
+            bias_px = bias.estimate()
             detections = replace(detections, feet_px=detections.feet_px - bias_px)
         update = update_tracks(tracks, detections.feet_px, self.camera, pose, V, parameters, detectable)
         self.tracks = update.tracks
-        if self.bias is not None and bias_px is not None:
+        if bias is not None:
             innovation_px, S = paired_innovations(tracks, update, detections.feet_px, self.camera, pose, V)
             weight = student_t_weight(squared_distances(innovation_px, S), parameters.noise_dof)
-            self.bias.observe(innovation_px + bias_px, S, weight)
+            bias.observe(innovation_px + bias_px, S, weight)
         if self.learner is not None:
             evidence = tracker_evidence(tracks, update, detections.feet_px, self.camera, pose, detectable, parameters)
             self.learner(replace(evidence, excess_px2=evidence.excess_px2 - np.trace(pose_noise)))
