@@ -6,8 +6,10 @@ import pytest
 
 from ptztrack.geometry.ptz import PTZCamera, apply_homography, feet_jacobian, ground_to_image, look_at
 from ptztrack.track import kalman
+from ptztrack.track.association import student_t_gate
 from ptztrack.track.kalman import constant_velocity_model
 from ptztrack.track.parameters import TrackerParameters
+from ptztrack.track.sensor_bias import PixelBias
 from ptztrack.track.tracker import (
     EkfTracker,
     existence_after_detection,
@@ -16,6 +18,7 @@ from ptztrack.track.tracker import (
     observation_matrix,
     predict_tracks,
     start_tracks,
+    student_t_noise,
     update_own_tracks,
     update_tracks,
 )
@@ -217,6 +220,91 @@ def test_the_innovation_likelihood_is_the_gaussian_density():
     innovation = np.array([[1.0, -2.0], [3.0, 0.5]])
     expected = [multivariate_normal(np.zeros(2), S[k]).pdf(innovation[k]) for k in range(2)]
     np.testing.assert_allclose(innovation_likelihood(innovation, S), expected, rtol=1e-12)
+
+
+def test_the_student_t_innovation_likelihood_is_scipys_density():
+    from scipy.stats import multivariate_t
+
+    S = np.array([[[4.0, 1.0], [1.0, 3.0]], [[9.0, 0.0], [0.0, 1.0]]])
+    innovation = np.array([[1.0, -2.0], [30.0, 0.5]])
+    expected = [multivariate_t(np.zeros(2), S[k], df=4).pdf(innovation[k]) for k in range(2)]
+    np.testing.assert_allclose(innovation_likelihood(innovation, S, 4.0), expected, rtol=1e-12)
+
+
+def test_the_student_t_gate_holds_its_probability_of_student_t_innovations():
+    from scipy.stats import chi2, multivariate_t
+
+    assert student_t_gate(0.99, math.inf) == 0.99
+    innovation = multivariate_t(np.zeros(2), np.eye(2), df=4).rvs(400_000, random_state=np.random.default_rng(0))
+    inside = np.mean(np.sum(innovation**2, axis=1) <= chi2.ppf(student_t_gate(0.99, 4.0), df=2))
+    assert inside == pytest.approx(0.99, abs=0.001)
+
+
+def test_a_far_detection_updates_by_the_student_t_weight():
+    # d2 = 5^2 for an innovation of 5 sigma along x of S = I: the noise grows by (4 + 25) / (4 + 2).
+    inflated = student_t_noise(V, np.array([[5.0, 0.0]]), np.eye(2)[None], 4.0)
+    np.testing.assert_allclose(inflated, [V * 29 / 6])
+    assert student_t_noise(V, np.array([[5.0, 0.0]]), np.eye(2)[None], math.inf) is V
+
+
+def track_and_far_detection(config):
+    """A sure track at (7.5, 6) and a detection 5 sigma of its innovation away, along the image's rows."""
+    tracks, F, U = detected_track(config)
+    predicted = predict_tracks(tracks, F, U)
+    C = observation_matrix(CAMERA, POSE, predicted.mean)
+    S = kalman.innovation_covariance(predicted.covariance, C, V)[0]
+    return predicted, feet_px([[7.5, 6.0]]) + [5 * np.sqrt(S[0, 0]), 0.0], S
+
+
+def test_student_t_noise_keeps_a_far_detection_on_its_track_and_moves_it_less():
+    gaussian, student = parameters(), parameters(noise_dof=4.0)
+    predicted, far, _ = track_and_far_detection(gaussian)
+    # Gaussian noise: 5 sigma is outside the gate, so the detection starts a track of its own (and the
+    # sure track, missed where it was surely detectable, goes).
+    assert 0 not in update_tracks(predicted, far, CAMERA, POSE, V, gaussian).tracks.ids
+    predicted, far, S = track_and_far_detection(student)
+    updated = update_tracks(predicted, far, CAMERA, POSE, V, student).tracks
+    np.testing.assert_array_equal(updated.ids, [0])
+    C = observation_matrix(CAMERA, POSE, predicted.mean)
+    innovation = far - feet_px(predicted.mean[:, :2])
+    d2 = innovation[0] @ np.linalg.solve(S, innovation[0])
+    expected, _ = kalman.update(predicted.mean, predicted.covariance, innovation, C, V * (4 + d2) / 6)
+    np.testing.assert_allclose(updated.mean, expected)
+    moved_gaussian, _ = kalman.update(predicted.mean, predicted.covariance, innovation, C, V)
+    assert np.linalg.norm(updated.mean[0, :2] - predicted.mean[0, :2]) < np.linalg.norm(
+        moved_gaussian[0, :2] - predicted.mean[0, :2]
+    )
+
+
+@pytest.mark.parametrize("birth, tracks_after", [("unassigned", 2), ("outside_gates", 1)])
+def test_a_second_detection_in_a_tracks_gate_starts_a_track_only_when_births_are_unassigned(birth, tracks_after):
+    config = parameters(birth=birth)
+    tracks, F, U = detected_track(config)
+    predicted = predict_tracks(tracks, F, U)
+    detections = feet_px([[7.5, 6.0], [7.55, 6.0]])
+    assert len(update_tracks(predicted, detections, CAMERA, POSE, V, config).tracks) == tracks_after
+
+
+def test_a_camera_with_a_bias_learns_it_from_a_sure_track_and_takes_it_off_its_detections():
+    config = parameters(noise_dof=4.0)
+    tracks, F, U = detected_track(config)
+    tracker = EkfTracker(CAMERA, 0.2, V, config, lambda mean, cov, pose: np.ones(len(mean)), tracks)
+    tracker.bias = PixelBias.centred(V)
+    predicted = tracker.predict()
+    shift = np.array([3.0, -2.0])
+    C = observation_matrix(CAMERA, POSE, predicted.mean)
+    S = kalman.innovation_covariance(predicted.covariance, C, V)[0]
+    innovation = feet_px(predicted.mean[:, :2])[0] + shift - feet_px(predicted.mean[:, :2])[0]
+    weight = 6 / (4 + innovation @ np.linalg.solve(S, innovation))
+    tracker.update(Detections(feet_px([[7.5, 6.0]]) + shift, np.array([80.0]), np.array([-1])), POSE, None)
+    expected = np.linalg.solve(np.linalg.inv(V) + weight * np.linalg.inv(S), weight * np.linalg.solve(S, innovation))
+    np.testing.assert_allclose(tracker.bias.estimate(), expected)
+    # The next detection at the same place is taken as the shifted feet minus that bias.
+    before = tracker.predict()
+    corrected = feet_px([[7.5, 6.0]]) + shift - expected
+    tracker.update(Detections(feet_px([[7.5, 6.0]]) + shift, np.array([80.0]), np.array([-1])), POSE, None)
+    alone = update_tracks(before, corrected, CAMERA, POSE, V, config)
+    np.testing.assert_allclose(tracker.tracks.mean, alone.tracks.mean)
 
 
 def test_a_detection_raises_existence_by_its_likelihood_against_the_clutter():

@@ -11,9 +11,20 @@ model, recall :data:`PUBLISHED_RECALL` for anybody wholly in its image, whatever
 kept, not learned). Boxes scored below the occupancy experiment's threshold for the same files
 (:attr:`ptztrack.occupancy.parameters.OccupancyParameters.min_box_score`) are not used. Every camera
 shares the PTZ camera's scene: its people (the annotations, scored) and its walkable area.
+
+The fixed cameras' tracker differs in three ways. Each view's calibration puts a person's feet on the
+ground somewhere else than the other views do, by an error that is unknown and, now and then, far
+larger than the pixel noise: under Gaussian noise such a detection falls outside the gate of the track
+the other cameras made certain, starts a second track of the same person, and keeps it. So the
+scenario's pixel noise is the scale of a Student-t noise of :data:`PUBLISHED_NOISE_DOF` degrees of
+freedom, which gates a far detection and lets it move its track less; a detection in the gate of a
+track starts no track (``TrackerParameters.birth`` 'outside_gates'); and what part of the error is
+common to a view's detections, its bias, is estimated as the run goes and taken off them
+(:mod:`ptztrack.track.sensor_bias`).
 """
 
 from collections.abc import Sequence
+from dataclasses import replace
 from typing import Literal
 
 import numpy as np
@@ -32,12 +43,18 @@ from ptztrack.loop import World, episode_seeds
 from ptztrack.network_loop import NetworkEpisode, NetworkWorld, run_network_loop
 from ptztrack.occupancy.multiview import CameraView
 from ptztrack.occupancy.parameters import OccupancyParameters
+from ptztrack.track.sensor_bias import PixelBias
 
 PUBLISHED_RECALL = 0.9
 """The fixed cameras' detector model: the probability that the published detector finds a person wholly
 in the view's image, at any size (people hidden by other tracks count as missed in proportion, as for
 every camera). Fixed a priori, before any run on S2.L1: a round figure for a fine-tuned R-CNN person
 detector's recall of unoccluded people at its usual score threshold of 0.5; not measured on these files."""
+
+
+PUBLISHED_NOISE_DOF = 4.0
+"""The fixed cameras' feet-pixel noise: Student-t with 4 degrees of freedom, the value Lange, Little & Taylor
+(JASA 1989, "Robust statistical modeling using the t distribution") recommend where it is not estimated."""
 
 
 def published_views(scenario: Scenario) -> tuple[CameraView, ...]:
@@ -97,7 +114,8 @@ def run_pets_network_episode(
 ) -> NetworkEpisode:
     """One closed-loop episode of the PETS network (:func:`pets_network_world`): the PTZ camera's
     information-gain policy ``method`` deciding ``coordination`` with the fixed views' expected
-    information, one belief updated by every camera in turn."""
+    information, one belief updated by every camera in turn (the fixed cameras' trackers as the module's
+    docstring says; the PTZ camera's the one-camera run's)."""
     world = pets_network_world(scenario, seed, ptz, views)
     fixed = [index > 0 or not ptz for index in range(len(world.cameras))]
     policy = policy_of_cameras(
@@ -106,4 +124,8 @@ def run_pets_network_episode(
         method,
     )
     tracker = belief_of_cameras([(scenario, camera) for camera in world.cameras])
+    for camera, is_fixed in zip(tracker.cameras, fixed, strict=True):
+        if is_fixed:
+            camera.parameters = replace(camera.parameters, noise_dof=PUBLISHED_NOISE_DOF, birth="outside_gates")
+            camera.bias = PixelBias.centred(camera.V)
     return run_network_loop(world, policy, tracker, seed)

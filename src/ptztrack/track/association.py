@@ -1,9 +1,11 @@
 """Association of measurements with tracks: the chi-square gate on squared Mahalanobis distances and the
 Hungarian assignment among the gated pairs (the tracker's default; :mod:`ptztrack.track.jpdaf` is the other)."""
 
+import math
+
 import numpy as np
 from scipy.optimize import linear_sum_assignment
-from scipy.stats import chi2
+from scipy.stats import chi2, f
 
 
 def gated_innovations(predicted_px, in_front, S, feet_px, gate_probability: float):
@@ -44,3 +46,13 @@ def assign_gated(distance2, allowed, gate_probability: float) -> tuple[np.ndarra
     rows, cols = linear_sum_assignment(cost)
     keep = allowed[rows, cols]
     return rows[keep], cols[keep]
+
+
+def student_t_gate(gate_probability: float, noise_dof: float) -> float:
+    """The chi-square gate probability (2 degrees of freedom) whose threshold holds ``gate_probability`` of a
+    bivariate Student-t innovation of ``noise_dof`` degrees of freedom: its squared Mahalanobis distance
+    ``d2`` has ``d2 / 2 ~ F(2, noise_dof)``, so the threshold is ``2 F^-1(gate_probability; 2, noise_dof)``;
+    ``gate_probability`` itself for Gaussian noise (``noise_dof`` inf)."""
+    if math.isinf(noise_dof):
+        return gate_probability
+    return float(chi2.cdf(2 * f.ppf(gate_probability, 2, noise_dof), df=2))

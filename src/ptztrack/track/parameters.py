@@ -1,6 +1,7 @@
 """The ground-plane tracker's parameters and their defaults, in a module of plain data that the
 configuration maps onto (:mod:`ptztrack.config` takes its defaults from here)."""
 
+import math
 from dataclasses import dataclass
 from typing import Literal
 
@@ -23,6 +24,12 @@ class TrackerParameters:
         reports no false positives.
     existence_update : 'bayes' (see :mod:`ptztrack.track.tracker`) or 'fixed'; existence_to_report :
         the existence from which a track is reported.
+    noise_dof : the feet-pixel noise's degrees of freedom: inf for Gaussian noise, finite for Student-t
+        noise of scale ``V``, whose gate is wider and whose far detections update less
+        (:func:`ptztrack.track.tracker.student_t_noise`).
+    birth : which detections the Hungarian association starts tracks from: 'unassigned' (every detection
+        assigned to no track) or 'outside_gates' (only those in the gate of no surviving track, as the
+        CJPDAF does: a detection another track could explain is not taken for a new person).
     """
 
     acceleration_sigma_m_s2: float = 1.5
@@ -38,3 +45,5 @@ class TrackerParameters:
     clutter_density_per_px2: float = 0.0
     existence_update: Literal["bayes", "fixed"] = "bayes"
     existence_to_report: float = 0.5
+    noise_dof: float = math.inf
+    birth: Literal["unassigned", "outside_gates"] = "unassigned"

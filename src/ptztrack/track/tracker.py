@@ -53,8 +53,9 @@ from ptztrack.geometry.ptz import (
 )
 from ptztrack.roles import ImageSource
 from ptztrack.track import jpdaf, kalman
-from ptztrack.track.association import assign_gated, associate, gated_innovations
+from ptztrack.track.association import assign_gated, associate, gated_innovations, student_t_gate
 from ptztrack.track.parameters import TrackerParameters
+from ptztrack.track.sensor_bias import PixelBias
 from ptztrack.types import Detections, TrackerEvidence, Tracks, TrackUpdate
 
 # Feet are found on a pixel grid: the tracker trusts them to half a pixel at
@@ -169,7 +170,11 @@ def update_tracks(
     predicted_px, in_front = predicted_feet_px(camera, pose, tracks.mean)
     C = observation_matrix(camera, pose, tracks.mean)
     S = kalman.innovation_covariance(tracks.covariance, C, V)
-    track_index, detection_index = associate(predicted_px, in_front, S, feet_px, parameters.gate_probability)
+    gate = student_t_gate(parameters.gate_probability, parameters.noise_dof)
+    track_index, detection_index = associate(predicted_px, in_front, S, feet_px, gate)
+    innovation_px = feet_px[detection_index] - predicted_px[track_index]
+    if parameters.association == "cjpdaf" and not np.isinf(parameters.noise_dof):
+        raise ValueError("the CJPDAF assumes Gaussian pixel noise (noise_dof inf)")
     if parameters.association == "cjpdaf":
         innovation, distance2, gated = gated_innovations(
             predicted_px, in_front, S, feet_px, parameters.gate_probability
@@ -188,22 +193,23 @@ def update_tracks(
         mean[track_index], covariance[track_index] = kalman.update(
             tracks.mean[track_index],
             tracks.covariance[track_index],
-            feet_px[detection_index] - predicted_px[track_index],
+            innovation_px,
             C[track_index],
-            V,
+            student_t_noise(V, innovation_px, S[track_index], parameters.noise_dof),
         )
         updated_index = track_index
     if detectable is None:
         detectable = (in_front & inside_image(camera, predicted_px)).astype(float)
     likelihood_px2 = np.zeros(len(tracks))
-    likelihood_px2[track_index] = innovation_likelihood(
-        feet_px[detection_index] - predicted_px[track_index], S[track_index]
-    )
+    likelihood_px2[track_index] = innovation_likelihood(innovation_px, S[track_index], parameters.noise_dof)
     survivors, keep = _after_update(tracks, mean, covariance, updated_index, detectable, parameters, likelihood_px2)
     if parameters.association == "cjpdaf":
         unmatched = np.flatnonzero(~gated[keep].any(axis=0))
     else:
         unmatched = np.setdiff1d(np.arange(len(feet_px)), detection_index)
+        if parameters.birth == "outside_gates":
+            _, _, gated = gated_innovations(predicted_px, in_front, S, feet_px, gate)
+            unmatched = np.intersect1d(unmatched, np.flatnonzero(~gated[keep].any(axis=0)))
     _, on_ground = ground_points(feet_px[unmatched], camera, pose)
     starting = unmatched[on_ground]
     born = start_tracks(
@@ -283,14 +289,61 @@ def _with_births(tracks: Tracks, survivors: Tracks, keep, born: Tracks, track_in
     )
 
 
-def innovation_likelihood(innovation, S) -> np.ndarray:
-    """``N(nu; 0, S)`` for innovations (k, d) of covariances (k, d, d), in the inverse units of ``S``'s
-    determinant's square root (1/px^2 for feet pixels); (k,)."""
+def innovation_likelihood(innovation, S, noise_dof: float = np.inf) -> np.ndarray:
+    """The density of innovations (k, d) of covariances (k, d, d), in the inverse units of ``S``'s
+    determinant's square root (1/px^2 for feet pixels); (k,). Gaussian, ``N(nu; 0, S)``, for ``noise_dof``
+    inf; else the Student-t of scale ``S`` (d = 2 only): ``(1 + d2 / nu) ^ -(nu / 2 + 1) / (2 pi sqrt|S|)``,
+    ``d2 = nu^T S^-1 nu``."""
     innovation, S = np.asarray(innovation, dtype=float), np.asarray(S, dtype=float)
     if len(innovation) == 0:
         return np.zeros(0)
-    d2 = np.einsum("ki,kij,kj->k", innovation, np.linalg.inv(S), innovation)
-    return np.exp(-0.5 * d2) / np.sqrt(np.linalg.det(2 * np.pi * S))
+    d2 = squared_distances(innovation, S)
+    if np.isinf(noise_dof):
+        return np.exp(-0.5 * d2) / np.sqrt(np.linalg.det(2 * np.pi * S))
+    return (1 + d2 / noise_dof) ** -(noise_dof / 2 + 1) / np.sqrt(np.linalg.det(2 * np.pi * S))
+
+
+def student_t_weight(d2, noise_dof: float) -> np.ndarray:
+    """``w = (nu + 2) / (nu + d2)`` (k,): the expected precision scale of a detection whose innovation has
+    the squared Mahalanobis distance ``d2`` (k,) under bivariate Student-t noise of ``noise_dof`` degrees of
+    freedom (the variational Student-t filter's, Piche, Sarkka & Hartikainen, MLSP 2012, at the predicted
+    state); 1 for Gaussian noise (``noise_dof`` inf)."""
+    d2 = np.asarray(d2, dtype=float)
+    if np.isinf(noise_dof):
+        return np.ones_like(d2)
+    return (noise_dof + 2) / (noise_dof + d2)
+
+
+def squared_distances(innovation, S) -> np.ndarray:
+    """``d2 = nu^T S^-1 nu`` (k,) of innovations (k, 2) of covariances (k, 2, 2)."""
+    return np.einsum("ki,kij,kj->k", innovation, np.linalg.inv(S), innovation)
+
+
+def student_t_noise(V, innovation, S, noise_dof: float) -> np.ndarray:
+    """The noise each detection updates its track with under Student-t pixel noise of ``noise_dof`` degrees
+    of freedom and scale ``V`` (2, 2) px^2: ``V / w`` (k, 2, 2), ``w`` the :func:`student_t_weight` of its
+    innovation (k, 2) px of covariance ``S`` (k, 2, 2) px^2. A detection far from its track updates it less.
+    ``V`` itself for Gaussian noise (``noise_dof`` inf)."""
+    if np.isinf(noise_dof):
+        return V
+    return V / student_t_weight(squared_distances(innovation, S), noise_dof)[:, None, None]
+
+
+def paired_innovations(tracks: Tracks, update: TrackUpdate, feet_px, camera: PTZCamera, pose, V):
+    """The innovations ``z - h(x-)`` (k, 2) px of the detections ``feet_px`` (K, 2) that ``update`` paired
+    with the predicted ``tracks`` (new tracks left out), and their covariances ``S`` (k, 2, 2) px^2 under
+    the noise ``V`` (2, 2) px^2."""
+    index_of_id = {track_id: index for index, track_id in enumerate(tracks.ids.tolist())}
+    pairs = [
+        (index_of_id[track_id], measurement)
+        for track_id, measurement in zip(update.track_ids.tolist(), update.measurement_index.tolist(), strict=True)
+        if track_id in index_of_id
+    ]
+    index, measurement = np.array(pairs, dtype=int).reshape(-1, 2).T
+    predicted_px, _ = predicted_feet_px(camera, pose, tracks.mean[index])
+    C = observation_matrix(camera, pose, tracks.mean[index])
+    feet_px = np.asarray(feet_px, dtype=float).reshape(-1, 2)
+    return feet_px[measurement] - predicted_px, kalman.innovation_covariance(tracks.covariance[index], C, V)
 
 
 def existence_after_detection(existence, detectable, likelihood, clutter_density, cap: float) -> np.ndarray:
@@ -401,6 +454,8 @@ class EkfTracker:
         learns from it, say; None: nobody).
     clutter_per_view : the false detections expected in a view, read every step (a learned model's
         estimate); its density over the image replaces ``parameters.clutter_density_per_px2``.
+    bias : the camera's feet-pixel bias, estimated from the innovations as the run goes and taken off its
+        detections (:mod:`ptztrack.track.sensor_bias`; None: none).
     """
 
     camera: PTZCamera
@@ -411,6 +466,7 @@ class EkfTracker:
     tracks: Tracks = field(default_factory=Tracks.empty)
     learner: Callable[[TrackerEvidence], None] | None = None
     clutter_per_view: Callable[[], float] | None = None
+    bias: PixelBias | None = None
 
     def predict(self, dt_s: float | None = None) -> Tracks:
         dt_s = self.step_s if dt_s is None else dt_s
@@ -435,8 +491,16 @@ class EkfTracker:
             image_area_px2 = self.camera.image_width_px * self.camera.image_height_px
             parameters = replace(parameters, clutter_density_per_px2=self.clutter_per_view() / image_area_px2)
         V = self.V + pose_noise
+        bias = self.bias
+        if bias is not None:
+            bias_px = bias.estimate()
+            detections = replace(detections, feet_px=detections.feet_px - bias_px)
         update = update_tracks(tracks, detections.feet_px, self.camera, pose, V, parameters, detectable)
         self.tracks = update.tracks
+        if bias is not None:
+            innovation_px, S = paired_innovations(tracks, update, detections.feet_px, self.camera, pose, V)
+            weight = student_t_weight(squared_distances(innovation_px, S), parameters.noise_dof)
+            bias.observe(innovation_px + bias_px, S, weight)
         if self.learner is not None:
             evidence = tracker_evidence(tracks, update, detections.feet_px, self.camera, pose, detectable, parameters)
             self.learner(replace(evidence, excess_px2=evidence.excess_px2 - np.trace(pose_noise)))
