@@ -342,6 +342,16 @@ def cases(scratch: Path | None) -> list[Case]:
         _recording("calibration binary", "--calibration", "c.xml", b"\x00\xff" * 50),
         _dataset("dataset: a good one", exit_status=0),
         Case("dataset missing", ("experiment", "occupancy", "{dir}/missing.yaml")),
+        Case(
+            "occupancy --lead-in on the room",
+            ("experiment", "occupancy", "synthetic-room", "--lead-in", "5"),
+            says=("--lead-in", "synthetic-plaza only"),
+        ),
+        Case(
+            "occupancy --lead-in negative",
+            ("experiment", "occupancy", "synthetic-plaza", "--lead-in", "-1"),
+            says=("--lead-in",),
+        ),
         Case("dataset a list", ("experiment", "occupancy", "{dir}/d.yaml"), {"d.yaml": "- 1\n- 2\n"}),
         _dataset("dataset duplicate keys", top="frame_rate_hz: 15\n"),
         _dataset("dataset frames 1e9", top="frames: 1000000000\n"),

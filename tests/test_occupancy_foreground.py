@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 from scipy.spatial.distance import pdist
 
-from ptztrack.builders.occupancy import room_recording
-from ptztrack.occupancy.detectors import LpomForegroundDetector, lpom_parameters
+from ptztrack.builders.occupancy import ROOM_AREA_M, rendered_recording, room_recording
+from ptztrack.occupancy.detectors import ClusteringDetector, LpomForegroundDetector, lpom_parameters
 from ptztrack.occupancy.foreground import ViewForeground, clean_silhouettes, silhouette_edges, view_foregrounds
 from ptztrack.occupancy.parameters import ForegroundParameters, OccupancyParameters
 from ptztrack.occupancy.render import draw_people
@@ -140,6 +140,25 @@ def test_a_lead_in_is_learned_before_the_first_frame_and_frame_0_has_silhouettes
         np.testing.assert_array_equal(with_lead_in.silhouettes(frame), without.silhouettes(frame + lead_in))
     assert with_lead_in.silhouettes(0).sum() > 100
     assert not ViewForeground(from_the_lead_in, ForegroundParameters()).silhouettes(0).any()
+
+
+def test_the_baselines_blob_boxes_learn_the_lead_in_as_well():
+    """The baseline's frame 0 after a lead-in of L frames is what its frame L is without one."""
+    layout = RoomLayout(image_size_px=(256, 192), focal_px=125.0)
+    renderer = RoomRenderer(layout, room_truth(layout, 3, 30, 1), 1)
+    names = [f"camera_{index + 1}" for index in range(len(renderer.cameras))]
+    lead_in = 20
+    with_lead_in = rendered_recording("room", names, renderer, ROOM_AREA_M, 15.0, lead_in)
+    without = rendered_recording("room", names, renderer, ROOM_AREA_M, 15.0)
+    learned = ClusteringDetector(with_lead_in, 1.0, 0.5, 100)
+    fresh = ClusteringDetector(without, 1.0, 0.5, 100)
+    for frame in range(lead_in):
+        fresh.detect(frame)
+    for frame in range(3):
+        expected, found = fresh.detect(frame + lead_in), learned.detect(frame)
+        np.testing.assert_array_equal(found.position_m, expected.position_m)
+        np.testing.assert_array_equal(found.views, expected.views)
+    assert len(expected.position_m) >= 1
 
 
 def test_lpom_from_the_silhouettes_finds_the_rooms_people_within_a_quarter_metre():

@@ -477,19 +477,19 @@ def plaza_renderer(people: int, frames: int, seed: int) -> SceneRenderer:
     return SceneRenderer(cameras, sizes_px, plaza_stage(layout, cameras), truth, seed)
 
 
-def plaza_recording(people: int, frames: int, seed: int) -> MultiViewRecording:
+def plaza_recording(
+    people: int, frames: int, seed: int, lead_in_frames: int = PLAZA_LEAD_IN_FRAMES
+) -> MultiViewRecording:
     """The synthetic plaza with ``people`` walking for ``frames`` frames at PETS's frame rate over its
     area, rendered on demand (:func:`plaza_renderer`); every view has frames and no detector's boxes.
 
-    The walk starts :data:`PLAZA_LEAD_IN_FRAMES` frames before the first frame: the recording's lead-in,
-    which the background models learn and nothing scores (a fixed camera has watched its scene before
-    any frame a table counts)."""
+    The walk starts ``lead_in_frames`` frames before the first frame: the recording's lead-in, which the
+    background models learn and nothing scores (a fixed camera has watched its scene before any frame a
+    table counts)."""
     layout = plaza_layout()
     names = [view.name for view in pets_dataset().views]
-    renderer = plaza_renderer(people, PLAZA_LEAD_IN_FRAMES + frames, seed)
-    return rendered_recording(
-        f"plaza-{people}", names, renderer, layout.area_m, layout.frame_rate_hz, PLAZA_LEAD_IN_FRAMES
-    )
+    renderer = plaza_renderer(people, lead_in_frames + frames, seed)
+    return rendered_recording(f"plaza-{people}", names, renderer, layout.area_m, layout.frame_rate_hz, lead_in_frames)
 
 
 def rendered_recording(

@@ -297,6 +297,13 @@ def _add_occupancy_parser(experiments) -> None:
         "--seed", type=_non_negative_int, default=0, help="synthetic-room, synthetic-plaza: draws people and textures"
     )
     occupancy.add_argument(
+        "--lead-in",
+        type=_occupancy_lead_in,
+        metavar="FRAMES",
+        help="synthetic-plaza: frames rendered before the first, which only the background models learn "
+        "(default: half the background model's history, after which it learns at its steady rate)",
+    )
+    occupancy.add_argument(
         "--methods",
         nargs="*",
         choices=OCCUPANCY_MAP_METHODS,
@@ -427,6 +434,13 @@ def _occupancy_frames(text: str) -> int:
         raise argparse.ArgumentTypeError(
             f"must be at most {MAX_FRAMES} (memory: every frame's map and modes are kept; got {value})"
         )
+    return value
+
+
+def _occupancy_lead_in(text: str) -> int:
+    value = _non_negative_int(text)
+    if value > MAX_FRAMES:
+        raise argparse.ArgumentTypeError(f"must be at most {MAX_FRAMES} (frames rendered and learned; got {value})")
     return value
 
 

@@ -3,20 +3,24 @@ against clustering."""
 
 import argparse
 
+from ptztrack.builders.occupancy import PLAZA_LEAD_IN_FRAMES
 from ptztrack.config import load_dataset, pets_dataset
 from ptztrack.evaluate.executors import Progress
 from ptztrack.experiments.occupancy import dataset_runs, format_occupancy_table, plaza_runs, room_runs
-from ptztrack.files import run_folder, write_json
+from ptztrack.files import InputError, run_folder, write_json
 from ptztrack.names import PLAZA_FRAMES, ROOM_FRAMES
 from ptztrack.occupancy.output import write_occupancy_outputs
 
 
 def occupancy_experiment_command(args: argparse.Namespace) -> int:
+    if args.lead_in is not None and args.dataset != "synthetic-plaza":
+        raise InputError(f"experiment occupancy {args.dataset}: --lead-in is an option of synthetic-plaza only")
     with Progress("frame", args.quiet) as progress:
         if args.dataset == "synthetic-room":
             runs = room_runs(args.frames or ROOM_FRAMES, args.seed, progress, args.methods)
         elif args.dataset == "synthetic-plaza":
-            runs = plaza_runs(args.frames or PLAZA_FRAMES, args.seed, progress, args.methods)
+            lead_in = PLAZA_LEAD_IN_FRAMES if args.lead_in is None else args.lead_in
+            runs = plaza_runs(args.frames or PLAZA_FRAMES, args.seed, progress, args.methods, lead_in)
         else:
             dataset = pets_dataset() if args.dataset == "pets" else load_dataset(args.dataset)
             runs = dataset_runs(dataset, args.frames, progress, args.methods)

@@ -12,6 +12,7 @@ import math
 from collections.abc import Callable, Sequence
 
 from ptztrack.builders.occupancy import (
+    PLAZA_LEAD_IN_FRAMES,
     plaza_recording,
     recording_from_dataset,
     refuse_if_map_too_large,
@@ -123,14 +124,19 @@ def room_runs(
 
 
 def plaza_runs(
-    frames: int, seed: int, progress=None, methods: Sequence[str] = OCCUPANCY_MAP_METHODS
+    frames: int,
+    seed: int,
+    progress=None,
+    methods: Sequence[str] = OCCUPANCY_MAP_METHODS,
+    lead_in_frames: int = PLAZA_LEAD_IN_FRAMES,
 ) -> list[OccupancyRun]:
-    """The synthetic plaza with 4 and with 8 people (seeds ``seed`` and ``seed + 1``), with the built-in
-    PETS dataset's parameters (its cells and kernel, its tracker), so that its rows compare with PETS's."""
+    """The synthetic plaza with 4 and with 8 people (seeds ``seed`` and ``seed + 1``), each after
+    ``lead_in_frames`` (:func:`~ptztrack.builders.occupancy.plaza_recording`), with the built-in PETS
+    dataset's parameters (its cells and kernel, its tracker), so that its rows compare with PETS's."""
     pets = pets_dataset()
     return [
         run_recording(
-            plaza_recording(people, frames, seed + index),
+            plaza_recording(people, frames, seed + index, lead_in_frames),
             pets.occupancy,
             pets.tracker,
             {"people": people},

@@ -70,6 +70,10 @@ class BlobBoxes:
         self.subtractor = cv2.createBackgroundSubtractorMOG2(detectShadows=False)
         self.min_area_px = min_area_px
 
+    def learn(self, image_bgr) -> None:
+        """Learn a frame (height, width, 3) uint8 BGR into the background without finding its boxes."""
+        self.subtractor.apply(image_bgr)
+
     def boxes(self, image_bgr) -> np.ndarray:
         """(K, 5) boxes (left, top, width, height, score 1) of the moving regions of the next frame."""
         foreground = self.subtractor.apply(image_bgr)

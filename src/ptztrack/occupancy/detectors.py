@@ -185,7 +185,8 @@ class ClusteringDetector:
     """The baseline's clusters for each frame of ``recording``, in order (``detect(frame)``).
 
     linkage_m : the clustering's cut; min_box_score : as LPOM's; blob_min_area_px : the blob
-    boxes' smallest region, for views without a detector's boxes.
+    boxes' smallest region, for views without a detector's boxes. The blob boxes' background models
+    learn the recording's lead-in frames on construction, as the other methods' do before frame 0.
     """
 
     def __init__(self, recording: MultiViewRecording, linkage_m: float, min_box_score: float, blob_min_area_px: int):
@@ -193,6 +194,11 @@ class ClusteringDetector:
         self.blobs = {
             index: BlobBoxes(blob_min_area_px) for index, view in enumerate(recording.views) if view.boxes is None
         }
+        for index, blobs in self.blobs.items():
+            frames = recording.views[index].frames
+            assert frames is not None
+            for frame in range(-recording.lead_in_frames, 0):
+                blobs.learn(frames(frame))
 
     def detect(self, frame: int) -> Clusters:
         ground, views = [], []
