@@ -7,10 +7,13 @@ second half, each half is scored with the threshold that gives the best
 MODA on the other half (two-fold cross-validation; a recording too short to
 split is scored with the threshold fitted on itself, and the rows say so).
 LPOM's threshold is a mode's strength (its value over the frame's largest);
-the baseline's is the number of views that must support a cluster. POM has
-a second parameter fitted the same way, its prior (:func:`fitted_prior`):
-each half is detected with the prior of the other half's people, and scored
-with the threshold fitted on the other half detected with that same prior.
+the baseline's is the number of views that must support a cluster. POM's
+threshold is fitted together with the radius over which its weaker
+candidates merge into stronger ones and the views a candidate's cell needs
+(:func:`merged_scores`, :func:`fitted_variant_selection`); and its prior
+(:func:`fitted_prior`) is fitted too: each half is detected with the prior
+of the other half's people, and scored with the settings fitted on the
+other half detected with that same prior.
 
 Detection is scored as in the multi-view detection literature (MVDet,
 WILDTRACK): per frame, detections and people are matched one to one by the
