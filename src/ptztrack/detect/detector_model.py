@@ -23,6 +23,17 @@ over a fixed grid that holds the prior curve's own parameters, so that with
 no evidence the model is the prior. Each bin's Beta posterior gives the
 reported recall and its standard deviation. The tracker reads this mode.
 
+A prior that does not depend on the height (``RecallModel.perfect``: a
+constant recall ``P``, say a fixed camera given a published detector's
+boxes) keeps to constants: the fitted recall is the mode of the same binned
+likelihood over every constant, ``P = sum_b s_b / sum_b (s_b + f_b)``, the
+pooled share of successes, and it stays height-independent. The curve is not
+learned there: a constant is not in its family (it is the limit Kd -> inf,
+r0 = 0), and a fixed camera sees each place at one height only, so the bins'
+recall would confound the height with the place (scene objects, the view's
+edges, the calibration's error with range), which a PTZ camera, zooming,
+tells apart.
+
 The policies plan with a draw instead (Thompson sampling): after every
 step, one recall per bin from its Beta posterior, with Jeffreys' half a
 success and half a failure added so that no bin is ever certain, and the
@@ -126,7 +137,8 @@ class OnlineDetectorModel:
             self.prior_successes = PRIOR_TRIALS_PER_BIN * p0
         self.successes = np.zeros(len(self.centres_px))
         self.trials = np.zeros(len(self.centres_px))
-        self._parameters, self._log_recall, self._log_miss = _curve_grid(self.prior, self.centres_px)
+        if not self.prior.perfect:
+            self._parameters, self._log_recall, self._log_miss = _curve_grid(self.prior, self.centres_px)
         self.curve = self.prior
         self._refit()
         self._draw()
@@ -153,7 +165,7 @@ class OnlineDetectorModel:
 
     def observe(self, evidence: TrackerEvidence) -> None:
         """Add one tracker step's evidence (see the module's docstring) and refit the curve."""
-        if not self.learning or self.prior.perfect:
+        if not self.learning:
             return
         self.views += 1
         self.false_births += evidence.false_births
@@ -194,20 +206,21 @@ class OnlineDetectorModel:
         return index, people.height_px[index], evidence.existence[index] * (1.0 - hidden[index])
 
     def _refit(self) -> None:
-        if self.prior.perfect:
-            return
         successes = self.prior_successes + self.successes
         self.curve = self._fitted(successes, self.prior_trials + self.trials - successes)
 
     def _fitted(self, successes, failures) -> RecallModel:
-        """The grid's curve of highest binned likelihood for these counts (B,) each."""
+        """The grid's curve of highest binned likelihood for these counts (B,) each; for a height-independent
+        prior, the constant of highest likelihood, ``sum(successes) / sum(successes + failures)``."""
+        if self.prior.perfect:
+            return RecallModel.constant(float(np.sum(successes) / (np.sum(successes) + np.sum(failures))))
         score = self._log_recall @ successes + self._log_miss @ failures
         kd, r0, plateau = self._parameters[int(np.argmax(score))]
         return RecallModel(float(kd), float(r0), plateau=float(plateau))
 
     def _draw(self) -> None:
         """A new planning curve from the posterior (see the module's docstring); the mode's when not learning."""
-        if not self.learning or self.prior.perfect:
+        if not self.learning:
             self.planning_curve = self.curve
             return
         successes = self.prior_successes + self.successes + 0.5
@@ -250,7 +263,12 @@ class OnlineDetectorModel:
             "recall_sd": sd.tolist(),
             "successes": (self.prior_successes + self.successes).tolist(),
             "trials": (self.prior_trials + self.trials).tolist(),
-            "curve": {"kd_per_px": self.kd_per_px, "r0_px": self.r0_px, "plateau": self.plateau},
+            "curve": {
+                "kd_per_px": self.kd_per_px,
+                "r0_px": self.r0_px,
+                "plateau": self.plateau,
+                "perfect": self.perfect,
+            },
             "clutter_per_view": self.clutter_per_view,
             "views": self.prior_views + self.views,
             "pixel_noise_px": self.learned_pixel_noise_px,
@@ -309,7 +327,12 @@ def read_detector_model_file(path: str | Path) -> dict:
         successes = np.asarray(data["successes"], dtype=float)
         trials = np.asarray(data["trials"], dtype=float)
         curve = data["curve"]
-        prior = RecallModel(float(curve["kd_per_px"]), float(curve["r0_px"]), plateau=float(curve["plateau"]))
+        prior = RecallModel(
+            float(curve["kd_per_px"]),
+            float(curve["r0_px"]),
+            perfect=bool(curve.get("perfect", False)),
+            plateau=float(curve["plateau"]),
+        )
         fields = {
             "false_positives_per_view": float(data["clutter_per_view"]),
             "prior_views": float(data["views"]),
