@@ -24,7 +24,9 @@ def model(**fields) -> OnlineDetectorModel:
     return OnlineDetectorModel(CAMERA, HEIGHT_M, WIDTH_M, fields.pop("prior", CALTECH), **fields)
 
 
-def evidence(pose, mean_m, detected, existence=None, hits=None, excess_px2=(), false_births=0) -> TrackerEvidence:
+def evidence(
+    pose, mean_m, detected, existence=None, hits=None, excess_px2=(), false_births=0, exposure=1.0
+) -> TrackerEvidence:
     n = len(mean_m)
     return TrackerEvidence(
         pose=np.asarray(pose, dtype=float),
@@ -35,6 +37,7 @@ def evidence(pose, mean_m, detected, existence=None, hits=None, excess_px2=(), f
         detected=np.asarray(detected, dtype=bool),
         excess_px2=np.asarray(excess_px2, dtype=float),
         false_births=false_births,
+        exposure=exposure,
     )
 
 
@@ -114,6 +117,15 @@ def test_clutter_and_noise_are_their_closed_form_posteriors():
     expected = (2 * 10 * 4.0 + np.sum(np.concatenate(excess))) / (2 * (10 + 4000))
     assert learned.learned_pixel_noise_px == pytest.approx(np.sqrt(expected))
     assert learned.learned_pixel_noise_px == pytest.approx(3.0, abs=0.1)
+
+
+def test_a_view_counts_in_the_clutter_by_its_exposure():
+    """False births seen on a quarter of each view are a quarter of the view's false positives."""
+    learned = model(false_positives_per_view=0.5)
+    pose = look_at(CAMERA, [0.0, -10.0], 1.0)
+    for _ in range(40):
+        learned.observe(evidence(pose, np.zeros((0, 2)), [], false_births=1, exposure=0.25))
+    assert learned.clutter_per_view == pytest.approx((10 * 0.5 + 40) / (10 + 0.25 * 40))
 
 
 def test_a_saved_model_is_the_next_runs_prior(tmp_path):

@@ -45,6 +45,10 @@ found. Once a bin holds evidence, its draws stay near its recall.
 False positives per view: a Gamma-Poisson posterior, with the prior mean
 weighted as ``PRIOR_VIEWS`` views, on the tracks that one detection started
 and that died unconfirmed where the detector would have found them again.
+A view counts by its exposure ``x_t``, the share of it where a false
+detection would have started a track (a tracker that starts none in a
+track's gate sees false births only outside the gates):
+``lambda = (PRIOR_VIEWS lambda0 + sum_t births_t) / (PRIOR_VIEWS + sum_t x_t)``.
 
 Pixel noise: with ``excess = |nu|^2 - tr(C P C^T)``, ``E[excess] = 2 sigma^2``;
 ``sigma^2`` is the mean of the excesses with the prior's ``sigma0^2`` weighted
@@ -125,7 +129,7 @@ class OnlineDetectorModel:
     curve: RecallModel = field(init=False)
     planning_curve: RecallModel = field(init=False)
     false_births: float = field(default=0.0, init=False)
-    views: int = field(default=0, init=False)
+    views: float = field(default=0.0, init=False)
     excess_sum_px2: float = field(default=0.0, init=False)
     innovations: int = field(default=0, init=False)
 
@@ -167,7 +171,7 @@ class OnlineDetectorModel:
         """Add one tracker step's evidence (see the module's docstring) and refit the curve."""
         if not self.learning:
             return
-        self.views += 1
+        self.views += evidence.exposure
         self.false_births += evidence.false_births
         self.excess_sum_px2 += float(np.sum(evidence.excess_px2))
         self.innovations += len(evidence.excess_px2)
@@ -242,7 +246,7 @@ class OnlineDetectorModel:
 
     @property
     def clutter_per_view(self) -> float:
-        """The posterior mean of the false positives per view."""
+        """The posterior mean of the false positives per view (the module's docstring)."""
         return (self.prior_views * self.false_positives_per_view + self.false_births) / (self.prior_views + self.views)
 
     @property
