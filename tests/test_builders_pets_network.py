@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 
 from ptztrack.builders.episode import run_episode
-from ptztrack.builders.pets_network import PUBLISHED_RECALL, published_views
+from ptztrack.builders.network import belief_of_cameras
+from ptztrack.builders.pets_network import PUBLISHED_RECALL, pets_network_world, published_views
 from ptztrack.camera.virtual import virtual_ptz
 from ptztrack.cli import main
 from ptztrack.config import pets_scenario
@@ -14,6 +15,7 @@ from ptztrack.detect.simulated import RecallModel
 from ptztrack.evaluate.metrics import episode_metrics
 from ptztrack.geometry.calibration import project_pinhole
 from ptztrack.track.tracker import ground_points
+from ptztrack.types import Detections
 
 
 @pytest.fixture(scope="module")
@@ -62,6 +64,32 @@ def test_a_constant_recall_scales_the_ideal_detectors_probability_of_detection(v
     assert np.all(ideal > 0.5)
     np.testing.assert_allclose(constant, PUBLISHED_RECALL * ideal)
     np.testing.assert_array_equal(RecallModel.constant(0.5)(np.array([3.0, 300.0])), [0.5, 0.5])
+
+
+def test_a_fixed_cameras_model_learns_its_clutter_from_false_births_and_its_tracker_reads_it(views):
+    """A fixed camera shown one detection every other step, at the same place: each starts a track that
+    the next step's miss deletes, a false birth; its model, prior recall PUBLISHED_RECALL and no clutter,
+    learns the clutter per view from them, and its tracker's clutter is the model's."""
+    scenario = pets_scenario("hog", frames=3)
+    world = pets_network_world(scenario, 0, False, [views["View_005"]])
+    camera = world.cameras[0]
+    model = camera.detector_model
+    assert model.learning and model.perfect and model.plateau == pytest.approx(PUBLISHED_RECALL)
+    assert model.clutter_per_view == 0.0
+    belief = belief_of_cameras([(scenario, camera)])
+    pose = camera.grid.poses[camera.start_action]
+    steps = 40
+    for step in range(steps):
+        belief.predict()
+        feet_px = np.array([[80.0, 90.0]]) if step % 2 == 0 else np.zeros((0, 2))
+        belief.updater(0).update(
+            Detections(feet_px, np.full(len(feet_px), 40.0), np.full(len(feet_px), -1)), pose, None
+        )
+    assert model.false_births == steps // 2
+    assert model.clutter_per_view == pytest.approx((steps // 2) / (10 + steps))
+    tracker = belief.cameras[0]
+    assert tracker.clutter_per_view is not None and tracker.clutter_per_view() == model.clutter_per_view
+    assert model.perfect
 
 
 def test_the_pets_network_rows_and_the_ptz_camera_alone_is_the_one_camera_run(tmp_path):

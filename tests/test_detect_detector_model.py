@@ -24,7 +24,9 @@ def model(**fields) -> OnlineDetectorModel:
     return OnlineDetectorModel(CAMERA, HEIGHT_M, WIDTH_M, fields.pop("prior", CALTECH), **fields)
 
 
-def evidence(pose, mean_m, detected, existence=None, hits=None, excess_px2=(), false_births=0) -> TrackerEvidence:
+def evidence(
+    pose, mean_m, detected, existence=None, hits=None, excess_px2=(), false_births=0, exposure=1.0
+) -> TrackerEvidence:
     n = len(mean_m)
     return TrackerEvidence(
         pose=np.asarray(pose, dtype=float),
@@ -35,6 +37,7 @@ def evidence(pose, mean_m, detected, existence=None, hits=None, excess_px2=(), f
         detected=np.asarray(detected, dtype=bool),
         excess_px2=np.asarray(excess_px2, dtype=float),
         false_births=false_births,
+        exposure=exposure,
     )
 
 
@@ -116,6 +119,15 @@ def test_clutter_and_noise_are_their_closed_form_posteriors():
     assert learned.learned_pixel_noise_px == pytest.approx(3.0, abs=0.1)
 
 
+def test_a_view_counts_in_the_clutter_by_its_exposure():
+    """False births seen on a quarter of each view are a quarter of the view's false positives."""
+    learned = model(false_positives_per_view=0.5)
+    pose = look_at(CAMERA, [0.0, -10.0], 1.0)
+    for _ in range(40):
+        learned.observe(evidence(pose, np.zeros((0, 2)), [], false_births=1, exposure=0.25))
+    assert learned.clutter_per_view == pytest.approx((10 * 0.5 + 40) / (10 + 0.25 * 40))
+
+
 def test_a_saved_model_is_the_next_runs_prior(tmp_path):
     learned = model()
     pose = look_at(CAMERA, [0.0, -10.0], 1.0)
@@ -131,6 +143,39 @@ def test_a_saved_model_is_the_next_runs_prior(tmp_path):
     assert (again.kd_per_px, again.r0_px, again.plateau) == (learned.kd_per_px, learned.r0_px, learned.plateau)
     assert again.clutter_per_view == pytest.approx(learned.clutter_per_view)
     assert again.learned_pixel_noise_px == pytest.approx(learned.learned_pixel_noise_px)
+
+
+def test_a_constant_prior_learns_a_constant_recall_pooled_over_the_bins():
+    """A height-independent prior (0.9) and a detector that finds people half the time at every size: the
+    fitted recall stays a constant, the pooled share of successes with the prior's pseudo-counts, and the
+    planning draws are constants too."""
+    learned = model(prior=RecallModel.constant(0.9))
+    assert learned.perfect and learned.plateau == pytest.approx(0.9)
+    np.testing.assert_allclose(learned(np.array([5.0, 50.0, 250.0])), 0.9)
+    rng = np.random.default_rng(2)
+    ground = people_in_a_row(3)
+    for zoom in np.repeat([0.5, 1.0, 2.0], 100):
+        learned.observe(evidence(look_at(CAMERA, [0.0, -10.0], zoom), ground, rng.random(3) < 0.5))
+        assert learned.planning_curve.perfect
+    assert learned.perfect
+    prior_successes, prior_trials = np.sum(learned.prior_successes), np.sum(learned.prior_trials)
+    expected = (prior_successes + np.sum(learned.successes)) / (prior_trials + np.sum(learned.trials))
+    assert learned.plateau == pytest.approx(expected)
+    assert learned.plateau == pytest.approx(0.5, abs=0.06)
+    assert learned.planning_curve.plateau == pytest.approx(learned.plateau, abs=0.1)
+    np.testing.assert_allclose(learned(np.array([5.0, 50.0, 250.0])), learned.plateau)
+
+
+def test_a_constant_prior_learns_clutter_and_a_saved_one_stays_constant(tmp_path):
+    learned = model(prior=RecallModel.constant(0.9))
+    pose = look_at(CAMERA, [0.0, -10.0], 1.0)
+    for _ in range(30):
+        learned.observe(evidence(pose, people_in_a_row(3), [True, True, False], false_births=2))
+    assert learned.clutter_per_view == pytest.approx(2 * 30 / (10 + 30))
+    path = tmp_path / "detector_model.json"
+    learned.save(path)
+    again = OnlineDetectorModel(CAMERA, HEIGHT_M, WIDTH_M, **read_detector_model_file(path))
+    assert again.perfect and again.plateau == pytest.approx(learned.plateau)
 
 
 @pytest.mark.parametrize(

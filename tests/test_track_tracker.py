@@ -3,6 +3,7 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
+from scipy.stats import chi2
 
 from ptztrack.geometry.ptz import PTZCamera, apply_homography, feet_jacobian, ground_to_image, look_at
 from ptztrack.track import kalman
@@ -12,6 +13,7 @@ from ptztrack.track.parameters import TrackerParameters
 from ptztrack.track.sensor_bias import PixelBias
 from ptztrack.track.tracker import (
     EkfTracker,
+    birth_exposure,
     existence_after_detection,
     existence_after_miss,
     innovation_likelihood,
@@ -283,6 +285,33 @@ def test_a_second_detection_in_a_tracks_gate_starts_a_track_only_when_births_are
     predicted = predict_tracks(tracks, F, U)
     detections = feet_px([[7.5, 6.0], [7.55, 6.0]])
     assert len(update_tracks(predicted, detections, CAMERA, POSE, V, config).tracks) == tracks_after
+
+
+def test_the_birth_exposure_is_the_share_of_the_image_outside_every_surviving_tracks_gate():
+    """With births only outside the gates, a detection at a point the exposure counts as gated starts no
+    track and one it counts as open starts one; the exposure is the whole image without tracks, and for
+    births wherever a detection is unassigned."""
+    config = parameters(birth="outside_gates")
+    tracks, F, U = detected_track(config)
+    predicted = predict_tracks(tracks, F, U)
+    # Not looked at: the track survives the step.
+    update = update_tracks(predicted, np.zeros((0, 2)), CAMERA, POSE, V, config, detectable=np.zeros(1))
+    exposure = birth_exposure(predicted, update, CAMERA, POSE, V, config)
+    C = observation_matrix(CAMERA, POSE, predicted.mean)
+    S = kalman.innovation_covariance(predicted.covariance, C, V)[0]
+    gate_d2 = chi2.ppf(config.gate_probability, df=2)
+    ellipse_px2 = math.pi * gate_d2 * math.sqrt(np.linalg.det(S))
+    assert exposure == pytest.approx(1 - ellipse_px2 / (CAMERA.image_width_px * CAMERA.image_height_px), abs=2e-4)
+    centre = feet_px(predicted.mean[:, :2])[0]
+    # A Cholesky column of S is one Mahalanobis unit from the prediction.
+    unit = np.linalg.cholesky(S)[:, 0]
+    for scale, tracks_after in ((0.9, 1), (1.1, 2)):
+        detection = centre + scale * math.sqrt(gate_d2) * unit
+        after = update_tracks(predicted, detection[None], CAMERA, POSE, V, config, detectable=np.zeros(1))
+        assert len(after.tracks) == tracks_after
+    empty = update_tracks(Tracks.empty(), np.zeros((0, 2)), CAMERA, POSE, V, config)
+    assert birth_exposure(Tracks.empty(), empty, CAMERA, POSE, V, config) == 1.0
+    assert birth_exposure(predicted, update, CAMERA, POSE, V, parameters()) == 1.0
 
 
 def test_a_camera_with_a_bias_learns_it_from_a_sure_track_and_takes_it_off_its_detections():

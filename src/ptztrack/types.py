@@ -55,6 +55,9 @@ class TrackerEvidence:
         share the prediction's own spread explains (its mean is ``tr V``, twice the pixel noise's variance).
     false_births : tracks started by one detection and deleted, unconfirmed, because the detector would
         have found their person again and did not (the evidence of the detector's false positives).
+    exposure : the share of the view where a false detection would have started a track (1: anywhere; less
+        where the tracker starts none in a surviving track's gate); the view counts as this much of one in
+        the false positives' posterior.
     """
 
     pose: np.ndarray
@@ -65,6 +68,7 @@ class TrackerEvidence:
     detected: np.ndarray
     excess_px2: np.ndarray
     false_births: int
+    exposure: float = 1.0
 
 
 @dataclass(frozen=True)

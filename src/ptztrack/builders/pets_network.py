@@ -7,8 +7,13 @@ step for step, that run. Each other view is a fixed camera backed by its publish
 (:class:`ptztrack.detect.published.PublishedDetections`): the virtual camera at its optical centre
 with the scenario's image (160 x 120 px) at the view's field of view, held at the pose that shows
 the recorded view; the scenario's pixel noise, tracker and policy settings; and, as its detector
-model, recall :data:`PUBLISHED_RECALL` for anybody wholly in its image, whatever their size (a curve
-kept, not learned). Boxes scored below the occupancy experiment's threshold for the same files
+model, one learned as the run goes as the PTZ camera's is
+(:class:`~ptztrack.detect.detector_model.OnlineDetectorModel`, with the same prior weights): its prior
+recall :data:`PUBLISHED_RECALL` for anybody wholly in its image, whatever their size, learned as a
+constant; its false positives per view learned from the tracks one detection started that died
+unconfirmed, from the scenario's (``detector.false_positives_per_frame``) as the prior, and the
+existence of a track it detects updated against their density over its image. Boxes scored below the
+occupancy experiment's threshold for the same files
 (:attr:`ptztrack.occupancy.parameters.OccupancyParameters.min_box_score`) are not used. Every camera
 shares the PTZ camera's scene: its people (the annotations, scored) and its walkable area.
 
@@ -48,8 +53,9 @@ from ptztrack.track.sensor_bias import PixelBias
 PUBLISHED_RECALL = 0.9
 """The fixed cameras' detector model: the probability that the published detector finds a person wholly
 in the view's image, at any size (people hidden by other tracks count as missed in proportion, as for
-every camera). Fixed a priori, before any run on S2.L1: a round figure for a fine-tuned R-CNN person
-detector's recall of unoccluded people at its usual score threshold of 0.5; not measured on these files."""
+every camera): the prior of its learned model. Fixed a priori, before any run on S2.L1: a round figure
+for a fine-tuned R-CNN person detector's recall of unoccluded people at its usual score threshold of 0.5;
+not measured on these files."""
 
 
 PUBLISHED_NOISE_DOF = 4.0
@@ -65,9 +71,11 @@ def published_views(scenario: Scenario) -> tuple[CameraView, ...]:
     return recording_from_dataset(pets_dataset(views=others)).views
 
 
-def published_camera_world(scenario: Scenario, scene: BuiltScene, view: CameraView) -> World:
+def published_camera_world(
+    scenario: Scenario, scene: BuiltScene, view: CameraView, model_seed: np.random.SeedSequence | None = None
+) -> World:
     """The fixed camera of ``view`` (its calibration and boxes) in the scene of ``scenario``'s recording
-    (see the module's docstring)."""
+    (see the module's docstring); model_seed : the stream of its detector model's draws."""
     if view.boxes is None or view.image_size_px is None:
         raise ScenarioError(f"{view.name}: a fixed camera of published detections needs its boxes and image size")
     assert scene.recording is not None  # published_views asked for the recording
@@ -86,13 +94,14 @@ def published_camera_world(scenario: Scenario, scene: BuiltScene, view: CameraVi
         start_action=0,
         pose_source=commanded_pose,
         landing_error=LandingError(),
-        detector_model=detector_model(scenario, virtual.camera, kept=RecallModel.constant(PUBLISHED_RECALL)),
+        detector_model=detector_model(scenario, virtual.camera, model_seed, own=RecallModel.constant(PUBLISHED_RECALL)),
     )
 
 
 def pets_network_world(scenario: Scenario, seed: int, ptz: bool, views: Sequence[CameraView]) -> NetworkWorld:
     """The network of the episode ``seed``: with ``ptz``, the PTZ camera first (the one-camera run's world),
-    then a fixed camera per published view of ``views``."""
+    then a fixed camera per published view of ``views``, its detector model drawing from a stream spawned
+    from the PTZ camera's model's (which spawning leaves as it was)."""
     if not ptz and not views:
         raise ScenarioError("a PETS camera network needs the PTZ camera or a published view")
     streams = episode_seeds(seed)
@@ -100,7 +109,10 @@ def pets_network_world(scenario: Scenario, seed: int, ptz: bool, views: Sequence
     worlds = []
     if ptz:
         worlds.append(camera_world(scenario, scene, tracker_seed=streams[4], model_seed=streams[5]))
-    worlds += [published_camera_world(scenario, scene, view) for view in views]
+    model_seeds = streams[5].spawn(len(views))
+    worlds += [
+        published_camera_world(scenario, scene, view, seed) for view, seed in zip(views, model_seeds, strict=True)
+    ]
     return NetworkWorld(tuple(worlds))
 
 

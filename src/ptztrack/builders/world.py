@@ -180,23 +180,26 @@ def recall_model(scenario: Scenario) -> RecallModel:
 
 
 def detector_model(
-    scenario: Scenario, camera: PTZCamera, seed: np.random.SeedSequence | None = None, kept: RecallModel | None = None
+    scenario: Scenario, camera: PTZCamera, seed: np.random.SeedSequence | None = None, own: RecallModel | None = None
 ) -> OnlineDetectorModel:
     """What the policies and the tracker know of the detector (``detector.model``): the scenario's curve with
     its r0 shifted by ``detector.prior_shift_px`` as the prior, learned as the run goes ('online') or kept
     ('a-priori'); the unshifted curve kept ('true'); or an earlier run's ``detector_model.json`` as the prior.
-    The ideal detector's model is perfect and kept. seed : the stream of the model's draws. kept : a curve
-    kept instead (a camera whose detector is not the scenario's), with the scenario's clutter and noise."""
+    The ideal detector's model is perfect and kept. seed : the stream of the model's draws. own : the
+    a-priori curve of a camera whose detector is not the scenario's, with the scenario's clutter and noise
+    as their priors; learned as the run goes unless ``detector.model`` is 'a-priori' or 'true'."""
     detector = scenario.detector
-    true_curve = recall_model(scenario) if kept is None else kept
     people = (camera, scenario.control.person_height_m, scenario.people.width_m)
     rng = np.random.default_rng(seed if seed is not None else 0)
-    if kept is None and detector.model not in ("online", "a-priori", "true"):
+    if own is not None:
+        prior, learning = own, detector.model not in ("a-priori", "true")
+    elif detector.model not in ("online", "a-priori", "true"):
         return OnlineDetectorModel(*people, **read_detector_model_file(detector.model), rng=rng)
-    prior, learning = true_curve, False
-    if kept is None and not true_curve.perfect and detector.model != "true":
-        prior = RecallModel(true_curve.kd_per_px, max(true_curve.r0_px + detector.prior_shift_px, 0.0))
-        learning = detector.model == "online"
+    else:
+        prior, learning = recall_model(scenario), False
+        if not prior.perfect and detector.model != "true":
+            prior = RecallModel(prior.kd_per_px, max(prior.r0_px + detector.prior_shift_px, 0.0))
+            learning = detector.model == "online"
     return OnlineDetectorModel(
         *people,
         prior,

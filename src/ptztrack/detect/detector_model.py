@@ -23,6 +23,17 @@ over a fixed grid that holds the prior curve's own parameters, so that with
 no evidence the model is the prior. Each bin's Beta posterior gives the
 reported recall and its standard deviation. The tracker reads this mode.
 
+A prior that does not depend on the height (``RecallModel.perfect``: a
+constant recall ``P``, say a fixed camera given a published detector's
+boxes) keeps to constants: the fitted recall is the mode of the same binned
+likelihood over every constant, ``P = sum_b s_b / sum_b (s_b + f_b)``, the
+pooled share of successes, and it stays height-independent. The curve is not
+learned there: a constant is not in its family (it is the limit Kd -> inf,
+r0 = 0), and a fixed camera sees each place at one height only, so the bins'
+recall would confound the height with the place (scene objects, the view's
+edges, the calibration's error with range), which a PTZ camera, zooming,
+tells apart.
+
 The policies plan with a draw instead (Thompson sampling): after every
 step, one recall per bin from its Beta posterior, with Jeffreys' half a
 success and half a failure added so that no bin is ever certain, and the
@@ -34,6 +45,10 @@ found. Once a bin holds evidence, its draws stay near its recall.
 False positives per view: a Gamma-Poisson posterior, with the prior mean
 weighted as ``PRIOR_VIEWS`` views, on the tracks that one detection started
 and that died unconfirmed where the detector would have found them again.
+A view counts by its exposure ``x_t``, the share of it where a false
+detection would have started a track (a tracker that starts none in a
+track's gate sees false births only outside the gates):
+``lambda = (PRIOR_VIEWS lambda0 + sum_t births_t) / (PRIOR_VIEWS + sum_t x_t)``.
 
 Pixel noise: with ``excess = |nu|^2 - tr(C P C^T)``, ``E[excess] = 2 sigma^2``;
 ``sigma^2`` is the mean of the excesses with the prior's ``sigma0^2`` weighted
@@ -114,7 +129,7 @@ class OnlineDetectorModel:
     curve: RecallModel = field(init=False)
     planning_curve: RecallModel = field(init=False)
     false_births: float = field(default=0.0, init=False)
-    views: int = field(default=0, init=False)
+    views: float = field(default=0.0, init=False)
     excess_sum_px2: float = field(default=0.0, init=False)
     innovations: int = field(default=0, init=False)
 
@@ -126,7 +141,8 @@ class OnlineDetectorModel:
             self.prior_successes = PRIOR_TRIALS_PER_BIN * p0
         self.successes = np.zeros(len(self.centres_px))
         self.trials = np.zeros(len(self.centres_px))
-        self._parameters, self._log_recall, self._log_miss = _curve_grid(self.prior, self.centres_px)
+        if not self.prior.perfect:
+            self._parameters, self._log_recall, self._log_miss = _curve_grid(self.prior, self.centres_px)
         self.curve = self.prior
         self._refit()
         self._draw()
@@ -153,9 +169,9 @@ class OnlineDetectorModel:
 
     def observe(self, evidence: TrackerEvidence) -> None:
         """Add one tracker step's evidence (see the module's docstring) and refit the curve."""
-        if not self.learning or self.prior.perfect:
+        if not self.learning:
             return
-        self.views += 1
+        self.views += evidence.exposure
         self.false_births += evidence.false_births
         self.excess_sum_px2 += float(np.sum(evidence.excess_px2))
         self.innovations += len(evidence.excess_px2)
@@ -194,20 +210,21 @@ class OnlineDetectorModel:
         return index, people.height_px[index], evidence.existence[index] * (1.0 - hidden[index])
 
     def _refit(self) -> None:
-        if self.prior.perfect:
-            return
         successes = self.prior_successes + self.successes
         self.curve = self._fitted(successes, self.prior_trials + self.trials - successes)
 
     def _fitted(self, successes, failures) -> RecallModel:
-        """The grid's curve of highest binned likelihood for these counts (B,) each."""
+        """The grid's curve of highest binned likelihood for these counts (B,) each; for a height-independent
+        prior, the constant of highest likelihood, ``sum(successes) / sum(successes + failures)``."""
+        if self.prior.perfect:
+            return RecallModel.constant(float(np.sum(successes) / (np.sum(successes) + np.sum(failures))))
         score = self._log_recall @ successes + self._log_miss @ failures
         kd, r0, plateau = self._parameters[int(np.argmax(score))]
         return RecallModel(float(kd), float(r0), plateau=float(plateau))
 
     def _draw(self) -> None:
         """A new planning curve from the posterior (see the module's docstring); the mode's when not learning."""
-        if not self.learning or self.prior.perfect:
+        if not self.learning:
             self.planning_curve = self.curve
             return
         successes = self.prior_successes + self.successes + 0.5
@@ -229,7 +246,7 @@ class OnlineDetectorModel:
 
     @property
     def clutter_per_view(self) -> float:
-        """The posterior mean of the false positives per view."""
+        """The posterior mean of the false positives per view (the module's docstring)."""
         return (self.prior_views * self.false_positives_per_view + self.false_births) / (self.prior_views + self.views)
 
     @property
@@ -250,7 +267,12 @@ class OnlineDetectorModel:
             "recall_sd": sd.tolist(),
             "successes": (self.prior_successes + self.successes).tolist(),
             "trials": (self.prior_trials + self.trials).tolist(),
-            "curve": {"kd_per_px": self.kd_per_px, "r0_px": self.r0_px, "plateau": self.plateau},
+            "curve": {
+                "kd_per_px": self.kd_per_px,
+                "r0_px": self.r0_px,
+                "plateau": self.plateau,
+                "perfect": self.perfect,
+            },
             "clutter_per_view": self.clutter_per_view,
             "views": self.prior_views + self.views,
             "pixel_noise_px": self.learned_pixel_noise_px,
@@ -309,7 +331,12 @@ def read_detector_model_file(path: str | Path) -> dict:
         successes = np.asarray(data["successes"], dtype=float)
         trials = np.asarray(data["trials"], dtype=float)
         curve = data["curve"]
-        prior = RecallModel(float(curve["kd_per_px"]), float(curve["r0_px"]), plateau=float(curve["plateau"]))
+        prior = RecallModel(
+            float(curve["kd_per_px"]),
+            float(curve["r0_px"]),
+            perfect=bool(curve.get("perfect", False)),
+            plateau=float(curve["plateau"]),
+        )
         fields = {
             "false_positives_per_view": float(data["clutter_per_view"]),
             "prior_views": float(data["views"]),

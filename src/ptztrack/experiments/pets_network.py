@@ -5,8 +5,8 @@ Configurations: ``ptz+6fixed`` (the PTZ camera deciding jointly with the fixed v
 information, :mod:`ptztrack.control.network_policy`), ``6fixed`` (the fixed views alone) and ``ptz``
 (the PTZ camera alone: ``experiment pets --detector hog``'s information-gain run of the same beta and
 seeds, step for step). A run with the PTZ camera depends on its seed (its online detector model's
-draws), so it runs on seeds 0 .. n-1, as the PETS table does; the fixed views alone draw nothing and
-run once.
+draws), so it runs on seeds 0 .. n-1, as the PETS table does; the fixed views alone do not depend on it
+(their models' draws only weigh a PTZ camera's decisions) and run once.
 
 Scoring. The annotations are View_001's: they hold the people View_001 shows, not those only the other
 views see. So the tracks are scored where the annotations are, inside the walkable area (the ground

@@ -58,6 +58,10 @@ from ptztrack.track.parameters import TrackerParameters
 from ptztrack.track.sensor_bias import PixelBias
 from ptztrack.types import Detections, TrackerEvidence, Tracks, TrackUpdate
 
+# The image's pixels are sampled every 2 px for the share outside the gates: the smallest gate, of the
+# half-pixel noise floor at the 0.99 chi-square gate, is 3 px across.
+EXPOSURE_GRID_PX = 2
+
 # Feet are found on a pixel grid: the tracker trusts them to half a pixel at
 # best, which also keeps the innovation covariance invertible for a
 # noiseless simulated detector.
@@ -442,6 +446,30 @@ def tracker_evidence(
     )
 
 
+def birth_exposure(
+    tracks: Tracks, update: TrackUpdate, camera: PTZCamera, pose, V, parameters: TrackerParameters
+) -> float:
+    """The share of the image where a detection at ``pose`` would have started a track in the step that took
+    the predicted ``tracks`` to ``update`` under the noise ``V`` (2, 2) px^2: 1 for ``birth`` 'unassigned'
+    (the CJPDAF's included, though it starts no track in a gate either); for 'outside_gates', the share of
+    the image (sampled every :data:`EXPOSURE_GRID_PX` px) in the gate of no surviving track, as
+    :func:`update_tracks` gates its births."""
+    if parameters.birth == "unassigned":
+        return 1.0
+    surviving = np.isin(tracks.ids, update.tracks.ids)
+    mean = tracks.mean[surviving]
+    predicted_px, in_front = predicted_feet_px(camera, pose, mean)
+    S = kalman.innovation_covariance(tracks.covariance[surviving], observation_matrix(camera, pose, mean), V)
+    half = EXPOSURE_GRID_PX / 2
+    u, v = np.meshgrid(
+        np.arange(half, camera.image_width_px, EXPOSURE_GRID_PX),
+        np.arange(half, camera.image_height_px, EXPOSURE_GRID_PX),
+    )
+    gate = student_t_gate(parameters.gate_probability, parameters.noise_dof)
+    _, _, gated = gated_innovations(predicted_px, in_front, S, np.c_[u.ravel(), v.ravel()], gate)
+    return float(1.0 - np.mean(gated.any(axis=0)))
+
+
 @dataclass
 class EkfTracker:
     """The ground-plane tracker as a role of the loop (:class:`ptztrack.roles.Tracker`).
@@ -503,7 +531,8 @@ class EkfTracker:
             bias.observe(innovation_px + bias_px, S, weight)
         if self.learner is not None:
             evidence = tracker_evidence(tracks, update, detections.feet_px, self.camera, pose, detectable, parameters)
-            self.learner(replace(evidence, excess_px2=evidence.excess_px2 - np.trace(pose_noise)))
+            exposure = birth_exposure(tracks, update, self.camera, pose, V, parameters)
+            self.learner(replace(evidence, excess_px2=evidence.excess_px2 - np.trace(pose_noise), exposure=exposure))
         return update
 
     def reported(self) -> Tracks:
