@@ -105,6 +105,24 @@ XML_LAUGHS = '<!ENTITY a "aaaaaaaaaa">' + "".join(
 )
 
 
+def calibration_fit_case(name: str, k_scale: float, extra: tuple[str, ...], says: tuple[str, ...] = ()) -> Case:
+    """A dataset whose one view, View_001, has the ground truth's own boxes as detections and PETS's pinhole
+    calibration with K scaled by ``k_scale`` (1: the calibration that projects the people onto the boxes)."""
+    return _dataset(
+        name,
+        view="image_size_px: [768, 576], detections: det.txt",
+        calibration="c.json",
+        files={
+            "c.json": _pinhole_with_k_scaled(k_scale),
+            "det.txt": _detections_of(FIRST_TEN_FRAMES),
+            "gt.txt": _ground_truth(FIRST_TEN_FRAMES),
+        },
+        extra=extra,
+        exit_status=0,
+        says=says,
+    )
+
+
 def _pinhole_with_k_scaled(scale: float) -> str:
     """PETS's pinhole calibrations with View_001's focal lengths and principal point scaled."""
     views = json.loads(PINHOLE)
@@ -413,17 +431,10 @@ def cases(scratch: Path | None) -> list[Case]:
             exit_status=0,
             says=(f"gt.txt: 1 of {len(FIRST_TWO_FRAMES)} rows of the 2 frames used lie outside area_m",),
         ),
-        _dataset(
+        calibration_fit_case(
             "dataset calibration with K halved",
-            view="image_size_px: [768, 576], detections: det.txt",
-            calibration="c.json",
-            files={
-                "c.json": _pinhole_with_k_scaled(0.5),
-                "det.txt": _detections_of(FIRST_TEN_FRAMES),
-                "gt.txt": _ground_truth(FIRST_TEN_FRAMES),
-            },
-            extra=("--methods",),
-            exit_status=0,
+            0.5,
+            ("--methods",),
             says=("c.json: views.0 (View_001): the ground truth projects a median", "is this the view's calibration?"),
         ),
         _dataset(

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from bad_inputs import FIRST_TEN_FRAMES, _dataset, _detections_of, _ground_truth, _pinhole_with_k_scaled, write_case
+from bad_inputs import calibration_fit_case, write_case
 from ptztrack.cli import main
 
 PETS = Path(__file__).resolve().parents[1] / "src" / "ptztrack" / "data" / "pets2009_s2l1"
@@ -93,17 +93,7 @@ def test_an_area_seen_whole_gets_no_warning(tmp_path, caplog):
 def test_a_calibration_that_projects_the_ground_truth_onto_the_views_detections_gets_no_warning(tmp_path, caplog):
     """View_001's detections are the ground truth's own boxes, and PETS's pinhole calibration projects the
     people onto them (the same with K halved is warned of: tests/bad_inputs.py)."""
-    case = _dataset(
-        "fit",
-        view="image_size_px: [768, 576], detections: det.txt",
-        calibration="c.json",
-        files={
-            "c.json": _pinhole_with_k_scaled(1.0),
-            "det.txt": _detections_of(FIRST_TEN_FRAMES),
-            "gt.txt": _ground_truth(FIRST_TEN_FRAMES),
-        },
-        extra=("--quiet", "--methods"),
-    )
+    case = calibration_fit_case("fit", 1.0, ("--quiet", "--methods"))
     with caplog.at_level(logging.WARNING):
         assert main(write_case(case, tmp_path)) == 0
     assert [record.getMessage() for record in caplog.records if record.levelno >= logging.WARNING] == []

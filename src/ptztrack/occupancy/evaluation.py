@@ -212,13 +212,14 @@ def fitted_variant_selection(
     return kept, fitted, recall
 
 
-def merged_scores(modes: Modes, radius_m: float, min_views: int = 0) -> np.ndarray:
+def merged_scores(modes: Modes, radius_m: float, min_views: int = 0, distance_m=None) -> np.ndarray:
     """The modes' strengths (K,) with ``-inf`` for each mode that is dropped: one whose cell fewer than
     ``min_views`` views see (where the modes say: :attr:`Modes.views`), and one within ``radius_m`` of a
     stronger mode that is itself kept (greedy non-maximum suppression on the ground, strongest first as
-    :class:`Modes` are)."""
+    :class:`Modes` are). distance_m : (K, K) the modes' distances, where the caller has them already."""
     eligible = np.ones(len(modes), bool) if modes.views is None else modes.views >= min_views
-    distance_m = cdist(modes.position_m, modes.position_m)
+    if distance_m is None:
+        distance_m = cdist(modes.position_m, modes.position_m)
     kept = np.zeros(len(modes), bool)
     for index in range(len(modes)):
         kept[index] = eligible[index] and not np.any(distance_m[index, :index][kept[:index]] < radius_m)
@@ -298,10 +299,14 @@ def score_recording(
     for method, modes_by_pair in frames.modes.items():
         merged = method in MERGED_METHODS
         settings = list(itertools.product(MERGE_RADIUS_CHOICES_M, views)) if merged else [(0.0, 1)]
+        distances_m = [[cdist(m.position_m, m.position_m) for m in modes] for modes in modes_by_pair]
         kept_modes, fitted, recall = fitted_variant_selection(
             truth_m,
             [
-                [[merged_scores(m, radius_m, min_views) for m in modes] for modes in modes_by_pair]
+                [
+                    [merged_scores(m, radius_m, min_views, d) for m, d in zip(modes, pair_distances, strict=True)]
+                    for modes, pair_distances in zip(modes_by_pair, distances_m, strict=True)
+                ]
                 for radius_m, min_views in settings
             ],
             [[m.position_m for m in modes] for modes in modes_by_pair],

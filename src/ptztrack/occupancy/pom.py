@@ -394,6 +394,7 @@ class PomDetector:
             parameters.block_px,
         )
         self.solver = PomSolver(self.boxes)
+        self.view_counts = self.boxes.visible.sum(axis=0)  # (cells,) the views that see each cell
         self.last: PomResult | None = None
 
     def with_prior(self, prior: float) -> "PomDetector":
@@ -433,7 +434,7 @@ class PomDetector:
             parameters.separation_m,
             parameters.window_m,
             parameters.candidate_probability,
-            self.boxes.visible.sum(axis=0),
+            self.view_counts,
         )
         return q_map, modes
 
