@@ -79,3 +79,23 @@ def test_a_new_person_seen_by_two_cameras_is_one_track_and_ids_stay_unique():
     belief.predict()
     belief.updater(1).update(detections, pose, lambda: None)
     assert sorted(belief.tracks.ids.tolist()) == [0, 1]
+
+
+def test_each_cameras_picture_weighs_the_time_since_that_cameras_last_one():
+    """The belief's clock runs for every camera: once a step, each camera's picture is a whole look;
+    with the cameras' pictures interleaved 0.05 s apart after that, each camera's picture 0.1 s after
+    its last is half of one (a 0.2 s step), the first one, 0.05 s after, a quarter."""
+    belief = network()
+    for _ in range(2):
+        belief.predict()
+        for index, camera in enumerate((SOUTH, EAST)):
+            assert belief.cameras[index].look_weight() == 1.0
+            pose, detections = seen_at(camera, PERSON_M)
+            belief.updater(index).update(detections, pose, lambda: None)
+    weights = []
+    for index, camera in (0, SOUTH), (1, EAST), (0, SOUTH), (1, EAST):
+        belief.predict(0.05)
+        weights.append(belief.cameras[index].look_weight())
+        pose, detections = seen_at(camera, PERSON_M)
+        belief.updater(index).update(detections, pose, lambda: None)
+    np.testing.assert_allclose(weights, [0.25, 0.5, 0.5, 0.5])

@@ -107,6 +107,39 @@ def test_the_tracker_predicts_by_any_time_and_by_its_step_by_default():
     np.testing.assert_allclose(later.predict(0.7).covariance[0], F @ tracks.covariance[0] @ F.T + U)
 
 
+def test_two_misses_half_a_step_apart_weigh_as_one_miss_a_step_apart():
+    """Pictures 0.1 s apart with a 0.2 s step are half a look each: two misses multiply the existence odds
+    by (1 - q)^(1/2) twice, as one miss a step apart does by 1 - q; a first picture is a whole look."""
+    q = 0.8
+    tracks = replace(detected_track(CONFIG)[0], existence=np.array([0.9]))
+    halves = EkfTracker(CAMERA, 0.2, V, CONFIG, lambda *a: np.full(len(a[0]), q), tracks)
+    whole = EkfTracker(CAMERA, 0.2, V, CONFIG, lambda *a: np.full(len(a[0]), q), tracks)
+    halves.unseen_s = whole.unseen_s = 0.0  # each camera's last picture was taken just now
+    for tracker, dt_s in ((halves, 0.1), (halves, 0.1), (whole, 0.2)):
+        tracker.predict(dt_s)
+        tracker.update(Detections.empty(), POSE, None)
+    odds = 0.9 / 0.1 * (1 - q)
+    np.testing.assert_allclose(whole.tracks.existence, [odds / (1 + odds)])
+    np.testing.assert_allclose(halves.tracks.existence, whole.tracks.existence)
+    first = EkfTracker(CAMERA, 0.2, V, CONFIG, lambda *a: np.full(len(a[0]), q), tracks)
+    first.update(Detections.empty(), POSE, None)
+    np.testing.assert_allclose(first.tracks.existence, whole.tracks.existence)
+
+
+def test_a_picture_a_fraction_of_a_step_after_the_last_is_measured_with_the_noise_over_that_fraction():
+    """A detection 0.05 s after the camera's last picture, with a 0.2 s step, updates the track as
+    :func:`update_tracks` does with 4 V; one a step or more after, with V."""
+    tracks, _, _ = detected_track(CONFIG)
+    seen = Detections(feet_px([[7.6, 6.1]]), np.array([100.0]), np.array([-1]))
+    for dt_s, noise in ((0.05, 4.0 * V), (0.2, V), (0.5, V)):
+        tracker = EkfTracker(CAMERA, 0.2, V, CONFIG, lambda *a: np.ones(len(a[0])), tracks)
+        tracker.unseen_s = 0.0
+        expected = update_tracks(tracker.predict(dt_s), seen.feet_px, CAMERA, POSE, noise, CONFIG, np.ones(1))
+        tracker.update(seen, POSE, None)
+        np.testing.assert_allclose(tracker.tracks.covariance, expected.tracks.covariance)
+        np.testing.assert_allclose(tracker.tracks.mean, expected.tracks.mean)
+
+
 def test_hungarian_assignment_ignores_detection_order_and_gates_outliers():
     F, U = constant_velocity_model(0.2, ACCELERATION_SIGMA_M_S2)
     tracks = start_tracks(

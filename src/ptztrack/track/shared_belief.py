@@ -50,6 +50,8 @@ class SharedBelief:
         first = self.cameras[0]
         first.tracks = self.tracks
         self.tracks = first.predict(dt_s)
+        for other in self.cameras[1:]:
+            other.elapse(first.step_s if dt_s is None else dt_s)
         return self.tracks
 
     def updater(self, camera: int) -> "CameraUpdater":

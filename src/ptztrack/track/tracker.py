@@ -36,6 +36,7 @@ localised to within ``report_position_sigma_m`` (beyond that, a reported
 track is more often a false positive and a miss at once than a match).
 """
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 
@@ -66,6 +67,9 @@ EXPOSURE_GRID_PX = 2
 # best, which also keeps the innovation covariance invertible for a
 # noiseless simulated detector.
 MIN_PIXEL_NOISE_PX = 0.5
+# A picture taken at the very moment of the camera's last one repeats it: it weighs (almost) nothing, and
+# its noise V / w stays finite.
+MIN_LOOK_WEIGHT = 1e-6
 
 
 def pixel_noise_covariance(pixel_noise_px: float) -> np.ndarray:
@@ -484,6 +488,14 @@ class EkfTracker:
         estimate); its density over the image replaces ``parameters.clutter_density_per_px2``.
     bias : the camera's feet-pixel bias, estimated from the innovations as the run goes and taken off its
         detections (:mod:`ptztrack.track.sensor_bias`; None: none).
+
+    A picture's weight. The detector model, the pixel noise ``V`` and the existence update are those of
+    one look per ``step_s``; pictures closer together than that (a live stream, which delivers several
+    pictures of what a step shows) do not miss or misplace a person independently. A picture taken
+    ``dt`` after this camera's last one counts as ``w = min(1, dt / step_s)`` of a look, a tempered
+    likelihood: the noise is ``V / w`` and a miss multiplies the existence odds by ``(1 - q)^w``
+    (the detection probability used is ``1 - (1 - q)^w``), so that ``1 / w`` pictures of one step weigh
+    as one. One picture per step, as every simulated run takes, has ``w = 1``.
     """
 
     camera: PTZCamera
@@ -495,12 +507,23 @@ class EkfTracker:
     learner: Callable[[TrackerEvidence], None] | None = None
     clutter_per_view: Callable[[], float] | None = None
     bias: PixelBias | None = None
+    unseen_s: float = field(default=math.inf, init=False, repr=False)
 
     def predict(self, dt_s: float | None = None) -> Tracks:
         dt_s = self.step_s if dt_s is None else dt_s
+        self.elapse(dt_s)
         F, U = kalman.constant_velocity_model(dt_s, self.parameters.acceleration_sigma_m_s2)
         self.tracks = predict_tracks(self.tracks, F, U)
         return self.tracks
+
+    def elapse(self, dt_s: float) -> None:
+        """Let ``dt_s`` seconds pass on this camera's clock (a network's belief is predicted once for
+        every camera)."""
+        self.unseen_s += dt_s
+
+    def look_weight(self) -> float:
+        """The weight ``w`` of a picture taken now (see the class's docstring), in (0, 1]."""
+        return float(np.clip(self.unseen_s / self.step_s, MIN_LOOK_WEIGHT, 1.0))
 
     def wants_detections(self, step: int) -> bool:
         return True
@@ -519,11 +542,16 @@ class EkfTracker:
             image_area_px2 = self.camera.image_width_px * self.camera.image_height_px
             parameters = replace(parameters, clutter_density_per_px2=self.clutter_per_view() / image_area_px2)
         V = self.V + pose_noise
+        look = self.look_weight()
+        self.unseen_s = 0.0
+        looked = detectable
+        if look < 1.0:
+            V, looked = V / look, 1.0 - (1.0 - np.asarray(detectable, dtype=float)) ** look
         bias = self.bias
         if bias is not None:
             bias_px = bias.estimate()
             detections = replace(detections, feet_px=detections.feet_px - bias_px)
-        update = update_tracks(tracks, detections.feet_px, self.camera, pose, V, parameters, detectable)
+        update = update_tracks(tracks, detections.feet_px, self.camera, pose, V, parameters, looked)
         self.tracks = update.tracks
         if bias is not None:
             innovation_px, S = paired_innovations(tracks, update, detections.feet_px, self.camera, pose, V)
