@@ -11,6 +11,7 @@ from ptztrack.config import dataset_from_dict, load_dataset, pets_dataset
 from ptztrack.experiments.occupancy import format_occupancy_table
 from ptztrack.geometry.calibration import project_pinhole
 from ptztrack.occupancy.evaluation import (
+    PooledDetectors,
     detection_metrics,
     fitted_prior,
     fitted_selection,
@@ -104,6 +105,28 @@ def test_the_merging_radius_and_threshold_are_fitted_together_on_the_other_half(
     assert fitted == [(0, 0.1), (1, 0.1)]
     assert [k.tolist() for k in kept] == [[True, True]] * 2 + [[True, False]] * 2
     np.testing.assert_array_equal(recall, [1.0, 1.0, 1.0, 1.0])
+
+
+def test_pooled_settings_are_tagged_and_each_merges_only_among_its_own_modes():
+    """Two settings' modes pooled: the first's map, every mode tagged with its setting; merging over 1 m
+    for setting 1 keeps its own mode 0.6 m from setting 0's stronger one and drops setting 0's."""
+
+    class Fixed:
+        def __init__(self, occupancy, modes):
+            self.found = occupancy, modes
+
+        def detect(self, frame):
+            return self.found
+
+    wide = Modes(np.array([[0.0, 0.0]]), np.zeros((1, 2, 2)), np.array([0.9]), np.array([4]))
+    narrow = Modes(np.array([[0.6, 0.0], [3.0, 0.0]]), np.zeros((2, 2, 2)), np.array([0.8, 0.7]), np.array([4, 2]))
+    occupancy, pooled = PooledDetectors([Fixed(np.ones((2, 2)), wide), Fixed(np.zeros((2, 2)), narrow)]).detect(0)
+    np.testing.assert_array_equal(occupancy, np.ones((2, 2)))
+    np.testing.assert_array_equal(pooled.variant, [0, 1, 1])
+    np.testing.assert_array_equal(pooled.views, [4, 4, 2])
+    np.testing.assert_array_equal(merged_scores(pooled, 1.0, variant=1), [-np.inf, 0.8, 0.7])
+    np.testing.assert_array_equal(merged_scores(pooled, 1.0, min_views=3, variant=1), [-np.inf, 0.8, -np.inf])
+    np.testing.assert_array_equal(merged_scores(pooled, 1.0, variant=0), [0.9, -np.inf, -np.inf])
 
 
 def write_room_dataset(directory: Path, frames: int = 8, seed: int = 5) -> Path:
@@ -247,6 +270,10 @@ def test_pets_runs_with_seven_views(tmp_path):
     rows = json.loads(rows_path.read_text())
     assert [row["method"] for row in rows] == ["lpom", "lpom-foreground", "pom", "clustering"]
     assert all(row["views"] == 7 and row["frames"] == 20 for row in rows) and "mota" in rows[0]
+    # POM's person width, radius and views are fitted on each half, from the choices.
+    pom = rows[2]
+    assert len(pom["fitted_width_m"]) == 2 and set(pom["fitted_width_m"]) <= {0.5, 0.4, 0.3}
+    assert len(pom["fitted_merge_radius_m"]) == 2 and len(pom["fitted_min_views"]) == 2
 
 
 def test_the_example_dataset_file_is_the_built_in_pets_dataset():

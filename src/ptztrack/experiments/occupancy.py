@@ -25,6 +25,7 @@ from ptztrack.occupancy.detectors import ClusteringDetector, LpomDetector, LpomF
 from ptztrack.occupancy.evaluation import (
     MapDetector,
     OccupancyRun,
+    PooledDetectors,
     detect_frames,
     fitted_prior,
     halves,
@@ -42,6 +43,10 @@ ROOM_PEOPLE = (1, 3)
 # S2.L1 has 5.8 people in its area on average, 8 at most: 4 (two pairs) is a sparse plaza, where the
 # far views' loci rarely cross another person's; 8 is S2.L1 at its busiest.
 PLAZA_PEOPLE = (4, 8)
+# POM's person rectangle: its widest diameter (PomParameters' 0.5 m, the a-priori one, first: it wins
+# ties) and narrower, down to a body's depth (0.3 m), fitted on the other half with the threshold: a
+# silhouette fills only part of the rectangle of its widest diameter (legs, head, arms).
+POM_WIDTH_CHOICES_M = (0.5, 0.4, 0.3)
 # The table's columns (a row's key) and their formats.
 OCCUPANCY_COLUMNS = (
     ("method", "{}"),
@@ -82,10 +87,10 @@ def run_recording(
         maps["lpom-foreground"] = [LpomForegroundDetector(recording, parameters, foregrounds, lpom.tables)]
     priors: list[float] = []
     if "pom" in methods and all(view.image_size_px is not None for view in recording.views):
-        pom = PomDetector(recording, PomParameters(), foregrounds)
+        poms = [PomDetector(recording, PomParameters(width_m=width_m), foregrounds) for width_m in POM_WIDTH_CHOICES_M]
         truth_m = scored_truth(recording)
-        priors = [fitted_prior(truth_m[fitting], pom.grid.cells) for _, fitting in halves(recording.frames)]
-        maps["pom"] = [pom.with_prior(prior) for prior in priors]
+        priors = [fitted_prior(truth_m[fitting], poms[0].grid.cells) for _, fitting in halves(recording.frames)]
+        maps["pom"] = [PooledDetectors([pom.with_prior(prior) for pom in poms]) for prior in priors]
     clustering = ClusteringDetector(recording, settings.linkage_m, settings.min_box_score, settings.blob_min_area_px)
     frames = detect_frames(recording, maps, clustering, progress)
     # People leave a dataset's area (and never the room's, whose tracks stay well localised).
@@ -94,6 +99,7 @@ def run_recording(
     for row in run.rows:
         if row["method"] == "pom":
             row["fitted_prior"] = priors
+            row["fitted_width_m"] = [POM_WIDTH_CHOICES_M[index] for index in row.pop("fitted_variant")]
     return run
 
 

@@ -119,6 +119,27 @@ class MapDetector(Protocol):
     def detect(self, frame: int) -> tuple[np.ndarray, Modes]: ...
 
 
+@dataclass(frozen=True)
+class PooledDetectors:
+    """One method's detectors under several settings (a parameter fitted on the other half of the frames,
+    as the threshold is), run as one: a frame's modes are every setting's, each tagged with its setting's
+    index (:attr:`Modes.variant`); the map is the first setting's."""
+
+    detectors: Sequence[MapDetector]
+
+    def detect(self, frame: int) -> tuple[np.ndarray, Modes]:
+        found = [detector.detect(frame) for detector in self.detectors]
+        modes = [frame_modes for _, frame_modes in found]
+        views = [m.views for m in modes if m.views is not None]
+        return found[0][0], Modes(
+            np.concatenate([m.position_m for m in modes]),
+            np.concatenate([m.covariance_m2 for m in modes]),
+            np.concatenate([m.strength for m in modes]),
+            np.concatenate(views) if len(views) == len(modes) else None,
+            np.concatenate([np.full(len(m), index) for index, m in enumerate(modes)]),
+        )
+
+
 def detect_frames(
     recording: MultiViewRecording,
     maps: dict[str, Sequence[MapDetector]],
@@ -212,12 +233,17 @@ def fitted_variant_selection(
     return kept, fitted, recall
 
 
-def merged_scores(modes: Modes, radius_m: float, min_views: int = 0, distance_m=None) -> np.ndarray:
+def merged_scores(
+    modes: Modes, radius_m: float, min_views: int = 0, distance_m=None, variant: int | None = None
+) -> np.ndarray:
     """The modes' strengths (K,) with ``-inf`` for each mode that is dropped: one whose cell fewer than
-    ``min_views`` views see (where the modes say: :attr:`Modes.views`), and one within ``radius_m`` of a
+    ``min_views`` views see (where the modes say: :attr:`Modes.views`), one of another setting than
+    ``variant`` (where the modes are pooled: :attr:`Modes.variant`), and one within ``radius_m`` of a
     stronger mode that is itself kept (greedy non-maximum suppression on the ground, strongest first as
     :class:`Modes` are). distance_m : (K, K) the modes' distances, where the caller has them already."""
     eligible = np.ones(len(modes), bool) if modes.views is None else modes.views >= min_views
+    if variant is not None and modes.variant is not None:
+        eligible &= modes.variant == variant
     if distance_m is None:
         distance_m = cdist(modes.position_m, modes.position_m)
     kept = np.zeros(len(modes), bool)
@@ -298,16 +324,21 @@ def score_recording(
     views = tuple(range(1, len(recording.views) + 1))
     for method, modes_by_pair in frames.modes.items():
         merged = method in MERGED_METHODS
-        settings = list(itertools.product(MERGE_RADIUS_CHOICES_M, views)) if merged else [(0.0, 1)]
+        pooled = sorted({int(v) for modes in modes_by_pair for m in modes if m.variant is not None for v in m.variant})
+        variants: list[int | None] = [*pooled] if pooled else [None]
+        settings = list(itertools.product(MERGE_RADIUS_CHOICES_M, views, variants)) if merged else [(0.0, 1, None)]
         distances_m = [[cdist(m.position_m, m.position_m) for m in modes] for modes in modes_by_pair]
         kept_modes, fitted, recall = fitted_variant_selection(
             truth_m,
             [
                 [
-                    [merged_scores(m, radius_m, min_views, d) for m, d in zip(modes, pair_distances, strict=True)]
+                    [
+                        merged_scores(m, radius_m, min_views, d, variant)
+                        for m, d in zip(modes, pair_distances, strict=True)
+                    ]
                     for modes, pair_distances in zip(modes_by_pair, distances_m, strict=True)
                 ]
-                for radius_m, min_views in settings
+                for radius_m, min_views, variant in settings
             ],
             [[m.position_m for m in modes] for modes in modes_by_pair],
             STRENGTH_CHOICES,
@@ -317,6 +348,7 @@ def score_recording(
             {
                 "fitted_merge_radius_m": [settings[index][0] for index, _ in fitted],
                 "fitted_min_views": [settings[index][1] for index, _ in fitted],
+                **({"fitted_variant": [settings[index][2] for index, _ in fitted]} if pooled else {}),
             }
             if merged
             else {}

@@ -215,20 +215,24 @@ class Modes:
 
     position_m : (K, 2) the map's mean around each maximum; covariance_m2 : (K, 2, 2) its spread there;
     strength : (K,) the map's value at the maximum divided by the map's largest value (in (0, 1]),
-    strongest first; views : (K,) how many views see each mode's cell, where the detector says (POM), or None.
+    strongest first; views : (K,) how many views see each mode's cell, where the detector says (POM), or None;
+    variant : (K,) the index of the detector's setting each mode came from, where several settings' modes are
+    pooled (:class:`ptztrack.occupancy.evaluation.PooledDetectors`; strongest first within each), or None.
     """
 
     position_m: np.ndarray
     covariance_m2: np.ndarray
     strength: np.ndarray
     views: np.ndarray | None = None
+    variant: np.ndarray | None = None
 
     def __len__(self) -> int:
         return len(self.strength)
 
     def select(self, keep) -> "Modes":
         views = None if self.views is None else self.views[keep]
-        return Modes(self.position_m[keep], self.covariance_m2[keep], self.strength[keep], views)
+        variant = None if self.variant is None else self.variant[keep]
+        return Modes(self.position_m[keep], self.covariance_m2[keep], self.strength[keep], views, variant)
 
     @staticmethod
     def empty() -> "Modes":
