@@ -305,6 +305,29 @@ def _used_modes(modes_by_pair: list[list[Modes]], frames: int) -> list[Modes]:
     return used
 
 
+def _settings_and_scores(
+    modes_by_pair: list[list[Modes]], merged: bool, views: Sequence[int]
+) -> tuple[list[tuple], list[list[list[np.ndarray]]]]:
+    """The settings a map method's threshold is fitted with, as (merging radius, views, pooled variant)
+    (None where the method has no such setting), and its modes' scores under each, per setting, pair and
+    frame (:func:`fitted_variant_selection`): the strengths themselves for a method that is not merged,
+    :func:`merged_scores` for one that is."""
+    if not merged:
+        return [(None, None, None)], [[[m.strength for m in modes] for modes in modes_by_pair]]
+    tags = [m.variant for modes in modes_by_pair for m in modes if m.variant is not None]
+    variants: list[int | None] = [int(v) for v in np.unique(np.concatenate(tags))] if tags else []
+    settings = list(itertools.product(MERGE_RADIUS_CHOICES_M, views, variants or [None]))
+    distances_m = [[cdist(m.position_m, m.position_m) for m in modes] for modes in modes_by_pair]
+    scores = [
+        [
+            [merged_scores(m, radius_m, min_views, d, variant) for m, d in zip(modes, pair_distances, strict=True)]
+            for modes, pair_distances in zip(modes_by_pair, distances_m, strict=True)
+        ]
+        for radius_m, min_views, variant in settings
+    ]
+    return settings, scores
+
+
 def score_recording(
     recording: MultiViewRecording,
     grid: GroundGrid,
@@ -323,36 +346,16 @@ def score_recording(
     rows, kept, tracks = [], {}, {}
     views = tuple(range(1, len(recording.views) + 1))
     for method, modes_by_pair in frames.modes.items():
-        merged = method in MERGED_METHODS
-        pooled = sorted({int(v) for modes in modes_by_pair for m in modes if m.variant is not None for v in m.variant})
-        variants: list[int | None] = [*pooled] if pooled else [None]
-        settings = list(itertools.product(MERGE_RADIUS_CHOICES_M, views, variants)) if merged else [(0.0, 1, None)]
-        distances_m = [[cdist(m.position_m, m.position_m) for m in modes] for modes in modes_by_pair]
+        settings, scores = _settings_and_scores(modes_by_pair, method in MERGED_METHODS, views)
         kept_modes, fitted, recall = fitted_variant_selection(
-            truth_m,
-            [
-                [
-                    [
-                        merged_scores(m, radius_m, min_views, d, variant)
-                        for m, d in zip(modes, pair_distances, strict=True)
-                    ]
-                    for modes, pair_distances in zip(modes_by_pair, distances_m, strict=True)
-                ]
-                for radius_m, min_views, variant in settings
-            ],
-            [[m.position_m for m in modes] for modes in modes_by_pair],
-            STRENGTH_CHOICES,
+            truth_m, scores, [[m.position_m for m in modes] for modes in modes_by_pair], STRENGTH_CHOICES
         )
         strengths = [threshold for _, threshold in fitted]
-        merging = (
-            {
-                "fitted_merge_radius_m": [settings[index][0] for index, _ in fitted],
-                "fitted_min_views": [settings[index][1] for index, _ in fitted],
-                **({"fitted_variant": [settings[index][2] for index, _ in fitted]} if pooled else {}),
-            }
-            if merged
-            else {}
-        )
+        merging = {
+            key: [settings[index][column] for index, _ in fitted]
+            for column, key in enumerate(("fitted_merge_radius_m", "fitted_min_views", "fitted_variant"))
+            if any(setting[column] is not None for setting in settings)
+        }
         used = _used_modes(modes_by_pair, truth_m.shape[0])
         kept[method] = [found.select(keep) for found, keep in zip(used, kept_modes, strict=True)]
         tracks[method] = track_on_ground(kept[method], recall, separation_m, recording.frame_rate_hz, tracker)
