@@ -273,6 +273,12 @@ def test_pets_runs_with_seven_views(tmp_path):
     # POM's person width, radius and views are fitted on each half, from the choices.
     pom = rows[2]
     assert len(pom["fitted_width_m"]) == 2 and set(pom["fitted_width_m"]) <= {0.5, 0.4, 0.3}
+    # View_001 has video and boxes: its mask is fitted too. The six views with boxes alone have their
+    # rectangles scaled to their boxes; View_001's only where its boxes make its mask.
+    assert len(pom["fitted_masks"]) == 2 and set(pom["fitted_masks"]) <= {"silhouettes", "boxes"}
+    for masks, scales in zip(pom["fitted_masks"], pom["fitted_box_scales"], strict=True):
+        assert np.shape(scales) == (7, 2) and not np.allclose(scales[1:], 1.0)
+        assert np.allclose(scales[0], 1.0) == (masks == "silhouettes")
     assert len(pom["fitted_merge_radius_m"]) == 2 and len(pom["fitted_min_views"]) == 2
 
 

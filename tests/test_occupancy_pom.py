@@ -17,11 +17,13 @@ from ptztrack.occupancy.pom import (
     PomDetector,
     box_sums,
     boxes_mask,
+    fitted_box_scales,
     integral_image,
     person_box_px,
     person_boxes,
     pom_modes,
     pom_posterior,
+    scaled_about_feet,
     working_mask,
 )
 from ptztrack.occupancy.room import RoomLayout, RoomRenderer, look_at, room_cameras, room_truth
@@ -316,3 +318,30 @@ def test_boxes_stand_in_for_the_masks_of_views_without_video():
     assert room_detector(layout, truth).view_masks(0) == [None] * 4
     with pytest.raises(ValueError, match="working image"):
         detector.solver.posterior([np.zeros((5, 5))] * 4, PARAMETERS)
+
+
+def test_boxes_scale_about_their_feet():
+    # Centre 20 px, bottom 100 px: 1.5 times as wide (30 px), half as tall (40 px).
+    scaled = scaled_about_feet(np.array([[10.0, 20.0, 30.0, 100.0]]), (1.5, 0.5))
+    np.testing.assert_allclose(scaled, [[5.0, 60.0, 35.0, 100.0]])
+
+
+def test_a_views_box_scales_are_the_median_ratio_of_its_matched_boxes_to_the_models():
+    layout = RoomLayout(image_size_px=(320, 240), focal_px=156.0)
+    truth = room_truth(layout, people=2, frames=12, seed=4)
+    cameras = room_cameras(layout)
+    scale = {0: (1.2, 0.9), 1: (0.8, 1.1), 2: (1.2, 0.9), 3: (1.2, 0.9)}
+    boxes = []
+    for index, camera in enumerate(cameras):
+        per_frame = []
+        for frame in range(12):
+            model = scaled_about_feet(person_box_px(camera, truth.positions_m[frame], 1.75, 0.5), scale[index])
+            found = np.c_[model[:, :2], model[:, 2:] - model[:, :2], np.full(2, 0.9)]
+            # A box far from anybody's feet, and one of too low a score: neither is matched.
+            per_frame.append(np.r_[found, [[5.0, 5.0, 20.0, 60.0, 0.9], [*found[0, :4], 0.1]]])
+        boxes.append(per_frame if index != 3 else per_frame[:4] + [np.zeros((0, 5))] * 8)
+    recording = room_detector(layout, truth, boxes).recording
+    assert np.all(np.isfinite(person_box_px(cameras[0], truth.positions_m[:12].reshape(-1, 2), 1.75, 0.5)))
+    scales = fitted_box_scales(recording, truth.positions_m, range(12), PARAMETERS, views=[1, 2, 3])
+    # View 0 is not asked for; view 3 has 8 matches, fewer than a fit needs.
+    np.testing.assert_allclose(scales, [[1.0, 1.0], [0.8, 1.1], [1.2, 0.9], [1.0, 1.0]], rtol=1e-9)

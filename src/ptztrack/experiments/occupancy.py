@@ -11,6 +11,8 @@ detectors over every frame (:func:`run_recording`); its rows, one per method, ar
 import math
 from collections.abc import Callable, Sequence
 
+import numpy as np
+
 from ptztrack.builders.occupancy import (
     PLAZA_LEAD_IN_FRAMES,
     plaza_recording,
@@ -32,10 +34,10 @@ from ptztrack.occupancy.evaluation import (
     score_recording,
     scored_truth,
 )
-from ptztrack.occupancy.foreground import view_foregrounds
+from ptztrack.occupancy.foreground import ViewForeground, view_foregrounds
 from ptztrack.occupancy.multiview import MultiViewRecording
 from ptztrack.occupancy.parameters import ForegroundParameters, OccupancyParameters, PomParameters
-from ptztrack.occupancy.pom import PomDetector
+from ptztrack.occupancy.pom import PomDetector, fitted_box_scales
 from ptztrack.scene.pets import DatasetError
 from ptztrack.track.parameters import TrackerParameters
 
@@ -47,6 +49,11 @@ PLAZA_PEOPLE = (4, 8)
 # ties) and narrower, down to a body's depth (0.3 m), fitted on the other half with the threshold: a
 # silhouette fills only part of the rectangle of its widest diameter (legs, head, arms).
 POM_WIDTH_CHOICES_M = (0.5, 0.4, 0.3)
+# Where a view has both video and a detector's boxes, its POM mask is its silhouettes (the paper's
+# foreground, first: it wins ties) or its boxes, fitted on the other half with the width; views whose
+# mask is their boxes have their rectangles scaled to the boxes' (:func:`~ptztrack.occupancy.pom.fitted_box_scales`,
+# on the other half too).
+POM_MASK_SOURCES = ("silhouettes", "boxes")
 # The table's columns (a row's key) and their formats.
 OCCUPANCY_COLUMNS = (
     ("method", "{}"),
@@ -86,11 +93,9 @@ def run_recording(
     if "lpom-foreground" in methods and any(view.frames is not None for view in recording.views):
         maps["lpom-foreground"] = [LpomForegroundDetector(recording, parameters, foregrounds, lpom.tables)]
     priors: list[float] = []
+    box_scales: list[list[np.ndarray]] = []
     if "pom" in methods and all(view.image_size_px is not None for view in recording.views):
-        poms = [PomDetector(recording, PomParameters(width_m=width_m), foregrounds) for width_m in POM_WIDTH_CHOICES_M]
-        truth_m = scored_truth(recording)
-        priors = [fitted_prior(truth_m[fitting], poms[0].grid.cells) for _, fitting in halves(recording.frames)]
-        maps["pom"] = [PooledDetectors([pom.with_prior(prior) for pom in poms]) for prior in priors]
+        maps["pom"], priors, box_scales = pom_detectors(recording, foregrounds)
     clustering = ClusteringDetector(recording, settings.linkage_m, settings.min_box_score, settings.blob_min_area_px)
     frames = detect_frames(recording, maps, clustering, progress)
     # People leave a dataset's area (and never the room's, whose tracks stay well localised).
@@ -98,9 +103,38 @@ def run_recording(
     run = score_recording(recording, lpom.grid, frames, tracking, occupancy.separation_m, label)
     for row in run.rows:
         if row["method"] == "pom":
+            variants = row.pop("fitted_variant")
+            widths_count = len(POM_WIDTH_CHOICES_M)
             row["fitted_prior"] = priors
-            row["fitted_width_m"] = [POM_WIDTH_CHOICES_M[index] for index in row.pop("fitted_variant")]
+            row["fitted_width_m"] = [POM_WIDTH_CHOICES_M[index % widths_count] for index in variants]
+            row["fitted_masks"] = [POM_MASK_SOURCES[index // widths_count] for index in variants]
+            row["fitted_box_scales"] = [
+                np.round(scales[index], 3).tolist() for scales, index in zip(box_scales, variants, strict=True)
+            ]
     return run
+
+
+def pom_detectors(
+    recording: MultiViewRecording, foregrounds: dict[int, ViewForeground]
+) -> tuple[list[PooledDetectors], list[float], list[list[np.ndarray]]]:
+    """POM's detectors for each :func:`halves` pair, fitted on the pair's other half: each pools every
+    width of ``POM_WIDTH_CHOICES_M`` under every mask source of ``POM_MASK_SOURCES`` (boxes only where a
+    view has boxes and silhouettes), in that order (sources outer); also each pair's prior and box scales
+    (per pooled detector, (views, 2))."""
+    truth_m = scored_truth(recording)
+    widths = [PomDetector(recording, PomParameters(width_m=width_m), foregrounds) for width_m in POM_WIDTH_CHOICES_M]
+    both = any(view.boxes is not None and index in foregrounds for index, view in enumerate(recording.views))
+    poms = widths + ([pom.with_masks_from_boxes() for pom in widths] if both else [])
+    detectors, priors, box_scales = [], [], []
+    for _, fitting in halves(recording.frames):
+        prior = fitted_prior(truth_m[fitting], poms[0].grid.cells)
+        scales = [fitted_box_scales(recording, truth_m, fitting, pom.parameters, pom.box_mask_views()) for pom in poms]
+        detectors.append(
+            PooledDetectors([pom.with_prior(prior).with_box_scales(s) for pom, s in zip(poms, scales, strict=True)])
+        )
+        priors.append(prior)
+        box_scales.append(scales)
+    return detectors, priors, box_scales
 
 
 def dataset_runs(

@@ -59,6 +59,8 @@ from dataclasses import dataclass, replace
 
 import cv2
 import numpy as np
+from scipy.optimize import linear_sum_assignment
+from scipy.spatial.distance import cdist
 from scipy.special import expit
 
 from ptztrack.geometry.calibration import PinholeCalibration, imaged_radius, project_pinhole
@@ -66,6 +68,7 @@ from ptztrack.occupancy.foreground import ViewForeground
 from ptztrack.occupancy.lpom import GroundGrid, Modes, map_modes
 from ptztrack.occupancy.multiview import CameraView, MultiViewRecording
 from ptztrack.occupancy.parameters import PomParameters
+from ptztrack.scene.pets import box_feet_px
 
 Q_FLOOR = 1e-9
 RIM_POINTS = (
@@ -79,6 +82,12 @@ CORNER_SIGNS = np.array([1.0, -1.0, -1.0, 1.0])
 
 
 BOX_CHUNK_CELLS = 1024
+# A view's box scales (:func:`fitted_box_scales`): a box is a person's when its feet lie within a quarter
+# of the model box's height of the model's (a person's width, so two people side by side are told
+# apart), and a view's scales need some matches to be more than one person's.
+SCALE_GATE_HEIGHTS = 0.25
+MIN_SCALE_MATCHES = 20
+UNMATCHED_PX = 1e9
 
 
 def person_box_px(calibration: PinholeCalibration, ground_m, height_m: float, width_m: float) -> np.ndarray:
@@ -141,23 +150,52 @@ def person_boxes(
     height_m: float,
     width_m: float,
     block_px: int,
+    box_scales=None,
 ) -> PersonBoxes:
     """:class:`PersonBoxes` of the grid's cells in views given as (calibration, image size (width, height) px).
 
-    A rectangle covers the blocks whose centres lie in the person's box (:func:`person_box_px`), clipped
-    to the working image of ``(height // block_px, width // block_px)`` blocks.
+    A rectangle covers the blocks whose centres lie in the person's box (:func:`person_box_px`, scaled
+    by :func:`scaled_about_feet` with the view's row of ``box_scales`` (views, 2), ones where not given),
+    clipped to the working image of ``(height // block_px, width // block_px)`` blocks.
     """
+    boxes_px = cell_boxes_px([calibration for calibration, _ in views], grid, height_m, width_m)
+    return blocked_boxes(boxes_px, [size_px for _, size_px in views], block_px, box_scales)
+
+
+def cell_boxes_px(
+    calibrations: Sequence[PinholeCalibration], grid: GroundGrid, height_m: float, width_m: float
+) -> list[np.ndarray]:
+    """Per view, the :func:`person_box_px` (cells, 4) of a person standing at each of the grid's cell centres."""
     rows, columns = np.mgrid[0 : grid.shape[0], 0 : grid.shape[1]]
     centres_m = grid.centre_of(rows.ravel(), columns.ravel())
+    return [person_box_px(calibration, centres_m, height_m, width_m) for calibration in calibrations]
+
+
+def scaled_about_feet(boxes_px, scale) -> np.ndarray:
+    """Boxes (K, 4) (left, top, right, bottom) px scaled about their feet (the bottom centre) by
+    ``scale`` (width factor, height factor): the bottom centre stays, the width and height are multiplied."""
+    boxes_px = np.asarray(boxes_px, dtype=float)
+    width_scale, height_scale = scale
+    centre_px = 0.5 * (boxes_px[:, 0] + boxes_px[:, 2])
+    half_width_px = 0.5 * width_scale * (boxes_px[:, 2] - boxes_px[:, 0])
+    bottom_px = boxes_px[:, 3]
+    top_px = bottom_px - height_scale * (bottom_px - boxes_px[:, 1])
+    return np.stack([centre_px - half_width_px, top_px, centre_px + half_width_px, bottom_px], axis=-1)
+
+
+def blocked_boxes(boxes_px: Sequence[np.ndarray], sizes_px, block_px: int, box_scales=None) -> PersonBoxes:
+    """:class:`PersonBoxes` from each view's person boxes (cells, 4) px (:func:`person_box_px`, NaN where
+    the cell has none) and image size (width, height) px, each view's boxes scaled about their feet by
+    its row of ``box_scales`` (views, 2) (width factor, height factor; ones where not given)."""
+    scales = np.ones((len(boxes_px), 2)) if box_scales is None else np.asarray(box_scales, dtype=float)
     boxes, visible, shapes = [], [], []
-    for calibration, (width_px, height_px) in views:
+    for box_px, (width_px, height_px), scale in zip(boxes_px, sizes_px, scales, strict=True):
         shape = (height_px // block_px, width_px // block_px)
-        box_px = person_box_px(calibration, centres_m, height_m, width_m)
         seen = ~np.isnan(box_px[:, 0])
         # Clipped to just outside the image before the blocks' integers: a strong distortion sends far
         # points beyond int64's range.
         limit_px = np.array([width_px, height_px, width_px, height_px]) + block_px
-        box_px = np.clip(np.where(seen[:, None], box_px, 0.0), -block_px, limit_px)
+        box_px = np.clip(np.where(seen[:, None], scaled_about_feet(box_px, scale), 0.0), -block_px, limit_px)
         left, right = covered_span(box_px[:, 0] / block_px, box_px[:, 2] / block_px)
         top, bottom = covered_span(box_px[:, 1] / block_px, box_px[:, 3] / block_px)
         box = np.stack(
@@ -364,6 +402,52 @@ def pom_modes(
     return Modes(modes.position_m, modes.covariance_m2, modes.strength * peak, views)
 
 
+def fitted_box_scales(recording: MultiViewRecording, truth_m, frames, parameters: PomParameters, views) -> np.ndarray:
+    """How much wider and taller than a person's rectangle each view's detector draws its boxes: (views, 2)
+    (width factor, height factor), ones for the views not in ``views`` or with fewer than
+    ``MIN_SCALE_MATCHES`` matches.
+
+    For each annotated person of ``frames`` (truth_m (T, N, 2) m, NaN where absent) seen by a view in
+    ``views``, the model's box (:func:`person_box_px`, ``height_m`` by ``width_m``) is matched one to one
+    (Hungarian, per frame) to the view's boxes of at least ``min_box_score`` by the distance between
+    their feet (bottom centres), within ``SCALE_GATE_HEIGHTS`` of the model box's height; a factor is the
+    median over the matches of the box's width (height) over the model box's. It takes up what the
+    calibration and the detector make of a person that the cylinder does not: a focal length or a
+    distance a few per cent off, a detector's box around the arms.
+    """
+    truth_m = np.asarray(truth_m, dtype=float)
+    scales = np.ones((len(recording.views), 2))
+    for index in views:
+        view = recording.views[index]
+        assert view.boxes is not None
+        ratios = []
+        for frame in frames:
+            people_m = truth_m[frame][~np.isnan(truth_m[frame][:, 0])]
+            found = view.boxes[frame][view.boxes[frame][:, 4] >= parameters.min_box_score]
+            model = person_box_px(view.calibration, people_m, parameters.height_m, parameters.width_m)
+            model = model[~np.isnan(model[:, 0])]
+            if len(model) == 0 or len(found) == 0:
+                continue
+            model_feet = np.stack([0.5 * (model[:, 0] + model[:, 2]), model[:, 3]], axis=-1)
+            found_feet = box_feet_px(found)
+            model_height = model[:, 3] - model[:, 1]
+            distance_px = cdist(model_feet, found_feet)
+            allowed = distance_px <= SCALE_GATE_HEIGHTS * model_height[:, None]
+            rows, columns = linear_sum_assignment(np.where(allowed, distance_px, UNMATCHED_PX))
+            keep = allowed[rows, columns]
+            rows, columns = rows[keep], columns[keep]
+            ratios.append(
+                np.stack(
+                    [found[columns, 2] / (model[rows, 2] - model[rows, 0]), found[columns, 3] / model_height[rows]],
+                    axis=-1,
+                )
+            )
+        matched = np.concatenate(ratios) if ratios else np.zeros((0, 2))
+        if len(matched) >= MIN_SCALE_MATCHES:
+            scales[index] = np.median(matched, axis=0)
+    return scales
+
+
 class PomDetector:
     """The POM and its candidates for frames of ``recording`` (``detect(frame, masks)``).
 
@@ -386,16 +470,18 @@ class PomDetector:
         for view in recording.views:
             if view.image_size_px is None:
                 raise ValueError(f"{view.name}: POM needs the view's image size (its rectangles and masks)")
-        self.boxes = person_boxes(
-            [(view.calibration, _size(view)) for view in recording.views],
-            self.grid,
-            parameters.height_m,
-            parameters.width_m,
-            parameters.block_px,
+        self.boxes_px = cell_boxes_px(
+            [view.calibration for view in recording.views], self.grid, parameters.height_m, parameters.width_m
+        )
+        self._use_boxes(None)
+        self.last: PomResult | None = None
+
+    def _use_boxes(self, box_scales) -> None:
+        self.boxes = blocked_boxes(
+            self.boxes_px, [_size(view) for view in self.recording.views], self.parameters.block_px, box_scales
         )
         self.solver = PomSolver(self.boxes)
         self.view_counts = self.boxes.visible.sum(axis=0)  # (cells,) the views that see each cell
-        self.last: PomResult | None = None
 
     def with_prior(self, prior: float) -> "PomDetector":
         """This detector with another prior ``epsilon``, sharing its rectangles, solver and background models."""
@@ -403,6 +489,32 @@ class PomDetector:
         other.parameters = replace(self.parameters, prior=prior)
         other.last = None
         return other
+
+    def with_box_scales(self, box_scales) -> "PomDetector":
+        """This detector with each view's rectangles scaled about their feet by its row of ``box_scales``
+        (views, 2) (width factor, height factor; :func:`fitted_box_scales`): new rectangles and solver."""
+        other = copy.copy(self)
+        other._use_boxes(box_scales)
+        other.last = None
+        return other
+
+    def with_masks_from_boxes(self) -> "PomDetector":
+        """This detector with every view that has a detector's boxes taking its mask from them, its
+        silhouettes unused."""
+        other = copy.copy(self)
+        other.foreground = {
+            index: model for index, model in self.foreground.items() if self.recording.views[index].boxes is None
+        }
+        other.last = None
+        return other
+
+    def box_mask_views(self) -> list[int]:
+        """The views whose mask is the union of their detector's boxes (they have boxes and no silhouettes)."""
+        return [
+            index
+            for index, view in enumerate(self.recording.views)
+            if view.boxes is not None and index not in self.foreground
+        ]
 
     def view_masks(self, frame: int, masks: Sequence[np.ndarray | None] | None = None) -> list[np.ndarray | None]:
         """Per view, its working mask at ``frame``: from ``masks`` (full-resolution, per view, None where
