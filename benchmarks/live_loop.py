@@ -14,24 +14,34 @@ rendered (by its thumbnail), which gives what the live run paid: the
 stream's true delay, the pose error at capture (the pose the tracker used
 against the pose rendered, still and moving), the recording step it took
 the picture for against the one shown, and the detections per picture
-against the offline run's.
+against the offline run's. The gap is then taken apart by replays through a
+fresh tracker, each changing one thing: the live run's pictures rendered
+exactly (the recording's view at the step and pose each showed, at its
+render time: no stream, no pose error), then one such picture per
+recording step (the offline run's rate, at the live camera's poses). What
+is left between the last and the offline run is where the camera looked.
+The offline run is also repeated over ``--offline-seeds`` seeds (its policy
+samples), for the spread of the figure the live run is held against.
 
-    python benchmarks/live_loop.py [--steps 700] [--time-scale 1] [--policy smpl] [--transport tcp] [--json PATH]
+    python benchmarks/live_loop.py [--steps 700] [--time-scale 1] [--policy smpl] [--transport tcp]
+                                   [--offline-seeds 5] [--json PATH]
 """
 
 import argparse
 import multiprocessing
 import time
+from functools import partial
 from pathlib import Path
 
 import cv2
 import numpy as np
 
-from ptztrack.builders.episode import episode_world, run_episode
+from ptztrack.builders.episode import episode_world, make_tracker, run_episode
 from ptztrack.builders.live import (
     RecordingFeed,
     camera_spaces,
     live_as_episode,
+    live_world,
     offline_counterpart,
     run_live_episode,
     shown_steps,
@@ -43,8 +53,9 @@ from ptztrack.camera.onvif_client import CameraAddress, ONVIFClient
 from ptztrack.camera.onvif_spaces import MoveTimes
 from ptztrack.camera.stream import FrameStream, rtsp_pictures, thumbnail
 from ptztrack.config import pets_scenario
-from ptztrack.evaluate.metrics import episode_metrics
+from ptztrack.evaluate.metrics import clear_metrics, episode_metrics
 from ptztrack.files import write_json
+from ptztrack.loop import track
 
 # A picture is matched among the renders of the second before its estimated capture time and after it.
 MATCH_WINDOW_S = (1.0, 0.5)
@@ -68,6 +79,23 @@ def identify(live, log: np.ndarray, thumbnails: np.ndarray) -> tuple[np.ndarray,
         if np.all(log[alike, 1:] == log[alike[0], 1:]):  # the same step at the same pose: any of them
             rows[index], only[index] = alike[0], len(alike) == 1
     return rows, only
+
+
+def replay(scenario, calibration, steps, poses, times_s) -> dict:
+    """The CLEAR figures of a fresh tracker (the live run's) fed pictures rendered exactly: for each
+    picture (T,), the recording's view at ``steps`` (T,) and ``poses`` (T, 3), detected as the live run
+    detects, predicted to ``times_s`` (T,) (wall seconds at time scale 1), scored against ``steps``."""
+    world = live_world(scenario, calibration, 0)
+    view = episode_world(scenario, 0).backend
+    tracker = make_tracker(None, scenario, world)
+    rng = np.random.default_rng(0)
+    reported = []
+    for index, (step, pose) in enumerate(zip(steps, poses, strict=True)):
+        tracker.predict(None if index == 0 else max(float(times_s[index] - times_s[index - 1]), 0.0))
+        detections = world.detector.detect(view, int(step), pose, rng)
+        track(tracker, detections, pose, partial(view.image, int(step), pose))
+        reported.append(tracker.reported())
+    return clear_metrics(world.truth.positions_m[steps], [t.ids for t in reported], [t.mean[:, :2] for t in reported])
 
 
 def serve(time_scale: float, ready, stop, results) -> None:
@@ -104,6 +132,7 @@ def main() -> None:
     parser.add_argument("--time-scale", type=float, default=1.0)
     parser.add_argument("--policy", default="smpl")
     parser.add_argument("--transport", choices=("tcp", "udp"), default="tcp")
+    parser.add_argument("--offline-seeds", type=int, default=5, help="seeds of the offline run (0 is the one compared)")
     parser.add_argument("--json", type=Path)
     args = parser.parse_args()
     scenario = pets_scenario("hog")
@@ -133,6 +162,9 @@ def main() -> None:
     offline = offline_counterpart(scenario, world, live, truth_log)
     offline_episode = run_episode(offline, args.policy, 0)
     offline_metrics = episode_metrics(offline_episode)
+    offline_seeds = [offline_metrics["mota"]] + [
+        episode_metrics(run_episode(offline, args.policy, seed))["mota"] for seed in range(1, args.offline_seeds)
+    ]
 
     rendered, timed = identify(live, truth_log, thumbnails)
     found = rendered >= 0
@@ -148,6 +180,14 @@ def main() -> None:
         "waiting for the tracker, tracking": float(np.median((live.tracked_s - live.detected_s)[decided])),
         "decision and command": float(np.median((live.decided_s - live.tracked_s)[decided])),
     }
+    # Each picture as rendered (unidentified ones: the step shown at its capture, the pose estimated).
+    steps = np.where(found, truth_log[np.maximum(rendered, 0), 1], shown_steps(truth_log, live.capture_time_s))
+    steps = np.clip(steps, 0, world.truth.positions_m.shape[0] - 1).astype(int)
+    poses = np.where(found[:, None], truth_log[np.maximum(rendered, 0), 2:], live.poses)
+    times_s = np.where(found, truth_log[np.maximum(rendered, 0), 0], live.capture_time_s)
+    rendered_exactly = replay(scenario, calibration, steps, poses, times_s)
+    last_of_step = np.r_[steps[1:] != steps[:-1], True]
+    per_step = replay(scenario, calibration, steps[last_of_step], poses[last_of_step], times_s[last_of_step])
     with_tracks = [seconds for seconds, tracks in decisions if tracks > 0]
     rates = live.rates()
     row = {
@@ -166,6 +206,10 @@ def main() -> None:
         "median_decision_s": rates["median_decision_s"],
         "mota_live": live_metrics["mota"],
         "mota_offline": offline_metrics["mota"],
+        "mota_replay_rendered": rendered_exactly["mota"],
+        "mota_replay_per_step": per_step["mota"],
+        "mota_offline_seeds_mean": float(np.mean(offline_seeds)),
+        "mota_offline_seeds_sd": float(np.std(offline_seeds, ddof=1)) if len(offline_seeds) > 1 else 0.0,
         "motp_live_m": live_metrics["motp_m"],
         "motp_offline_m": offline_metrics["motp_m"],
         "idf1_live": live_metrics["idf1"],
@@ -186,6 +230,8 @@ def main() -> None:
         "detections_per_step_offline": float(np.mean([len(d) for d in offline_episode.detections])),
         "zoom_live": float(np.mean(live.poses[:, 2])),
         "zoom_offline": float(np.mean(offline_episode.poses[:, 2])),
+        "pose_changes_live": float(np.mean(np.any(np.diff(live.commanded, axis=0) != 0, axis=1))),
+        "pose_changes_offline": float(np.mean(np.any(np.diff(offline_episode.commanded, axis=0) != 0, axis=1))),
     }
     width = max(map(len, row))
     for key, value in row.items():
@@ -194,7 +240,7 @@ def main() -> None:
     for stage, seconds in stages_s.items():
         print(f"  {stage:<36} {1e3 * seconds:7.1f}")
     if args.json is not None:
-        write_json(args.json, {**row, "stages_s": stages_s})
+        write_json(args.json, {**row, "mota_offline_per_seed": offline_seeds, "stages_s": stages_s})
 
 
 if __name__ == "__main__":
