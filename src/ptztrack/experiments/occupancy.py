@@ -52,7 +52,7 @@ POM_WIDTH_CHOICES_M = (0.5, 0.4, 0.3)
 # Where a view has both video and a detector's boxes, its POM mask is its silhouettes (the paper's
 # foreground, first: it wins ties) or its boxes, fitted on the other half with the width; views whose
 # mask is their boxes have their rectangles scaled to the boxes' (:func:`~ptztrack.occupancy.pom.fitted_box_scales`,
-# on the other half too).
+# on the other half too), so the width matters only to views masked by their silhouettes.
 POM_MASK_SOURCES = ("silhouettes", "boxes")
 # The table's columns (a row's key) and their formats.
 OCCUPANCY_COLUMNS = (
@@ -92,10 +92,11 @@ def run_recording(
     foregrounds = view_foregrounds(recording, ForegroundParameters())
     if "lpom-foreground" in methods and any(view.frames is not None for view in recording.views):
         maps["lpom-foreground"] = [LpomForegroundDetector(recording, parameters, foregrounds, lpom.tables)]
+    pom_settings: list[tuple[float, str]] = []
     priors: list[float] = []
     box_scales: list[list[np.ndarray]] = []
     if "pom" in methods and all(view.image_size_px is not None for view in recording.views):
-        maps["pom"], priors, box_scales = pom_detectors(recording, foregrounds)
+        maps["pom"], pom_settings, priors, box_scales = pom_detectors(recording, foregrounds)
     clustering = ClusteringDetector(recording, settings.linkage_m, settings.min_box_score, settings.blob_min_area_px)
     frames = detect_frames(recording, maps, clustering, progress)
     # People leave a dataset's area (and never the room's, whose tracks stay well localised).
@@ -104,10 +105,9 @@ def run_recording(
     for row in run.rows:
         if row["method"] == "pom":
             variants = row.pop("fitted_variant")
-            widths_count = len(POM_WIDTH_CHOICES_M)
             row["fitted_prior"] = priors
-            row["fitted_width_m"] = [POM_WIDTH_CHOICES_M[index % widths_count] for index in variants]
-            row["fitted_masks"] = [POM_MASK_SOURCES[index // widths_count] for index in variants]
+            row["fitted_width_m"] = [pom_settings[index][0] for index in variants]
+            row["fitted_masks"] = [pom_settings[index][1] for index in variants]
             row["fitted_box_scales"] = [
                 np.round(scales[index], 3).tolist() for scales, index in zip(box_scales, variants, strict=True)
             ]
@@ -116,25 +116,32 @@ def run_recording(
 
 def pom_detectors(
     recording: MultiViewRecording, foregrounds: dict[int, ViewForeground]
-) -> tuple[list[PooledDetectors], list[float], list[list[np.ndarray]]]:
-    """POM's detectors for each :func:`halves` pair, fitted on the pair's other half: each pools every
-    width of ``POM_WIDTH_CHOICES_M`` under every mask source of ``POM_MASK_SOURCES`` (boxes only where a
-    view has boxes and silhouettes), in that order (sources outer); also each pair's prior and box scales
-    (per pooled detector, (views, 2))."""
+) -> tuple[list[PooledDetectors], list[tuple[float, str]], list[float], list[list[np.ndarray]]]:
+    """POM's detectors for each :func:`halves` pair, fitted on the pair's other half, and the (width,
+    mask source) of each setting they pool: every width of ``POM_WIDTH_CHOICES_M`` with the silhouettes
+    where a view has them, then, where a view has both silhouettes and boxes, the same with every box view
+    masked by its boxes (the a-priori width alone where that leaves no view to silhouettes: a box view's
+    rectangles are scaled to its boxes, whatever the width). Also each pair's prior and box scales (per
+    setting, (views, 2))."""
     truth_m = scored_truth(recording)
     widths = [PomDetector(recording, PomParameters(width_m=width_m), foregrounds) for width_m in POM_WIDTH_CHOICES_M]
-    both = any(view.boxes is not None and index in foregrounds for index, view in enumerate(recording.views))
-    poms = widths + ([pom.with_masks_from_boxes() for pom in widths] if both else [])
+    poms = [(pom, POM_MASK_SOURCES[0]) for pom in widths]
+    if any(view.boxes is not None and index in foregrounds for index, view in enumerate(recording.views)):
+        from_boxes = [pom.with_masks_from_boxes() for pom in widths]
+        every_view_boxed = len(from_boxes[0].box_mask_views()) == len(recording.views)
+        poms += [(pom, POM_MASK_SOURCES[1]) for pom in (from_boxes[:1] if every_view_boxed else from_boxes)]
+    settings = [(pom.parameters.width_m, source) for pom, source in poms]
     detectors, priors, box_scales = [], [], []
     for _, fitting in halves(recording.frames):
-        prior = fitted_prior(truth_m[fitting], poms[0].grid.cells)
-        scales = [fitted_box_scales(recording, truth_m, fitting, pom.parameters, pom.box_mask_views()) for pom in poms]
-        detectors.append(
-            PooledDetectors([pom.with_prior(prior).with_box_scales(s) for pom, s in zip(poms, scales, strict=True)])
-        )
+        prior = fitted_prior(truth_m[fitting], widths[0].grid.cells)
+        scales = [
+            fitted_box_scales(recording, truth_m, fitting, pom.parameters, pom.box_mask_views()) for pom, _ in poms
+        ]
+        pooled = [pom.with_prior(prior).with_box_scales(scale) for (pom, _), scale in zip(poms, scales, strict=True)]
+        detectors.append(PooledDetectors(pooled))
         priors.append(prior)
         box_scales.append(scales)
-    return detectors, priors, box_scales
+    return detectors, settings, priors, box_scales
 
 
 def dataset_runs(
