@@ -50,7 +50,10 @@ iterations. Every ``q`` starts at the prior. ``q`` is kept within
 Masks are averaged over blocks of pixels (a fraction of foreground per
 block, which the distance above takes as it is) and the rectangles are
 snapped to the blocks: the working resolution. A view without video gets
-the union of its detector's boxes as its mask (:func:`boxes_mask`).
+the union of its detector's boxes as its mask (:func:`boxes_mask`), and its
+rectangles may be scaled about their feet to the size its detector draws a
+person (:func:`fitted_box_scales`): the mask is then the union of what the
+model says it is made of.
 """
 
 import copy
