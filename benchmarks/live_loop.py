@@ -86,7 +86,7 @@ def replay(scenario, calibration, steps, poses, times_s) -> dict:
     picture (T,), the recording's view at ``steps`` (T,) and ``poses`` (T, 3), detected as the live run
     detects, predicted to ``times_s`` (T,) (wall seconds at time scale 1), scored against ``steps``."""
     world = live_world(scenario, calibration, 0)
-    view = episode_world(scenario, 0).backend
+    view = world.backend
     tracker = make_tracker(None, scenario, world)
     rng = np.random.default_rng(0)
     reported = []
