@@ -280,6 +280,10 @@ def test_pets_runs_with_seven_views(tmp_path):
         assert np.shape(scales) == (7, 2) and not np.allclose(scales[1:], 1.0)
         assert np.allclose(scales[0], 1.0) == (masks == "silhouettes")
     assert len(pom["fitted_merge_radius_m"]) == 2 and len(pom["fitted_min_views"]) == 2
+    # Every view has boxes: the candidates are localized by their feet, each view's spread fitted per half.
+    assert np.shape(pom["fitted_feet_sd_m"]) == (2, 7)
+    assert all(sd is None or 0 < sd < 1.0 for half in pom["fitted_feet_sd_m"] for sd in half)
+    assert any(sd is not None for half in pom["fitted_feet_sd_m"] for sd in half)
 
 
 def test_the_example_dataset_file_is_the_built_in_pets_dataset():

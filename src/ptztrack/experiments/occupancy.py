@@ -34,6 +34,7 @@ from ptztrack.occupancy.evaluation import (
     score_recording,
     scored_truth,
 )
+from ptztrack.occupancy.feet import fitted_feet_variances
 from ptztrack.occupancy.foreground import ViewForeground, view_foregrounds
 from ptztrack.occupancy.multiview import MultiViewRecording
 from ptztrack.occupancy.parameters import ForegroundParameters, OccupancyParameters, PomParameters
@@ -95,8 +96,9 @@ def run_recording(
     pom_settings: list[tuple[float, str]] = []
     priors: list[float] = []
     box_scales: list[list[np.ndarray]] = []
+    feet_variances: list[np.ndarray] = []
     if "pom" in methods and all(view.image_size_px is not None for view in recording.views):
-        maps["pom"], pom_settings, priors, box_scales = pom_detectors(recording, foregrounds)
+        maps["pom"], pom_settings, priors, box_scales, feet_variances = pom_detectors(recording, foregrounds)
     clustering = ClusteringDetector(recording, settings.linkage_m, settings.min_box_score, settings.blob_min_area_px)
     frames = detect_frames(recording, maps, clustering, progress)
     # People leave a dataset's area (and never the room's, whose tracks stay well localised).
@@ -111,18 +113,25 @@ def run_recording(
             row["fitted_box_scales"] = [
                 np.round(scales[index], 3).tolist() for scales, index in zip(box_scales, variants, strict=True)
             ]
+            if feet_variances:
+                row["fitted_feet_sd_m"] = [
+                    [round(float(np.sqrt(variance)), 3) if np.isfinite(variance) else None for variance in variances]
+                    for variances in feet_variances
+                ]
     return run
 
 
 def pom_detectors(
     recording: MultiViewRecording, foregrounds: dict[int, ViewForeground]
-) -> tuple[list[PooledDetectors], list[tuple[float, str]], list[float], list[list[np.ndarray]]]:
+) -> tuple[list[PooledDetectors], list[tuple[float, str]], list[float], list[list[np.ndarray]], list[np.ndarray]]:
     """POM's detectors for each :func:`halves` pair, fitted on the pair's other half, and the (width,
     mask source) of each setting they pool: every width of ``POM_WIDTH_CHOICES_M`` with the silhouettes
     where a view has them, then, where a view has both silhouettes and boxes, the same with every box view
     masked by its boxes (the a-priori width alone where that leaves no view to silhouettes: a box view's
     rectangles are scaled to its boxes, whatever the width). Also each pair's prior and box scales (per
-    setting, (views, 2))."""
+    setting, (views, 2)) and, where a view has boxes, each pair's feet variances (views,) m^2, with which
+    the candidates are localized by the views' box feet (:func:`~ptztrack.occupancy.feet.fitted_feet_variances`,
+    on the other half too)."""
     truth_m = scored_truth(recording)
     widths = [PomDetector(recording, PomParameters(width_m=width_m), foregrounds) for width_m in POM_WIDTH_CHOICES_M]
     poms = [(pom, POM_MASK_SOURCES[0]) for pom in widths]
@@ -131,17 +140,25 @@ def pom_detectors(
         every_view_boxed = len(from_boxes[0].box_mask_views()) == len(recording.views)
         poms += [(pom, POM_MASK_SOURCES[1]) for pom in (from_boxes[:1] if every_view_boxed else from_boxes)]
     settings = [(pom.parameters.width_m, source) for pom, source in poms]
-    detectors, priors, box_scales = [], [], []
+    boxed = any(view.boxes is not None for view in recording.views)
+    parameters = widths[0].parameters
+    detectors, priors, box_scales, feet_variances = [], [], [], []
     for _, fitting in halves(recording.frames):
         prior = fitted_prior(truth_m[fitting], widths[0].grid.cells)
         scales = [
             fitted_box_scales(recording, truth_m, fitting, pom.parameters, pom.box_mask_views()) for pom, _ in poms
         ]
         pooled = [pom.with_prior(prior).with_box_scales(scale) for (pom, _), scale in zip(poms, scales, strict=True)]
+        if boxed:
+            variances = fitted_feet_variances(
+                recording, truth_m, fitting, parameters.feet_gate_m, parameters.min_box_score
+            )
+            pooled = [pom.with_feet_variances(variances) for pom in pooled]
+            feet_variances.append(variances)
         detectors.append(PooledDetectors(pooled))
         priors.append(prior)
         box_scales.append(scales)
-    return detectors, settings, priors, box_scales
+    return detectors, settings, priors, box_scales, feet_variances
 
 
 def dataset_runs(

@@ -17,6 +17,7 @@ import numpy as np
 from scipy.cluster.hierarchy import fcluster, linkage
 
 from ptztrack.geometry.calibration import PinholeCalibration, pixel_rays
+from ptztrack.occupancy.multiview import CameraView
 from ptztrack.scene.pets import box_feet_px
 
 # Blob boxes from MOG2: morphological opening removes speckle, closing joins a body's parts.
@@ -33,6 +34,15 @@ def feet_on_ground(calibration: PinholeCalibration, boxes_px) -> np.ndarray:
     t_m = -centre_m[2] / direction[:, 2]
     ground_m = centre_m[:2] + t_m[:, None] * direction[:, :2]
     return np.where((t_m > 0)[:, None], ground_m, np.nan)
+
+
+def view_feet_on_ground(view: CameraView, frame: int, min_box_score: float) -> np.ndarray:
+    """The feet (K, 2) m on the ground (:func:`feet_on_ground`) of the view's boxes at ``frame`` with a
+    score of at least ``min_box_score``, those whose ray reaches the ground."""
+    assert view.boxes is not None
+    boxes = view.boxes[frame]
+    feet_m = feet_on_ground(view.calibration, boxes[boxes[:, 4] >= min_box_score])
+    return feet_m[~np.isnan(feet_m[:, 0])]
 
 
 @dataclass(frozen=True)

@@ -70,6 +70,9 @@ class PomParameters:
     OccupancyParameters'; candidate_probability 0.02, below the smallest threshold the experiment's
     fit tries, 0.05, as LPOM's candidates. min_probability: the detections' q, 0.5 (more likely there
     than not), where no threshold is fitted.
+    Feet: a candidate localized by the views' box feet (:mod:`ptztrack.occupancy.feet`) takes each
+    view's feet nearest to it within feet_gate_m, 1.0 m, OccupancyParameters.linkage_m (the farthest
+    apart the baseline lets one person's feet lie in two views).
     """
 
     prior: float = 0.01
@@ -86,6 +89,7 @@ class PomParameters:
     window_m: float = 0.25
     candidate_probability: float = 0.02
     min_probability: float = 0.5
+    feet_gate_m: float = 1.0
 
 
 @dataclass(frozen=True)

@@ -53,7 +53,10 @@ snapped to the blocks: the working resolution. A view without video gets
 the union of its detector's boxes as its mask (:func:`boxes_mask`), and its
 rectangles may be scaled about their feet to the size its detector draws a
 person (:func:`fitted_box_scales`): the mask is then the union of what the
-model says it is made of.
+model says it is made of. Where views have boxes, the candidates may be
+localized by the boxes' feet near them (:mod:`ptztrack.occupancy.feet`): the
+cells place a person where the views' masks agree best, the feet where each
+view's detector put them.
 """
 
 import copy
@@ -67,6 +70,7 @@ from scipy.spatial.distance import cdist
 from scipy.special import expit
 
 from ptztrack.geometry.calibration import PinholeCalibration, imaged_radius, project_pinhole
+from ptztrack.occupancy.feet import localized_by_feet, recording_feet_m
 from ptztrack.occupancy.foreground import ViewForeground
 from ptztrack.occupancy.lpom import GroundGrid, Modes, map_modes
 from ptztrack.occupancy.multiview import CameraView, MultiViewRecording
@@ -477,6 +481,7 @@ class PomDetector:
             [view.calibration for view in recording.views], self.grid, parameters.height_m, parameters.width_m
         )
         self._use_boxes(None)
+        self.feet_variances_m2: np.ndarray | None = None
         self.last: PomResult | None = None
 
     def _use_boxes(self, box_scales) -> None:
@@ -498,6 +503,15 @@ class PomDetector:
         (views, 2) (width factor, height factor; :func:`fitted_box_scales`): new rectangles and solver."""
         other = copy.copy(self)
         other._use_boxes(box_scales)
+        other.last = None
+        return other
+
+    def with_feet_variances(self, variances_m2) -> "PomDetector":
+        """This detector with its candidates localized by the views' box feet near them
+        (:func:`~ptztrack.occupancy.feet.localized_by_feet`, within ``feet_gate_m``), each view's feet of
+        variance ``variances_m2`` (views,) m^2 per axis (:func:`~ptztrack.occupancy.feet.fitted_feet_variances`)."""
+        other = copy.copy(self)
+        other.feet_variances_m2 = np.asarray(variances_m2, dtype=float)
         other.last = None
         return other
 
@@ -538,7 +552,8 @@ class PomDetector:
         full-resolution foreground mask (height, width) or None (its boxes, if any, stand in).
 
         The detections are the candidates of at least ``min_probability`` (or of a threshold fitted
-        on other frames); ``last`` keeps the frame's :class:`PomResult` (iterations, convergence).
+        on other frames), localized by the views' box feet where the detector has their variances
+        (:meth:`with_feet_variances`); ``last`` keeps the frame's :class:`PomResult` (iterations, convergence).
         """
         parameters = self.parameters
         self.last = self.solver.posterior(self.view_masks(frame, masks), parameters)
@@ -551,6 +566,9 @@ class PomDetector:
             parameters.candidate_probability,
             self.view_counts,
         )
+        if self.feet_variances_m2 is not None:
+            feet_m = recording_feet_m(self.recording, frame, parameters.min_box_score)
+            modes = localized_by_feet(modes, feet_m, self.feet_variances_m2, parameters.feet_gate_m)
         return q_map, modes
 
 
