@@ -11,6 +11,7 @@ the "detector and clustering" baseline of the multi-view literature.
 * :mod:`~ptztrack.occupancy.lpom`: the ground grid, the locus tables, the map and its modes;
 * :mod:`~ptztrack.occupancy.pom`: the probabilistic occupancy map of Fleuret et al. (TPAMI 2008) from
   foreground masks, by mean field;
+* :mod:`~ptztrack.occupancy.feet`: a candidate's position from the views' box feet near it;
 * :mod:`~ptztrack.occupancy.motion_edges`: a view's evidence (motion edges, box outlines);
 * :mod:`~ptztrack.occupancy.foreground`: a view's evidence from a background model (silhouettes, their edges);
 * :mod:`~ptztrack.occupancy.clustering`: the baseline (box feet on the ground, clustered, blob boxes);
