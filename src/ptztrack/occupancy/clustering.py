@@ -36,13 +36,18 @@ def feet_on_ground(calibration: PinholeCalibration, boxes_px) -> np.ndarray:
     return np.where((t_m > 0)[:, None], ground_m, np.nan)
 
 
+def grounded_feet(calibration: PinholeCalibration, boxes_px) -> np.ndarray:
+    """:func:`feet_on_ground` of the boxes whose ray reaches the ground, the others left out: (K', 2) m."""
+    feet_m = feet_on_ground(calibration, boxes_px)
+    return feet_m[~np.isnan(feet_m[:, 0])]
+
+
 def view_feet_on_ground(view: CameraView, frame: int, min_box_score: float) -> np.ndarray:
-    """The feet (K, 2) m on the ground (:func:`feet_on_ground`) of the view's boxes at ``frame`` with a
-    score of at least ``min_box_score``, those whose ray reaches the ground."""
+    """The :func:`grounded_feet` (K, 2) m of the view's boxes at ``frame`` with a score of at least
+    ``min_box_score``."""
     assert view.boxes is not None
     boxes = view.boxes[frame]
-    feet_m = feet_on_ground(view.calibration, boxes[boxes[:, 4] >= min_box_score])
-    return feet_m[~np.isnan(feet_m[:, 0])]
+    return grounded_feet(view.calibration, boxes[boxes[:, 4] >= min_box_score])
 
 
 @dataclass(frozen=True)

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ptztrack.occupancy.clustering import BlobBoxes, Clusters, cluster_feet, feet_on_ground, view_feet_on_ground
+from ptztrack.occupancy.clustering import BlobBoxes, Clusters, cluster_feet, grounded_feet, view_feet_on_ground
 from ptztrack.occupancy.foreground import ViewForeground
 from ptztrack.occupancy.locus import PERSON, ConeModel
 from ptztrack.occupancy.lpom import (
@@ -207,8 +207,7 @@ class ClusteringDetector:
                 feet_m = view_feet_on_ground(view, frame, self.min_box_score)
             else:
                 assert view.frames is not None
-                feet_m = feet_on_ground(view.calibration, self.blobs[index].boxes(view.frames(frame)))
-                feet_m = feet_m[~np.isnan(feet_m[:, 0])]
+                feet_m = grounded_feet(view.calibration, self.blobs[index].boxes(view.frames(frame)))
             ground.append(feet_m)
             views.append(np.full(len(feet_m), index))
         return cluster_feet(np.concatenate(ground), np.concatenate(views), self.linkage_m)
