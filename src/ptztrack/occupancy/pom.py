@@ -491,39 +491,38 @@ class PomDetector:
         self.solver = PomSolver(self.boxes)
         self.view_counts = self.boxes.visible.sum(axis=0)  # (cells,) the views that see each cell
 
-    def with_prior(self, prior: float) -> "PomDetector":
-        """This detector with another prior ``epsilon``, sharing its rectangles, solver and background models."""
+    def _copy(self, **attributes) -> "PomDetector":
+        """A shallow copy with ``attributes`` replaced and no last result."""
         other = copy.copy(self)
-        other.parameters = replace(self.parameters, prior=prior)
+        for name, value in attributes.items():
+            setattr(other, name, value)
         other.last = None
         return other
+
+    def with_prior(self, prior: float) -> "PomDetector":
+        """This detector with another prior ``epsilon``, sharing its rectangles, solver and background models."""
+        return self._copy(parameters=replace(self.parameters, prior=prior))
 
     def with_box_scales(self, box_scales) -> "PomDetector":
         """This detector with each view's rectangles scaled about their feet by its row of ``box_scales``
         (views, 2) (width factor, height factor; :func:`fitted_box_scales`): new rectangles and solver."""
-        other = copy.copy(self)
+        other = self._copy()
         other._use_boxes(box_scales)
-        other.last = None
         return other
 
     def with_feet_variances(self, variances_m2) -> "PomDetector":
         """This detector with its candidates localized by the views' box feet near them
         (:func:`~ptztrack.occupancy.feet.localized_by_feet`, within ``feet_gate_m``), each view's feet of
         variance ``variances_m2`` (views,) m^2 per axis (:func:`~ptztrack.occupancy.feet.fitted_feet_variances`)."""
-        other = copy.copy(self)
-        other.feet_variances_m2 = np.asarray(variances_m2, dtype=float)
-        other.last = None
-        return other
+        return self._copy(feet_variances_m2=np.asarray(variances_m2, dtype=float))
 
     def with_masks_from_boxes(self) -> "PomDetector":
         """This detector with every view that has a detector's boxes taking its mask from them, its
         silhouettes unused."""
-        other = copy.copy(self)
-        other.foreground = {
+        boxless = {
             index: model for index, model in self.foreground.items() if self.recording.views[index].boxes is None
         }
-        other.last = None
-        return other
+        return self._copy(foreground=boxless)
 
     def box_mask_views(self) -> list[int]:
         """The views whose mask is the union of their detector's boxes (they have boxes and no silhouettes)."""
