@@ -54,6 +54,22 @@ def test_past_the_last_sample_the_camera_heads_for_its_target_at_its_speeds_and_
     assert not timeline.moving()
 
 
+def test_a_picture_shows_the_camera_settled_only_at_rest_and_once_its_move_could_have_landed():
+    timeline = PoseTimeline(SPEEDS)
+    assert not timeline.settled(1.0)  # nothing is known yet
+    timeline.sample(10.0, np.array([0.0, 0.0, 1.0]), moving=False)
+    assert timeline.settled(10.0)
+    timeline.sent(10.0, np.array([9.0, 0.0, 1.0]))  # 9 deg at 90 deg/s: it lands at 10.1
+    for time_s, pan_deg, moving in ((10.04, 3.6, True), (10.08, 7.2, True), (10.12, 9.0, False), (10.16, 9.0, False)):
+        timeline.sample(time_s, np.array([pan_deg, 0.0, 1.0]), moving)
+    assert not timeline.settled(10.06) and timeline.settled(10.14)
+    # A status that lags the command: still, where the camera was, before the move could have landed.
+    timeline.sent(20.0, np.array([0.0, 0.0, 1.0]))
+    for time_s in (20.02, 20.04, 20.2, 20.24):
+        timeline.sample(time_s, np.array([9.0, 0.0, 1.0]), moving=False)
+    assert not timeline.settled(20.03) and timeline.settled(20.22)
+
+
 def test_the_newest_picture_is_handed_over_once_and_a_wait_ends_with_nothing():
     latest = LatestFrame()
     assert latest.newer(0, timeout_s=0.01) is None

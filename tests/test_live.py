@@ -5,6 +5,7 @@ it reports."""
 import threading
 import time
 from dataclasses import replace
+from functools import partial
 
 import numpy as np
 import pytest
@@ -23,8 +24,8 @@ class PictureCamera:
     """A camera whose pictures come every PICTURE_S from a thread, standing at ``pose`` (or moving
     there, ``moving``); its targets are kept in ``sent``."""
 
-    def __init__(self, world, moving: bool = False):
-        self.frames, self.timeline, self.sent = self, PoseTimeline(None), []
+    def __init__(self, world, moving: bool = False, speeds=None):
+        self.frames, self.timeline, self.sent = self, PoseTimeline(speeds), []
         self.latest = LatestFrame()
         self.pose = world.grid.poses[world.start_action]
         self.moving, self.image = moving, np.zeros((world.camera.image_height_px, world.camera.image_width_px, 3))
@@ -35,6 +36,7 @@ class PictureCamera:
         if self.sent and np.array_equal(pose, self.sent[-1]):
             return False
         self.sent.append(np.asarray(pose))
+        self.timeline.sent(time.time(), pose)
         return True
 
     def _run(self) -> None:
@@ -121,6 +123,29 @@ def test_no_new_target_goes_out_while_the_camera_moves(world):
         live = run_live(built, policy, make_tracker(None, scenario, built), camera, 6, 1.0, 0, observer)
     assert all(len(reachable) == 1 and reachable[0] == built.start_action for reachable in seen)
     assert not live.sent.any() and len(camera.sent) == 1
+
+
+def _keep_reachable(seen: list, step, context, record) -> None:
+    seen.append(context.reachable)
+
+
+def test_a_camera_that_stands_still_before_its_move_could_have_landed_is_given_its_target_only(world):
+    """The policy chooses anew only on a picture taken at rest where the camera was sent: with a move
+    that takes an hour, after the first move the policy is given that move's target alone; with one that
+    lands at once, it chooses among every reachable action at each picture."""
+    scenario, built = world
+    for speeds, choices in ((np.array([1e-3, 1e-3, 1e-4]), 1), (np.array([1e6, 1e6, 1e6]), 12)):
+        policy = make_policy("random", scenario, built)
+        seen: list[np.ndarray] = []
+        with PictureCamera(built, speeds=speeds) as camera:
+            observer = partial(_keep_reachable, seen)
+            run_live(built, policy, make_tracker(None, scenario, built), camera, 12, 1.0, 0, observer)
+        given_a_choice = [len(reachable) > 1 for reachable in seen]
+        assert sum(given_a_choice) == choices and given_a_choice[0]
+        if choices == 1:
+            assert len(camera.sent) == 2 and all(
+                reachable[0] == built.grid.nearest(camera.sent[1]) for reachable in seen[1:]
+            )
 
 
 def test_warming_up_leaves_the_policy_and_the_tracker_as_they_were(world):

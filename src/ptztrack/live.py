@@ -265,6 +265,9 @@ def run_live_network(
         for index, (camera_world, camera, seeds) in enumerate(zip(worlds, cameras, detector_seeds, strict=True))
     ]
     rows: list[list[dict]] = [[] for _ in cameras]
+    # Whether each camera's newest picture used shows it at rest where it was last sent: only then has the
+    # belief seen what its last move was for, and may it choose the next.
+    settled = [False for _ in cameras]
     used = 0
     started_s = time.time()
     for detector in detectors:
@@ -287,6 +290,7 @@ def run_live_network(
             view = _CapturedView(frame.image)
             image = partial(view.image, used, at.pose)
             update, measured = track(tracker.updater(index), detections, at.pose, image, at.sd)
+            settled[index] = cameras[index].timeline.settled(frame.time_s)
             row = {
                 "capture_time_s": frame.time_s,
                 "picked_s": picked_s,
@@ -306,8 +310,8 @@ def run_live_network(
                 since_s = None if last_decided_s is None else (decided_s - last_decided_s) * time_scale
                 last_decided_s = decided_s
                 contexts = [
-                    _context(camera, grid, sent_to, used, update.tracks, policy_rng, decided_s, since_s)
-                    for camera, grid, sent_to in zip(cameras, grids, commanded, strict=True)
+                    _context(camera, grid, sent_to, used, update.tracks, policy_rng, decided_s, since_s, at_rest)
+                    for camera, grid, sent_to, at_rest in zip(cameras, grids, commanded, settled, strict=True)
                 ]
                 choices, row["decision_s"] = timed(policy.choose, contexts)
                 sent = []
@@ -337,15 +341,23 @@ def run_live_network(
 
 
 def _context(
-    camera: LiveCamera, grid, commanded, step: int, tracks: Tracks, rng, decided_s: float, since_s: float | None
+    camera: LiveCamera,
+    grid,
+    commanded,
+    step: int,
+    tracks: Tracks,
+    rng,
+    decided_s: float,
+    since_s: float | None,
+    settled: bool,
 ) -> DecisionContext:
     """The decision context of ``camera`` at epoch ``decided_s``: where it is (the pose it was sent to,
     ``commanded`` (3,), where no pose is known yet), the nearest grid action to that, and what it may reach:
-    while it moves, only the action nearest to its target (the paper's camera is sent no new decision while
-    it moves)."""
+    while it moves, and until a picture taken at rest where it went is in the belief (``settled``), only
+    the action nearest to its target (the paper's camera is sent no new decision while it moves)."""
     now = camera.timeline.at(decided_s)
     here = commanded if now is None else now.pose
-    if camera.timeline.moving():
+    if camera.timeline.moving() or not settled:
         nearest = grid.nearest(commanded)
         reachable = np.array([nearest])
     else:

@@ -45,6 +45,7 @@ class PoseTimeline:
         self._condition = threading.Condition()
         self._samples: deque[tuple[float, np.ndarray, bool]] = deque()
         self._target: tuple[float, np.ndarray] | None = None
+        self._lands_s = -np.inf
 
     def sample(self, time_s: float, pose, moving: bool) -> None:
         """A GetStatus answer: the pose (3,) at ``time_s`` and whether it was moving."""
@@ -55,9 +56,24 @@ class PoseTimeline:
             self._condition.notify_all()
 
     def sent(self, time_s: float, target) -> None:
-        """A move to ``target`` (3,) sent at ``time_s``."""
+        """A move to ``target`` (3,) sent at ``time_s``: it lands, at the speeds of the move-time model, no
+        sooner than from where the camera was then."""
+        target = np.asarray(target, dtype=float)
+        here = self.at(time_s)
+        move_s = 0.0
+        if here is not None and self.speeds is not None:
+            move_s = float(np.max(np.abs(target - here.pose) / self.speeds))
         with self._condition:
-            self._target = (time_s, np.asarray(target, dtype=float))
+            self._target = (time_s, target)
+            self._lands_s = time_s + move_s
+
+    def settled(self, time_s: float) -> bool:
+        """Whether a picture captured at ``time_s`` shows the camera at rest where its last move took it:
+        standing still then (no spread), and no sooner than that move could land."""
+        at = self.at(time_s)
+        with self._condition:
+            lands_s = self._lands_s
+        return at is not None and not np.any(at.sd > 0) and time_s >= lands_s
 
     def wait_past(self, time_s: float, timeout_s: float) -> bool:
         """Wait at most ``timeout_s`` for a sample at ``time_s`` or later; whether there is one."""
