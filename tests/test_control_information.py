@@ -323,35 +323,6 @@ def test_the_patrolling_term_grows_by_the_time_unobserved_in_steps_of_any_length
     np.testing.assert_allclose(halves.occupancy[~looked], whole.occupancy[~looked], rtol=1e-12)
 
 
-def test_a_camera_whose_moves_take_time_compares_information_per_second():
-    """With move times, an action's reward is divided by a step and the move there: an action twice as
-    informative but a step and a half away loses to staying."""
-    policy = policy_for("intg", "ideal")
-    tracks = Tracks(
-        np.array([0]),
-        np.array([[7.5, 6.0, 0.0, 0.0]]),
-        np.diag([1.0, 1.0, 0.1, 0.1])[None],
-        np.ones(1),
-        np.ones(1, int),
-    )
-    here = int(GRID.nearest(look_at(CAMERA, np.array([7.5, 6.0]), 1.0)))
-    reachable = GRID.reachable(here)
-    rewards = policy.rewards(reachable, tracks, np.random.default_rng(0))
-    best = int(reachable[np.argmax(rewards)])
-    assert best != here
-    context = DecisionContext(0, here, reachable, tracks, np.random.default_rng(0), GRID.poses[here])
-    step_s, ratio = 0.2, rewards.max() / rewards[reachable == here][0]
-    policy.step_s = step_s
-    policy.move_seconds = lambda start, poses: np.where(
-        np.all(poses == GRID.poses[here], axis=-1), 0.0, 1.01 * step_s * (ratio - 1)
-    )
-    assert policy.choose(context) == here
-    policy.move_seconds = lambda start, poses: np.where(
-        np.all(poses == GRID.poses[here], axis=-1), 0.0, 0.99 * step_s * (ratio - 1)
-    )
-    assert policy.choose(context) == best
-
-
 def test_without_tracks_the_patrolling_term_moves_the_camera_and_without_it_the_camera_stays():
     empty = Tracks.empty()
     start = int(GRID.index(3, 4, 1))

@@ -23,12 +23,11 @@ from ptztrack.builders.network import Coordination, belief_of_cameras, policy_of
 from ptztrack.builders.world import detector_model
 from ptztrack.camera.live_camera import LiveONVIFCamera
 from ptztrack.camera.onvif_client import CameraAddress, CameraError, ONVIFClient
-from ptztrack.camera.onvif_spaces import AxisSpeeds, CameraSpaces, MoveTimes
+from ptztrack.camera.onvif_spaces import AxisSpeeds, CameraSpaces
 from ptztrack.camera.pose_timeline import PoseTimeline
 from ptztrack.camera.recorded import RecordedPTZ
 from ptztrack.camera.stream import thumbnail
 from ptztrack.config import VIRTUAL_CAMERA_CALIBRATION, CameraCalibrationFile, Scenario
-from ptztrack.control.information_policy import InformationGainPolicy
 from ptztrack.control.network_policy import NetworkInformationPolicy
 from ptztrack.evaluate.video import RenderView
 from ptztrack.live import LiveEpisode, run_live, run_live_network, warm_up
@@ -250,14 +249,6 @@ def live_world(
     return replace(world, camera=camera, detector_model=detector_model(scenario, camera, model_seed))
 
 
-def _time_moves(policy: Policy, scenario: Scenario, calibration: CameraCalibrationFile) -> None:
-    """Give an information-gain ``policy`` the camera's calibrated move times, so that it compares
-    information per second (the reward over a step plus the move); other policies need none."""
-    if isinstance(policy, InformationGainPolicy):
-        move_times = MoveTimes(calibration.move_times.pan, calibration.move_times.tilt, calibration.move_times.zoom)
-        policy.move_seconds, policy.step_s = move_times.seconds, 1.0 / scenario.frame_rate_hz
-
-
 def _live_camera(
     address: CameraAddress, calibration: CameraCalibrationFile, timeout_s: float, transport: str
 ) -> LiveONVIFCamera:
@@ -300,7 +291,6 @@ def run_live_episode(
     """
     world = live_world(scenario, calibration, seed)
     live_policy = make_policy(policy, scenario, world)
-    _time_moves(live_policy, scenario, calibration)
     tracker = make_tracker(None, scenario, world)
     warm_up(world, live_policy, tracker)
     camera = _live_camera(address, calibration, timeout_s, transport)
@@ -349,8 +339,7 @@ def run_live_network_episode(
     ]
     policy = policy_of_cameras([(scenario, world, False) for world in worlds], coordination, method)
     tracker = belief_of_cameras([(scenario, world) for world in worlds])
-    for world, member, updater, calibration in zip(worlds, policy.cameras, tracker.cameras, calibrations, strict=True):
-        _time_moves(member.policy, scenario, calibration)
+    for world, member, updater in zip(worlds, policy.cameras, tracker.cameras, strict=True):
         warm_up(world, member.policy, updater)
     cameras: list[LiveONVIFCamera] = []
     try:

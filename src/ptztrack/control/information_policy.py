@@ -8,14 +8,11 @@ with ``alpha`` in closed form ('intg') or by sampling with occlusions
 ('smpl'). When no action is strictly better than staying (no tracks and no
 exploration term), the camera stays.
 
-A camera whose moves take time (a live one) gains an action's information
-only once it gets there: with its move times ``t_move(a)`` from where it
-is, the policy compares information per second, the reward over
-``step_s + t_move(a)``; a simulated camera, which lands at once, compares
-the rewards themselves.
+A camera whose moves take time (a live one) plans the same way: it is
+given a new choice only once a picture taken at rest where its last move
+took it is in the belief (:func:`ptztrack.live.run_live_network`).
 """
 
-from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Literal
 
@@ -64,9 +61,6 @@ class InformationGainPolicy:
     person_height_m, person_width_m : the person the policy expects.
     method : 'intg' (equation 8, closed form) or 'smpl' (equation 19, ``samples`` draws).
     beta, exploration : the patrolling term's weight and map (None: no patrolling term).
-    move_seconds : ``move_seconds(here (3,), poses (k, 3)) -> (k,)`` how long the camera takes to get to
-        each pose (:meth:`ptztrack.camera.onvif_spaces.MoveTimes.seconds`; None: it lands at once);
-        step_s : the seconds one step's reward is gained over.
     last_terms : the last choice's rewards term by term (for a live view of the decision; None before
         the first choice). Kept by reference: the arrays are the ones the choice was made from.
     """
@@ -81,8 +75,6 @@ class InformationGainPolicy:
     samples: int = ControlParameters.samples
     beta: float = ControlParameters.beta
     exploration: ExplorationMap | None = None
-    move_seconds: Callable[[np.ndarray, np.ndarray], np.ndarray] | None = None
-    step_s: float = 1.0
     geometry: ActionGeometry = field(init=False, repr=False)
     last_terms: RewardTerms | None = field(default=None, init=False, repr=False)
 
@@ -129,10 +121,6 @@ class InformationGainPolicy:
     def choose(self, context: DecisionContext) -> int:
         self.last_terms = self.reward_terms(context.reachable, context.tracks, context.rng)
         reward = self.last_terms.total_nats
-        if self.move_seconds is not None:
-            reward = reward / (
-                self.step_s + self.move_seconds(context.current_pose, self.grid.poses[context.reachable])
-            )
         best = int(np.argmax(reward))
         staying = np.flatnonzero(context.reachable == context.current_action)
         if len(staying) and reward[staying[0]] >= reward[best]:
