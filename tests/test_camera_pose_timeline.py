@@ -8,6 +8,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
+from ptztrack.camera.onvif_spaces import MoveTimes
 from ptztrack.camera.pose_timeline import PoseTimeline
 from ptztrack.camera.stream import LatestFrame
 
@@ -55,7 +56,7 @@ def test_past_the_last_sample_the_camera_heads_for_its_target_at_its_speeds_and_
 
 
 def test_a_picture_shows_the_camera_settled_only_at_rest_and_once_its_move_could_have_landed():
-    timeline = PoseTimeline(SPEEDS)
+    timeline = PoseTimeline(SPEEDS, move_times=MoveTimes((0.0, 1 / 90), (0.0, 1 / 90), (0.0, 1 / 3)))
     assert not timeline.settled(1.0)  # nothing is known yet
     timeline.sample(10.0, np.array([0.0, 0.0, 1.0]), moving=False)
     assert timeline.settled(10.0)

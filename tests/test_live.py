@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 from ptztrack.builders.episode import episode_world, make_policy, make_tracker
+from ptztrack.camera.onvif_spaces import MoveTimes
 from ptztrack.camera.pose_timeline import PoseTimeline
 from ptztrack.camera.stream import LatestFrame
 from ptztrack.config import scenario_from_dict
@@ -24,8 +25,8 @@ class PictureCamera:
     """A camera whose pictures come every PICTURE_S from a thread, standing at ``pose`` (or moving
     there, ``moving``); its targets are kept in ``sent``."""
 
-    def __init__(self, world, moving: bool = False, speeds=None):
-        self.frames, self.timeline, self.sent = self, PoseTimeline(speeds), []
+    def __init__(self, world, moving: bool = False, move_times=None):
+        self.frames, self.timeline, self.sent = self, PoseTimeline(None, move_times=move_times), []
         self.latest = LatestFrame()
         self.pose = world.grid.poses[world.start_action]
         self.moving, self.image = moving, np.zeros((world.camera.image_height_px, world.camera.image_width_px, 3))
@@ -134,10 +135,10 @@ def test_a_camera_that_stands_still_before_its_move_could_have_landed_is_given_i
     that takes an hour, after the first move the policy is given that move's target alone; with one that
     lands at once, it chooses among every reachable action at each picture."""
     scenario, built = world
-    for speeds, choices in ((np.array([1e-3, 1e-3, 1e-4]), 1), (np.array([1e6, 1e6, 1e6]), 12)):
+    for slope, choices in ((1e3, 1), (0.0, 12)):
         policy = make_policy("random", scenario, built)
         seen: list[np.ndarray] = []
-        with PictureCamera(built, speeds=speeds) as camera:
+        with PictureCamera(built, move_times=MoveTimes((0.0, slope), (0.0, slope), (0.0, slope))) as camera:
             observer = partial(_keep_reachable, seen)
             run_live(built, policy, make_tracker(None, scenario, built), camera, 12, 1.0, 0, observer)
         given_a_choice = [len(reachable) > 1 for reachable in seen]
@@ -189,7 +190,8 @@ class EveryCameraLast:
 def test_a_network_updates_one_belief_with_every_cameras_pictures_and_decides_for_all(world):
     """Two cameras, one moving all the time: each picture, whichever camera took it, updates the one
     belief through its camera's updater, predicted forward only; every decision has both cameras'
-    contexts, the moving camera's with its target alone, and only the still camera is sent anywhere new."""
+    contexts, the moving camera's with its target alone (the still one's too until a picture of it is in the
+    belief), and only the still camera is sent anywhere new."""
     scenario, built = world
     belief, policy = RecordingBelief(make_tracker(None, scenario, built)), EveryCameraLast()
     with PictureCamera(built, moving=True) as moving, PictureCamera(built) as still:
@@ -200,5 +202,5 @@ def test_a_network_updates_one_belief_with_every_cameras_pictures_and_decides_fo
     assert belief.dt_s[0] is None and min(belief.dt_s[1:]) >= 0.0
     assert policy.contexts and all(len(contexts) == 2 for contexts in policy.contexts)
     assert all(len(contexts[0].reachable) == 1 for contexts in policy.contexts)
-    assert len(policy.contexts[0][1].reachable) > 1
+    assert any(len(contexts[1].reachable) > 1 for contexts in policy.contexts)
     assert len(moving.sent) == 1 and len(still.sent) > 1

@@ -23,7 +23,7 @@ from ptztrack.builders.network import Coordination, belief_of_cameras, policy_of
 from ptztrack.builders.world import detector_model
 from ptztrack.camera.live_camera import LiveONVIFCamera
 from ptztrack.camera.onvif_client import CameraAddress, CameraError, ONVIFClient
-from ptztrack.camera.onvif_spaces import AxisSpeeds, CameraSpaces
+from ptztrack.camera.onvif_spaces import AxisSpeeds, CameraSpaces, MoveTimes
 from ptztrack.camera.pose_timeline import PoseTimeline
 from ptztrack.camera.recorded import RecordedPTZ
 from ptztrack.camera.stream import thumbnail
@@ -172,10 +172,11 @@ def virtual_calibration() -> CameraCalibrationFile:
 
 
 def pose_timeline(calibration: CameraCalibrationFile) -> PoseTimeline:
-    """The timeline of a camera's poses with the speeds of its calibrated move times (none where a slope
-    is not measured)."""
-    slopes = np.array([calibration.move_times.pan[1], calibration.move_times.tilt[1], calibration.move_times.zoom[1]])
-    return PoseTimeline(1.0 / slopes if np.all(slopes > 0) else None)
+    """The timeline of a camera's poses with its calibrated move times, and the speeds of their slopes
+    (none where a slope is not measured)."""
+    move_times = MoveTimes(calibration.move_times.pan, calibration.move_times.tilt, calibration.move_times.zoom)
+    slopes = np.array([move_times.pan[1], move_times.tilt[1], move_times.zoom[1]])
+    return PoseTimeline(1.0 / slopes if np.all(slopes > 0) else None, move_times=move_times)
 
 
 def virtual_onvif_camera(

@@ -18,6 +18,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ptztrack.camera.onvif_spaces import MoveTimes
+
 # Samples older than this are dropped: a picture is looked up within a second of its capture.
 KEEP_S = 10.0
 
@@ -37,11 +39,12 @@ class PoseTimeline:
     (then a pose past the last sample is the last sample's, uncertain by nothing while it stood still and
     by the move's length while it moved).
     capture_time_sd_s : how uncertain a capture time is (s); a priori half a frame at 25 fps.
+    move_times : the move-time model a move is timed with, to tell when it can have landed (None: at once).
     """
 
-    def __init__(self, speeds, capture_time_sd_s: float = 0.02):
+    def __init__(self, speeds, capture_time_sd_s: float = 0.02, move_times: MoveTimes | None = None):
         self.speeds = None if speeds is None else np.asarray(speeds, dtype=float)
-        self.capture_time_sd_s = capture_time_sd_s
+        self.capture_time_sd_s, self.move_times = capture_time_sd_s, move_times
         self._condition = threading.Condition()
         self._samples: deque[tuple[float, np.ndarray, bool]] = deque()
         self._target: tuple[float, np.ndarray] | None = None
@@ -56,13 +59,13 @@ class PoseTimeline:
             self._condition.notify_all()
 
     def sent(self, time_s: float, target) -> None:
-        """A move to ``target`` (3,) sent at ``time_s``: it lands, at the speeds of the move-time model, no
-        sooner than from where the camera was then."""
+        """A move to ``target`` (3,) sent at ``time_s``: it lands no sooner than the move-time model takes
+        from where the camera was then."""
         target = np.asarray(target, dtype=float)
         here = self.at(time_s)
         move_s = 0.0
-        if here is not None and self.speeds is not None:
-            move_s = float(np.max(np.abs(target - here.pose) / self.speeds))
+        if here is not None and self.move_times is not None:
+            move_s = float(self.move_times.seconds(here.pose, target))
         with self._condition:
             self._target = (time_s, target)
             self._lands_s = time_s + move_s
