@@ -5,11 +5,12 @@ its stream's pictures are (:func:`measure_image_delay`)."""
 
 import time
 
+import cv2
 import numpy as np
 
 from ptztrack.camera.onvif_client import ONVIFClient
 from ptztrack.camera.onvif_spaces import CameraSpaces, MoveTimes
-from ptztrack.camera.stream import OPEN_TIMEOUT_S, LatestFrame, thumbnail
+from ptztrack.camera.stream import OPEN_TIMEOUT_S, LatestFrame
 
 # Moves of these fractions of each axis' range, there and back from the middle of the range.
 MOVE_FRACTIONS = (0.05, 0.1, 0.2, 0.4)
@@ -45,9 +46,10 @@ def measure_move_times(client: ONVIFClient, spaces: CameraSpaces) -> tuple[MoveT
     return MoveTimes(*fits), samples
 
 
-# A picture has changed when it differs from the one before the move by this many times the differences of
-# pictures of the standing camera (the scene's own motion, the stream's noise), and by at least CHANGED_GREY.
-CHANGED_NOISE_RATIO, CHANGED_GREY = 4.0, 2.0
+# The pictures' sideways shift is measured on grey copies this wide (px), by phase correlation with the
+# picture before the turn, until they have shifted SHIFT_FRACTION of it (well within what it tells apart);
+# a picture has begun to shift once it is SHIFTED_PX off.
+SHIFT_WIDTH_PX, SHIFT_FRACTION, SHIFTED_PX = 160, 0.3, 0.5
 SETTLE_S = 0.5
 
 
@@ -57,9 +59,11 @@ def measure_image_delay(
     """How much older than its arrival a picture of the camera's stream is: ``moves`` pans of a tenth of
     the range, either way from where the camera stands when asked, each timed from the moment the head
     began to turn (its first GetStatus that has moved, less the distance over the pan's speed from
-    ``move_times``) to the arrival of the first picture that shows it (``latest``: the stream's pictures
-    stamped with their arrival), less half the stream's frame interval (a picture shows the head at a
-    moment within its interval). Returns the median delay (s) and each move's (moves,)."""
+    ``move_times``) to the arrival at which its pictures began to shift (``latest``: the stream's pictures
+    stamped with their arrival). A picture shows the head at one moment, so its shift ``x`` grows with the
+    time since the turn began, and the straight line through the (arrival, ``x``) of the pictures that have
+    shifted crosses ``x = 0`` at that moment plus the delay. Returns the median delay (s) and each move's
+    (moves,)."""
     here = spaces.pose(client.status().position)  # where it stands shows the scene; the middle may not
     pan_ends = spaces.pose(np.array([[-1.0, 0.0, 0.0], [1.0, 0.0, 0.0]]))[:, 0]
     step_deg = 0.1 * float(np.ptp(pan_ends))
@@ -69,35 +73,30 @@ def measure_image_delay(
         start, there = here.copy(), here.copy()
         there[0] += step_deg if move % 2 == 0 else -step_deg
         timed_move(client, spaces.normalised(start))
-        arrivals, changes, baseline = _still_pictures(latest)
-        interval_s = float(np.median(np.diff(arrivals)))
-        threshold = max(CHANGED_NOISE_RATIO * float(np.max(changes)), CHANGED_GREY)
+        baseline = _still_picture(latest)
         number = latest.received
         client.move_to(spaces.normalised(there))
         began_s = _began_turning(client, spaces, start, move_times.pan[1])
-        delays.append(_first_changed(latest, number, baseline, threshold) - began_s - interval_s / 2)
+        delays.append(_shift_onset(latest, number, baseline) - began_s)
     return float(np.median(delays)), np.asarray(delays)
 
 
-def _still_pictures(latest: LatestFrame) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The arrival times of the pictures of SETTLE_S while the camera stands, their thumbnails'
-    differences from one to the next, and the last thumbnail."""
+def _grey(image: np.ndarray) -> np.ndarray:
+    """A picture (h, w, 3) uint8 BGR as a float32 grey copy SHIFT_WIDTH_PX wide."""
+    height_px = max(1, round(SHIFT_WIDTH_PX * image.shape[0] / image.shape[1]))
+    grey = cv2.cvtColor(image, cv2.COLOR_BGR2GRAY)
+    return cv2.resize(grey, (SHIFT_WIDTH_PX, height_px), interpolation=cv2.INTER_AREA).astype(np.float32)
+
+
+def _still_picture(latest: LatestFrame) -> np.ndarray:
+    """The newest picture (grey, :func:`_grey`) once the camera has stood for SETTLE_S."""
     if latest.newer(0, OPEN_TIMEOUT_S) is None:
         raise TimeoutError(f"no picture from the stream within {OPEN_TIMEOUT_S:g} s")
     time.sleep(SETTLE_S)
-    number, arrivals, thumbnails = latest.received, [], []
-    ends_s = time.monotonic() + SETTLE_S
-    while time.monotonic() < ends_s:
-        frame = latest.newer(number, SETTLE_S)
-        if frame is None:
-            break
-        number = frame.number
-        arrivals.append(frame.time_s)
-        thumbnails.append(thumbnail(frame.image))
-    if len(thumbnails) < 3:
-        raise TimeoutError(f"fewer than 3 pictures from the stream in {SETTLE_S:g} s")
-    changes = np.mean(np.abs(np.diff(np.asarray(thumbnails), axis=0)), axis=(1, 2))
-    return np.asarray(arrivals), changes, thumbnails[-1]
+    frame = latest.newer(0, SETTLE_S)
+    if frame is None:
+        raise TimeoutError(f"no picture from the stream in {SETTLE_S:g} s")
+    return _grey(frame.image)
 
 
 def _began_turning(client: ONVIFClient, spaces: CameraSpaces, start, seconds_per_deg: float) -> float:
@@ -113,15 +112,25 @@ def _began_turning(client: ONVIFClient, spaces: CameraSpaces, start, seconds_per
     raise TimeoutError("the camera did not begin to turn within 5 s")
 
 
-def _first_changed(latest: LatestFrame, number: int, baseline: np.ndarray, threshold: float) -> float:
-    """The arrival time of the first picture after picture ``number`` that differs from ``baseline`` by more
-    than ``threshold`` grey levels on average."""
+def _shift_onset(latest: LatestFrame, number: int, baseline: np.ndarray) -> float:
+    """The arrival time at which the pictures after picture ``number`` began to shift sideways from
+    ``baseline``: the straight line through (arrival, shift) of those that have shifted, followed until they
+    have shifted SHIFT_FRACTION of the width, at no shift."""
+    arrivals, shifts_px = [], []
     ends_s = time.monotonic() + 5.0
     while time.monotonic() < ends_s:
         frame = latest.newer(number, 1.0)
         if frame is None:
             continue
         number = frame.number
-        if np.mean(np.abs(thumbnail(frame.image) - baseline)) > threshold:
-            return frame.time_s
-    raise TimeoutError("no picture showed the move within 5 s")
+        (shift_px, _), _ = cv2.phaseCorrelate(baseline, _grey(frame.image))
+        if abs(shift_px) > SHIFT_FRACTION * SHIFT_WIDTH_PX:
+            break
+        arrivals.append(frame.time_s)
+        shifts_px.append(abs(shift_px))
+    shifted = np.asarray(shifts_px) > SHIFTED_PX
+    if shifted.sum() < 2:
+        raise TimeoutError("fewer than 2 pictures showed the turn beginning within 5 s")
+    first_s = arrivals[0]
+    slope, intercept = np.polyfit(np.asarray(arrivals)[shifted] - first_s, np.asarray(shifts_px)[shifted], 1)
+    return first_s - intercept / slope

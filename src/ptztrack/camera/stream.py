@@ -15,6 +15,7 @@ import logging
 import os
 import threading
 import time
+from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass
 from urllib.parse import urlsplit
@@ -32,6 +33,8 @@ _OPEN_LOCK = threading.Lock()
 
 
 THUMBNAIL_SIZE_PX = (64, 48)
+# The frame clock is fitted to a stream's last this many pictures (2 s at 25 fps).
+FRAME_CLOCK_PICTURES = 50
 
 
 def thumbnail(image: np.ndarray) -> np.ndarray:
@@ -105,11 +108,31 @@ def open_rtsp(uri: str, transport: str = "tcp", timeout_s: float = OPEN_TIMEOUT_
     return capture
 
 
+def on_frame_clock(numbers, times_s) -> float:
+    """The capture time of the newest of a stream's pictures on the camera's frame clock: the straight line
+    ``t = a + P k`` through the pictures' numbers ``k`` (n,) and their times (n,) (s, arrival less the
+    delay), fitted by least squares, at the newest ``k``. A camera takes its pictures ``P`` apart, and
+    the line averages away how unevenly they arrive. The newest time as it is where fewer than 3 pictures
+    are given, or where they lie off any clock (rms distance from the line over a quarter of ``P``:
+    snapshots, say)."""
+    numbers = np.asarray(numbers, dtype=float)
+    times_s = np.asarray(times_s, dtype=float)
+    if len(times_s) < 3 or np.ptp(numbers) == 0:
+        return float(times_s[-1])
+    offsets_s = times_s - times_s[0]
+    period_s, start_s = np.polyfit(numbers - numbers[0], offsets_s, 1)
+    residuals_s = offsets_s - (start_s + period_s * (numbers - numbers[0]))
+    if not period_s > 0 or np.sqrt(np.mean(residuals_s**2)) > period_s / 4:
+        return float(times_s[-1])
+    return float(times_s[0] + start_s + period_s * (numbers[-1] - numbers[0]))
+
+
 class FrameStream:
     """Pictures from ``open_source()``, a callable that gives a ``read() -> image or None`` (None when
     the source has ended) and a ``close()``, or raises ConnectionError while it cannot be opened; read in
-    a daemon thread, each picture stamped ``clock() - delay_s``. A source that ends or cannot be opened
-    is opened again after ``retry_s``. Pictures go to ``latest``."""
+    a daemon thread, each picture stamped ``clock() - delay_s`` and put on the frame clock of the last
+    FRAME_CLOCK_PICTURES pictures since the source was opened (:func:`on_frame_clock`). A source that ends
+    or cannot be opened is opened again after ``retry_s``. Pictures go to ``latest``."""
 
     def __init__(
         self,
@@ -138,12 +161,16 @@ class FrameStream:
                 log.debug("no pictures: %s", error)
                 self._stopping.wait(self._retry_s)
                 continue
+            numbers: deque[int] = deque(maxlen=FRAME_CLOCK_PICTURES)
+            times_s: deque[float] = deque(maxlen=FRAME_CLOCK_PICTURES)
             try:
                 while not self._stopping.is_set():
                     image = read()
                     if image is None:
                         break
-                    self.latest.put(image, self._clock() - self.delay_s)
+                    numbers.append(numbers[-1] + 1 if numbers else 0)
+                    times_s.append(self._clock() - self.delay_s)
+                    self.latest.put(image, on_frame_clock(numbers, times_s))
             except Exception as error:  # noqa: BLE001 - a source that fails is opened again, as one that ends
                 log.debug("the pictures stopped: %s", error)
             finally:
