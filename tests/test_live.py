@@ -126,6 +126,30 @@ def test_no_new_target_goes_out_while_the_camera_moves(world):
     assert not live.sent.any() and len(camera.sent) == 1
 
 
+def test_the_policy_plans_on_the_tracks_predicted_from_the_pictures_capture_to_its_decision(world):
+    """``plan_ahead`` is given the belief's tracks and the scenario seconds from the capture of the picture
+    decided on to the decision (the time scale's multiple of the wall seconds), and the policy what it
+    returns."""
+    scenario, built = world
+    given, seen = [], []
+
+    def plan_ahead(tracks, seconds):
+        given.append(seconds)
+        return replace(tracks, next_id=1000 + len(given))
+
+    def observer(step, context, record):
+        seen.append((context.tracks.next_id, record["decided_s"] - record["capture_time_s"]))
+
+    with PictureCamera(built) as camera:
+        tracker = make_tracker(None, scenario, built)
+        run_live(
+            built, make_policy("fix", scenario, built), tracker, camera, 8, 0.5, 0, observer, plan_ahead=plan_ahead
+        )
+    assert len(seen) == len(given) > 0
+    for k, ((next_id, wall_s), seconds) in enumerate(zip(seen, given, strict=True)):
+        assert next_id == 1001 + k and 0.0 <= seconds <= 0.5 * wall_s
+
+
 def _keep_reachable(seen: list, step, context, record) -> None:
     seen.append(context.reachable)
 

@@ -2,6 +2,8 @@ import numpy as np
 import pytest
 
 from ptztrack.track import kalman
+from ptztrack.track.tracker import tracks_ahead
+from ptztrack.types import Tracks
 
 
 def test_predict_of_a_certain_state_is_the_process_noise():
@@ -52,3 +54,15 @@ def test_joseph_update_keeps_covariance_symmetric_positive_definite_under_huge_g
     _, P_plus = kalman.update(np.zeros((1, 4)), P, np.ones((1, 2)), C, 0.25 * np.eye(2))
     np.testing.assert_allclose(P_plus, np.swapaxes(P_plus, -1, -2))
     assert np.all(np.linalg.eigvalsh(P_plus) > 0)
+
+
+def test_tracks_ahead_walk_on_at_their_velocity_and_grow_as_white_acceleration_makes_them():
+    """From a known state, after 0.5 s at 1.5 m/s^2: mean x + v t; position variance sigma^2 t^4 / 4,
+    velocity variance sigma^2 t^2, their covariance sigma^2 t^3 / 2."""
+    tracks = Tracks(np.array([7]), np.array([[1.0, 2.0, 1.0, -0.5]]), np.zeros((1, 4, 4)), np.ones(1), np.ones(1, int))
+    ahead = tracks_ahead(tracks, 0.5, 1.5)
+    np.testing.assert_allclose(ahead.mean, [[1.5, 1.75, 1.0, -0.5]])
+    variance = 1.5**2 * np.array([[0.5**4 / 4, 0.5**3 / 2], [0.5**3 / 2, 0.5**2]])
+    np.testing.assert_allclose(ahead.covariance[0][np.ix_([0, 2], [0, 2])], variance)
+    np.testing.assert_allclose(ahead.covariance[0][0, 1], 0.0)
+    assert ahead.ids[0] == 7 and np.array_equal(tracks.mean, [[1.0, 2.0, 1.0, -0.5]])

@@ -37,7 +37,7 @@ import copy
 import queue
 import threading
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from functools import partial
 from typing import Protocol
@@ -58,6 +58,11 @@ IDLE_WAIT_S = 0.5
 # The detector takes the next picture no sooner than this many times its last detection's time after it took
 # the last one.
 DETECTOR_DUTY_INVERSE = 2.0
+
+
+PlanAhead = Callable[[Tracks, float], Tracks]
+"""``plan_ahead(tracks, seconds)``: the tracks a live policy plans on, from the belief's and the scenario
+seconds since the capture of the picture the decision is made on."""
 
 
 class LiveCamera(Protocol):
@@ -174,10 +179,12 @@ def run_live(
     seed: int,
     observer: StepObserver | None = None,
     keep_images: bool = False,
+    plan_ahead: PlanAhead | None = None,
 ) -> LiveEpisode:
     """Use at most ``steps`` pictures; Ctrl-C ends the run early with what was recorded.
 
     time_scale : scenario seconds per wall-clock second (a virtual camera's recording plays that fast).
+    plan_ahead : what the policy plans on, as :func:`run_live_network` takes it.
     observer : called after every decision as :func:`ptztrack.loop.run_loop` calls it, with the row's
     fields, its ``actions`` (flat index, -1 off the grid), ``poses`` and the picture as ``image``.
     keep_images : keep each picture used, as JPEG, in the episode (for its video).
@@ -185,7 +192,7 @@ def run_live(
     # A camera alone is a network of one: the same stages, the same order.
     (episode,) = run_live_network(
         (world,), _Alone(policy), _AloneTracker(tracker), [camera], steps, time_scale, seed,
-        observer, keep_images,
+        observer, keep_images, plan_ahead,
     )  # fmt: skip
     return episode
 
@@ -226,6 +233,7 @@ def run_live_network(
     seed: int,
     observer: StepObserver | None = None,
     keep_images: bool = False,
+    plan_ahead: PlanAhead | None = None,
 ) -> tuple[LiveEpisode, ...]:
     """Drive every camera of ``cameras``, each deciding in its world of ``worlds`` (in the same order; a
     network's :attr:`ptztrack.network_loop.NetworkWorld.cameras`), with one ground belief: use at most
@@ -239,7 +247,9 @@ def run_live_network(
 
     Returns each camera's :class:`LiveEpisode`: the pictures it supplied, each with the belief's tracks
     after its update, and its camera's command after it. observer : called after every decision with the
-    context and row of the camera whose picture led to it, the row's ``camera`` its index; the rest as
+    context and row of the camera whose picture led to it, the row's ``camera`` its index; plan_ahead :
+    ``plan_ahead(tracks, seconds)``, the tracks the policy plans on, given the belief's and the scenario
+    seconds since the capture of the picture decided on (None: the belief's as they are); the rest as
     :func:`run_live`.
     """
     _, detector_seed, policy_seed, _, _, _ = episode_seeds(seed)
@@ -309,8 +319,11 @@ def run_live_network(
                 decided_s = time.time()
                 since_s = None if last_decided_s is None else (decided_s - last_decided_s) * time_scale
                 last_decided_s = decided_s
+                planned = update.tracks
+                if plan_ahead is not None:
+                    planned = plan_ahead(planned, max(decided_s - frame.time_s, 0.0) * time_scale)
                 contexts = [
-                    _context(camera, grid, sent_to, used, update.tracks, policy_rng, decided_s, since_s, at_rest)
+                    _context(camera, grid, sent_to, used, planned, policy_rng, decided_s, since_s, at_rest)
                     for camera, grid, sent_to, at_rest in zip(cameras, grids, commanded, settled, strict=True)
                 ]
                 choices, row["decision_s"] = timed(policy.choose, contexts)

@@ -30,9 +30,10 @@ from ptztrack.camera.stream import thumbnail
 from ptztrack.config import VIRTUAL_CAMERA_CALIBRATION, CameraCalibrationFile, Scenario
 from ptztrack.control.network_policy import NetworkInformationPolicy
 from ptztrack.evaluate.video import RenderView
-from ptztrack.live import LiveEpisode, run_live, run_live_network, warm_up
+from ptztrack.live import LiveEpisode, PlanAhead, run_live, run_live_network, warm_up
 from ptztrack.loop import Episode, StepObserver, World, episode_seeds
 from ptztrack.roles import Policy
+from ptztrack.track.tracker import tracks_ahead
 from ptztrack.types import GroundTruth
 
 if TYPE_CHECKING:
@@ -250,6 +251,14 @@ def live_world(
     return replace(world, camera=camera, detector_model=detector_model(scenario, camera, model_seed))
 
 
+def _plan_ahead(scenario: Scenario) -> PlanAhead:
+    """The tracks a live policy plans on: the belief's predicted from the capture of the picture decided on
+    to a step after the decision, as an offline policy plans on the tracks predicted to the step its
+    picture is taken at."""
+    step_s, acceleration_sigma_m_s2 = 1.0 / scenario.frame_rate_hz, scenario.tracker.acceleration_sigma_m_s2
+    return lambda tracks, since_capture_s: tracks_ahead(tracks, since_capture_s + step_s, acceleration_sigma_m_s2)
+
+
 def _live_camera(
     address: CameraAddress, calibration: CameraCalibrationFile, timeout_s: float, transport: str
 ) -> LiveONVIFCamera:
@@ -298,7 +307,10 @@ def run_live_episode(
     try:
         camera.start()
         observer = None if observe is None else observe(world, live_policy)
-        live = run_live(world, live_policy, tracker, camera, steps, time_scale, seed, observer, keep_images)
+        live = run_live(
+            world, live_policy, tracker, camera, steps, time_scale, seed, observer, keep_images,
+            _plan_ahead(scenario),
+        )  # fmt: skip
     finally:
         camera.close()
     return world, live
@@ -349,7 +361,10 @@ def run_live_network_episode(
             cameras.append(_live_camera(address, calibration, timeout_s, transport))
             cameras[-1].start()
         observer = None if observe is None else observe(worlds, policy)
-        live = run_live_network(worlds, policy, tracker, cameras, steps, time_scale, seed, observer, keep_images)
+        live = run_live_network(
+            worlds, policy, tracker, cameras, steps, time_scale, seed, observer, keep_images,
+            _plan_ahead(scenario),
+        )  # fmt: skip
     finally:
         for camera in cameras:
             camera.close()

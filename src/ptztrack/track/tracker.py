@@ -93,6 +93,12 @@ def predict_tracks(tracks: Tracks, F, U) -> Tracks:
     return replace(tracks, mean=mean, covariance=covariance)
 
 
+def tracks_ahead(tracks: Tracks, dt_s: float, acceleration_sigma_m_s2: float) -> Tracks:
+    """``tracks`` predicted ``dt_s`` seconds on by the constant-velocity model whose white acceleration
+    has ``acceleration_sigma_m_s2`` (m/s^2) per axis."""
+    return predict_tracks(tracks, *kalman.constant_velocity_model(dt_s, acceleration_sigma_m_s2))
+
+
 def predicted_feet_px(camera: PTZCamera, pose, mean) -> tuple[np.ndarray, np.ndarray]:
     """Where the states ``mean`` (n, 4) put the feet in the image at ``pose``.
 
@@ -512,8 +518,7 @@ class EkfTracker:
     def predict(self, dt_s: float | None = None) -> Tracks:
         dt_s = self.step_s if dt_s is None else dt_s
         self.elapse(dt_s)
-        F, U = kalman.constant_velocity_model(dt_s, self.parameters.acceleration_sigma_m_s2)
-        self.tracks = predict_tracks(self.tracks, F, U)
+        self.tracks = tracks_ahead(self.tracks, dt_s, self.parameters.acceleration_sigma_m_s2)
         return self.tracks
 
     def elapse(self, dt_s: float) -> None:
