@@ -33,6 +33,7 @@ def test_the_default_grid_is_the_papers_280_actions():
         ("camera: {live_view: {jpeg_quality: 0}}\n", "camera.live_view.jpeg_quality: Input should be greater than"),
         ("- 1\n- 2\n", "expected a mapping of scenario fields (got list)"),
         ("area_m: [1, 2\n", "not valid YAML at line"),
+        ('{"frames": 5, [1, 2]: 3}\n', "not valid YAML at line 1"),
         ("cameras: [{kind: pan, position_m: [0, 0, 3]}]\n", "cameras.0.kind: Input should be 'ptz' or 'fixed'"),
         ("cameras: [{kind: ptz}]\n", "cameras.0.position_m: Field required"),
         ("cameras: [{position_m: [0, 0, -3]}]\n", "cameras.0.position_m.2: Input should be greater than 0 (got -3)"),

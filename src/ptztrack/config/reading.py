@@ -32,13 +32,18 @@ def _first_error_line(error: pydantic.ValidationError, source: str) -> str:
 
 
 class _LimitedLoader(yaml.SafeLoader):
-    """YAML's safe loader, refusing duplicate keys (YAML forbids them; PyYAML keeps the last)."""
+    """YAML's safe loader, refusing duplicate keys (YAML forbids them; PyYAML keeps the last) and keys that
+    are lists or mappings (which name no field)."""
 
     def construct_mapping(self, node, deep=False):
         seen = set()
         for key_node, _ in node.value:
             key = self.construct_object(key_node, deep=deep)
-            if isinstance(key, Hashable) and key in seen:
+            if not isinstance(key, Hashable):  # a list or a mapping as a key: no name for a field
+                raise yaml.constructor.ConstructorError(
+                    "while reading a mapping", node.start_mark, "a key that is a list or a mapping", key_node.start_mark
+                )
+            if key in seen:
                 raise _DuplicateKey(key, key_node.start_mark.line + 1)
             seen.add(key)
         return super().construct_mapping(node, deep=deep)
