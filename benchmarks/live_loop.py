@@ -113,7 +113,8 @@ def serve(time_scale: float, ready, stop, results) -> None:
 
 
 def calibrated(address: CameraAddress):
-    """The virtual calibration with the stream's delay as ``camera calibrate`` measures it on the camera."""
+    """The virtual calibration with the stream's delay and its capture times' uncertainty as ``camera
+    calibrate`` measures them on the camera."""
     calibration = virtual_calibration()
     client = ONVIFClient(address)
     client.connect()
@@ -121,11 +122,11 @@ def calibrated(address: CameraAddress):
     stream.start()
     try:
         move_times = MoveTimes(calibration.move_times.pan, calibration.move_times.tilt, calibration.move_times.zoom)
-        delay_s, _ = measure_image_delay(client, camera_spaces(calibration), move_times, stream.latest)
+        delay_s, delays = measure_image_delay(client, camera_spaces(calibration), move_times, stream.latest)
     finally:
         stream.stop()
         client.close()
-    return calibration.model_copy(update={"image_delay_s": delay_s})
+    return calibration.model_copy(update={"image_delay_s": delay_s, "capture_time_sd_s": float(np.std(delays, ddof=1))})
 
 
 def main() -> None:
@@ -201,6 +202,7 @@ def main() -> None:
         "time_scale": args.time_scale,
         "transport": args.transport,
         "image_delay_s_calibrated": calibration.image_delay_s,
+        "capture_time_sd_s_calibrated": calibration.capture_time_sd_s,
         "pictures_used": len(live.capture_time_s),
         "recording_steps": offline.frames,
         "wall_s": wall_s,

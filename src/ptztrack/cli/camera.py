@@ -185,15 +185,23 @@ def calibrate_camera_command(args: argparse.Namespace) -> int:
                 f"({len(seconds)} moves of {distances.max():.3g} {unit} at most)"
             )
         image_delay_s, delays = measure_image_delay(client, spaces, move_times, stream.latest)
-        print(f"image delay: {image_delay_s:.3f} s (median of {len(delays)} pans, {np.ptp(delays):.3f} s apart)")
+        capture_time_sd_s = float(np.std(delays, ddof=1))
+        print(
+            f"image delay: {image_delay_s:.3f} s (median of {len(delays)} pans, standard deviation "
+            f"{capture_time_sd_s:.4f} s: a capture time's uncertainty)"
+        )
     finally:
         if stream is not None:
             stream.stop()
         client.close()
     section = MoveTimesSection(pan=move_times.pan, tilt=move_times.tilt, zoom=move_times.zoom)
-    update = {"move_times": section, "image_delay_s": round(image_delay_s, 4)}
+    update = {
+        "move_times": section,
+        "image_delay_s": round(image_delay_s, 4),
+        "capture_time_sd_s": round(capture_time_sd_s, 4),
+    }
     write_camera_calibration(args.calibration, calibration.model_copy(update=update))
-    print(f"wrote move_times and image_delay_s into {args.calibration}")
+    print(f"wrote move_times, image_delay_s and capture_time_sd_s into {args.calibration}")
     return 0
 
 

@@ -43,7 +43,9 @@ class CameraCalibrationFile(_Strict):
     both increasing, from the widest view (zoom factor 1); position_m : the optical centre (x, y, z) on the
     ground plane's axes, metres, and f_min_px : the focal length at zoom 1 (null: the scenario's camera);
     move_times : see :class:`MoveTimesSection`; image_delay_s : how long after the camera stands still
-    its images show where it stands (a frame interval and the stream's latency; 0.1 s: a 10 fps stream).
+    its images show where it stands (a frame interval and the stream's latency; 0.1 s: a 10 fps stream);
+    capture_time_sd_s : how uncertain a picture's capture time is (0.02 s, half a frame at 25 fps, until
+    ``ptztrack camera calibrate`` measures it: the spread of its delays).
     """
 
     pan_deg: tuple[Degrees, Degrees]
@@ -55,6 +57,7 @@ class CameraCalibrationFile(_Strict):
     f_min_px: Annotated[PositiveFloat, at_most(1e6, "pixels")] | None = None
     move_times: MoveTimesSection = MoveTimesSection()
     image_delay_s: Annotated[NonNegativeFloat, at_most(10, "seconds")] = 0.1
+    capture_time_sd_s: Annotated[NonNegativeFloat, at_most(1, "seconds")] = 0.02
 
     @model_validator(mode="after")
     def _monotonic(self):
