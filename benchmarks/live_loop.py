@@ -122,11 +122,13 @@ def calibrated(address: CameraAddress):
     stream.start()
     try:
         move_times = MoveTimes(calibration.move_times.pan, calibration.move_times.tilt, calibration.move_times.zoom)
-        delay_s, delays = measure_image_delay(client, camera_spaces(calibration), move_times, stream.latest)
+        delay_s, capture_time_sd_s, _ = measure_image_delay(
+            client, camera_spaces(calibration), move_times, stream.latest
+        )
     finally:
         stream.stop()
         client.close()
-    return calibration.model_copy(update={"image_delay_s": delay_s, "capture_time_sd_s": float(np.std(delays, ddof=1))})
+    return calibration.model_copy(update={"image_delay_s": delay_s, "capture_time_sd_s": capture_time_sd_s})
 
 
 def main() -> None:

@@ -12,14 +12,14 @@ from ptztrack.camera.onvif_spaces import MoveTimes
 from ptztrack.camera.pose_timeline import PoseTimeline
 from ptztrack.camera.stream import LatestFrame, on_frame_clock
 
-SPEEDS = np.array([90.0, 90.0, 3.0])
+MOVE_TIMES = MoveTimes((0.0, 1 / 90), (0.0, 1 / 90), (0.0, 1 / 3))  # 90 deg/s, 90 deg/s, 3 zoom/s
 
 
 @given(st.floats(0.0, 1.0), st.floats(-50.0, 50.0), st.floats(1.0, 4.0))
 def test_between_two_samples_the_pose_is_interpolated_and_uncertain_by_its_speed_times_the_timing(
     fraction, pan_deg, zoom
 ):
-    timeline = PoseTimeline(SPEEDS, capture_time_sd_s=0.02)
+    timeline = PoseTimeline(MOVE_TIMES, capture_time_sd_s=0.02)
     start, end = np.array([pan_deg, -10.0, zoom]), np.array([pan_deg + 9.0, -10.0, zoom])
     timeline.sample(100.0, start, moving=True)
     timeline.sample(100.1, end, moving=True)
@@ -29,7 +29,7 @@ def test_between_two_samples_the_pose_is_interpolated_and_uncertain_by_its_speed
 
 
 def test_a_camera_standing_still_is_exactly_where_it_stands():
-    timeline = PoseTimeline(SPEEDS)
+    timeline = PoseTimeline(MOVE_TIMES)
     pose = np.array([10.0, -5.0, 2.0])
     timeline.sample(1.0, pose, moving=False)
     timeline.sample(1.04, pose, moving=False)
@@ -41,7 +41,7 @@ def test_a_camera_standing_still_is_exactly_where_it_stands():
 
 
 def test_past_the_last_sample_the_camera_heads_for_its_target_at_its_speeds_and_stops_there():
-    timeline = PoseTimeline(SPEEDS, capture_time_sd_s=0.0)
+    timeline = PoseTimeline(MOVE_TIMES, capture_time_sd_s=0.0)
     timeline.sample(10.0, np.array([0.0, 0.0, 1.0]), moving=False)
     timeline.sent(10.0, np.array([9.0, -4.5, 4.0]))
     assert timeline.moving()
@@ -56,7 +56,7 @@ def test_past_the_last_sample_the_camera_heads_for_its_target_at_its_speeds_and_
 
 
 def test_a_picture_shows_the_camera_settled_only_at_rest_and_once_its_move_could_have_landed():
-    timeline = PoseTimeline(SPEEDS, move_times=MoveTimes((0.0, 1 / 90), (0.0, 1 / 90), (0.0, 1 / 3)))
+    timeline = PoseTimeline(MOVE_TIMES)
     assert not timeline.settled(1.0)  # nothing is known yet
     timeline.sample(10.0, np.array([0.0, 0.0, 1.0]), moving=False)
     assert timeline.settled(10.0)

@@ -26,7 +26,7 @@ class PictureCamera:
     there, ``moving``); its targets are kept in ``sent``."""
 
     def __init__(self, world, moving: bool = False, move_times=None):
-        self.frames, self.timeline, self.sent = self, PoseTimeline(None, move_times=move_times), []
+        self.frames, self.timeline, self.sent = self, PoseTimeline(move_times), []
         self.latest = LatestFrame()
         self.pose = world.grid.poses[world.start_action]
         self.moving, self.image = moving, np.zeros((world.camera.image_height_px, world.camera.image_width_px, 3))

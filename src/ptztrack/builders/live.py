@@ -173,12 +173,9 @@ def virtual_calibration() -> CameraCalibrationFile:
 
 
 def pose_timeline(calibration: CameraCalibrationFile) -> PoseTimeline:
-    """The timeline of a camera's poses with its calibrated move times, the speeds of their slopes (none
-    where a slope is not measured) and its capture times' uncertainty."""
+    """The timeline of a camera's poses with its calibrated move times and capture times' uncertainty."""
     move_times = MoveTimes(calibration.move_times.pan, calibration.move_times.tilt, calibration.move_times.zoom)
-    slopes = np.array([move_times.pan[1], move_times.tilt[1], move_times.zoom[1]])
-    speeds = 1.0 / slopes if np.all(slopes > 0) else None
-    return PoseTimeline(speeds, calibration.capture_time_sd_s, move_times)
+    return PoseTimeline(move_times, calibration.capture_time_sd_s)
 
 
 def virtual_onvif_camera(

@@ -55,15 +55,15 @@ SETTLE_S = 0.5
 
 def measure_image_delay(
     client: ONVIFClient, spaces: CameraSpaces, move_times: MoveTimes, latest: LatestFrame, moves: int = 6
-) -> tuple[float, np.ndarray]:
+) -> tuple[float, float, np.ndarray]:
     """How much older than its arrival a picture of the camera's stream is: ``moves`` pans of a tenth of
     the range, either way from where the camera stands when asked, each timed from the moment the head
     began to turn (its first GetStatus that has moved, less the distance over the pan's speed from
     ``move_times``) to the arrival at which its pictures began to shift (``latest``: the stream's pictures
     stamped with their arrival). A picture shows the head at one moment, so its shift ``x`` grows with the
     time since the turn began, and the straight line through the (arrival, ``x``) of the pictures that have
-    shifted crosses ``x = 0`` at that moment plus the delay. Returns the median delay (s) and each move's
-    (moves,)."""
+    shifted crosses ``x = 0`` at that moment plus the delay. Returns the median delay (s), how uncertain a
+    capture time is (s: the delays' standard deviation) and each move's delay (moves,)."""
     here = spaces.pose(client.status().position)  # where it stands shows the scene; the middle may not
     pan_ends = spaces.pose(np.array([[-1.0, 0.0, 0.0], [1.0, 0.0, 0.0]]))[:, 0]
     step_deg = 0.1 * float(np.ptp(pan_ends))
@@ -78,7 +78,7 @@ def measure_image_delay(
         client.move_to(spaces.normalised(there))
         began_s = _began_turning(client, spaces, start, move_times.pan[1])
         delays.append(_shift_onset(latest, number, baseline) - began_s)
-    return float(np.median(delays)), np.asarray(delays)
+    return float(np.median(delays)), float(np.std(delays, ddof=1)), np.asarray(delays)
 
 
 def _grey(image: np.ndarray) -> np.ndarray:

@@ -35,15 +35,16 @@ class PoseAt:
 class PoseTimeline:
     """GetStatus samples and the targets sent, on the epoch clock, shared between threads.
 
-    speeds : (3,) the axes' speeds (deg/s, deg/s, zoom factor per s) of the move-time model, or None
-    (then a pose past the last sample is the last sample's, uncertain by nothing while it stood still and
-    by the move's length while it moved).
+    move_times : the camera's move-time model (None: its moves take no time), which times a move to tell
+        when it can have landed; its slopes' inverses are the axes' ``speeds`` (3,) (deg/s, deg/s, zoom
+        factor per s), None where a slope is not measured (then a pose past the last sample is the last
+        sample's, uncertain by nothing while it stood still and by the move's length while it moved).
     capture_time_sd_s : how uncertain a capture time is (s); a priori half a frame at 25 fps.
-    move_times : the move-time model a move is timed with, to tell when it can have landed (None: at once).
     """
 
-    def __init__(self, speeds, capture_time_sd_s: float = 0.02, move_times: MoveTimes | None = None):
-        self.speeds = None if speeds is None else np.asarray(speeds, dtype=float)
+    def __init__(self, move_times: MoveTimes | None = None, capture_time_sd_s: float = 0.02):
+        slopes = None if move_times is None else np.array([move_times.pan[1], move_times.tilt[1], move_times.zoom[1]])
+        self.speeds = 1.0 / slopes if slopes is not None and np.all(slopes > 0) else None
         self.capture_time_sd_s, self.move_times = capture_time_sd_s, move_times
         self._condition = threading.Condition()
         self._samples: deque[tuple[float, np.ndarray, bool]] = deque()

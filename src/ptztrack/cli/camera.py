@@ -184,8 +184,7 @@ def calibrate_camera_command(args: argparse.Namespace) -> int:
                 f"{axis}: {intercept:.3f} s + {slope:.4f} s/{unit} "
                 f"({len(seconds)} moves of {distances.max():.3g} {unit} at most)"
             )
-        image_delay_s, delays = measure_image_delay(client, spaces, move_times, stream.latest)
-        capture_time_sd_s = float(np.std(delays, ddof=1))
+        image_delay_s, capture_time_sd_s, delays = measure_image_delay(client, spaces, move_times, stream.latest)
         print(
             f"image delay: {image_delay_s:.3f} s (median of {len(delays)} pans, standard deviation "
             f"{capture_time_sd_s:.4f} s: a capture time's uncertainty)"
