@@ -323,6 +323,25 @@ def test_the_patrolling_term_grows_by_the_time_unobserved_in_steps_of_any_length
     np.testing.assert_allclose(halves.occupancy[~looked], whole.occupancy[~looked], rtol=1e-12)
 
 
+def test_looks_closer_than_a_step_clear_a_cell_together_as_one_look_of_a_step():
+    """A live camera decides about three times a step: three looks of a third of a step at one view leave
+    every cell, seen or not, where one look of a whole step does (no arrivals), and each clears less than
+    that look (a miss's evidence raised to its share of the step)."""
+    thirds, whole = policy_for("intg", beta=1.0).exploration, policy_for("intg", beta=1.0).exploration
+    for exploration in (thirds, whole):
+        exploration.arrival_rate_per_s = np.zeros_like(exploration.arrival_rate_per_s)
+    q = thirds.detection_probability(np.arange(len(thirds.height_px)))
+    view = int(np.argmax(q.sum(axis=1)))
+    thirds.advance(view, thirds.step_s / 3)
+    seen = (q[view] > 0) & (q[view] < 1)
+    one_look = whole.occupancy * (1 - q[view]) / (1 - whole.occupancy * q[view])
+    assert seen.any() and np.all(thirds.occupancy[seen] > one_look[seen])
+    thirds.advance(view, thirds.step_s / 3)
+    thirds.advance(view, thirds.step_s / 3)
+    whole.advance(view)
+    np.testing.assert_allclose(thirds.occupancy, whole.occupancy, rtol=1e-12)
+
+
 def test_without_tracks_the_patrolling_term_moves_the_camera_and_without_it_the_camera_stays():
     empty = Tracks.empty()
     start = int(GRID.index(3, 4, 1))

@@ -81,10 +81,19 @@ class ExplorationMap:
 
     def advance(self, action: int, dt_s: float | None = None) -> None:
         """One step of ``dt_s`` seconds (None: ``step_s``): people may arrive anywhere, each cell's with
-        probability ``1 - exp(-rate dt)``, then the camera looks with ``action``."""
-        arrival_probability = -np.expm1(-self.arrival_rate_per_s * (self.step_s if dt_s is None else dt_s))
+        probability ``1 - exp(-rate dt)``, then the camera looks with ``action``.
+
+        A look ``dt`` after the last counts as ``w = min(1, dt / step_s)`` of one, as a tracker counts a
+        picture (:class:`ptztrack.track.tracker.EkfTracker`): a miss multiplies a cell's odds by
+        ``(1 - q_c)^w``, so that the ``1 / w`` decisions a live camera makes in a step clear a cell as the
+        one look of a step does."""
+        dt_s = self.step_s if dt_s is None else dt_s
+        arrival_probability = -np.expm1(-self.arrival_rate_per_s * dt_s)
         self.occupancy = 1.0 - (1.0 - self.occupancy) * (1.0 - arrival_probability)
         q = self.detection_probability(action)
+        weight = dt_s / self.step_s
+        if weight < 1.0:
+            q = 1.0 - (1.0 - q) ** weight
         self.occupancy = self.occupancy * (1.0 - q) / (1.0 - self.occupancy * q)
 
 
