@@ -249,7 +249,7 @@ def live_world(
     return replace(world, camera=camera, detector_model=detector_model(scenario, camera, model_seed))
 
 
-def _plan_ahead(scenario: Scenario) -> PlanAhead:
+def plan_ahead_of(scenario: Scenario) -> PlanAhead:
     """The tracks a live policy plans on: the belief's predicted from the capture of the picture decided on
     to a step after the decision, as an offline policy plans on the tracks predicted to the step its
     picture is taken at."""
@@ -307,7 +307,7 @@ def run_live_episode(
         observer = None if observe is None else observe(world, live_policy)
         live = run_live(
             world, live_policy, tracker, camera, steps, time_scale, seed, observer, keep_images,
-            _plan_ahead(scenario),
+            plan_ahead_of(scenario),
         )  # fmt: skip
     finally:
         camera.close()
@@ -361,7 +361,7 @@ def run_live_network_episode(
         observer = None if observe is None else observe(worlds, policy)
         live = run_live_network(
             worlds, policy, tracker, cameras, steps, time_scale, seed, observer, keep_images,
-            _plan_ahead(scenario),
+            plan_ahead_of(scenario),
         )  # fmt: skip
     finally:
         for camera in cameras:
