@@ -6,7 +6,7 @@ it) drives the virtual camera's head (:mod:`ptztrack.camera.onvif_head`, 90
 deg/s and 3 zoom per second, times ``--speedup``), whose pictures are the
 PETS S2.L1 view at its pose, the recording playing in real time: 25 a
 second, each handed to the loop ``--delay-s`` after its capture with its
-exact capture time, its pose sampled every 40 ms as GetStatus samples it.
+exact capture time, its pose sampled as the live camera polls GetStatus.
 It prints the live run's MOTA beside the offline run of the recording
 steps its pictures showed, as ``benchmarks/live_loop.py`` scores them: what
 the loop costs without the stream, the H.264 and a camera's process on the
@@ -28,6 +28,7 @@ from ptztrack.builders.live import (
     VIRTUAL_FRAME_RATE_HZ,
     VIRTUAL_SPEEDS,
     RecordingFeed,
+    camera_spaces,
     live_as_episode,
     live_world,
     offline_counterpart,
@@ -35,15 +36,13 @@ from ptztrack.builders.live import (
     pose_timeline,
     virtual_calibration,
 )
-from ptztrack.camera.onvif_head import Head
+from ptztrack.camera.live_camera import POLL_S
+from ptztrack.camera.onvif_head import Head, head_axes
 from ptztrack.camera.stream import LatestFrame
 from ptztrack.config import pets_scenario
 from ptztrack.evaluate.metrics import episode_metrics
 from ptztrack.files import write_json
 from ptztrack.live import run_live, warm_up
-
-# GetStatus as the live ONVIF camera polls it (ptztrack.camera.live_camera.POLL_S).
-POLL_S = 0.04
 
 
 class InProcessCamera:
@@ -105,7 +104,7 @@ def main() -> None:
     args = parser.parse_args()
     scenario = pets_scenario("hog")
     calibration = virtual_calibration()
-    move_times = {axis: (0.0, seconds / args.speedup) for axis, (_, seconds) in calibration.move_times}
+    move_times = {axis: (offset_s, seconds / args.speedup) for axis, (offset_s, seconds) in calibration.move_times}
     calibration = calibration.model_copy(
         update={"move_times": calibration.move_times.model_copy(update=move_times), "capture_time_sd_s": 0.001}
     )
@@ -114,11 +113,8 @@ def main() -> None:
     plan_ahead = plan_ahead_of(scenario)
     warm_up(world, policy, tracker)
     feed = RecordingFeed(episode_world(scenario, 0), 1.0 / scenario.frame_rate_hz)
-    zooms = [zoom for _, zoom in calibration.zoom_curve]
-    limits = np.array([sorted(calibration.pan_deg), sorted(calibration.tilt_deg), [zooms[0], zooms[-1]]])
-    speeds = VIRTUAL_SPEEDS
-    rates_per_s = args.speedup * np.array([speeds.pan_deg_s, speeds.tilt_deg_s, speeds.zoom_per_s])
-    head = Head(world.grid.poses[world.start_action], limits, rates_per_s)
+    limits, rates_per_s = head_axes(camera_spaces(calibration), VIRTUAL_SPEEDS)
+    head = Head(world.grid.poses[world.start_action], limits, args.speedup * rates_per_s)
     with InProcessCamera(feed, head, pose_timeline(calibration), args.delay_s) as camera:
         live = run_live(world, policy, tracker, camera, args.steps, 1.0, 0, plan_ahead=plan_ahead)
     truth_log = feed.rows()

@@ -13,6 +13,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ptztrack.camera.onvif_spaces import AxisSpeeds, CameraSpaces
+
 
 @dataclass(frozen=True)
 class _Ramp:
@@ -35,6 +37,14 @@ class _Ramp:
 
 def _ramp(t_s: float, here: float, there: float, rate_per_s: float) -> _Ramp:
     return _Ramp(t_s, here, t_s + abs(there - here) / rate_per_s, there)
+
+
+def head_axes(spaces: CameraSpaces, speeds: AxisSpeeds) -> tuple[np.ndarray, np.ndarray]:
+    """A head's axes for a camera's ``spaces`` and ``speeds``: the limits (3, 2), (low, high) of pan_deg,
+    tilt_deg and zoom factor, and the full rates (3,) per second."""
+    zoom_factors = [zoom for _, zoom in spaces.zoom_curve]
+    limits = np.array([sorted(spaces.pan_deg), sorted(spaces.tilt_deg), [zoom_factors[0], zoom_factors[-1]]])
+    return limits, np.array([speeds.pan_deg_s, speeds.tilt_deg_s, speeds.zoom_per_s], dtype=float)
 
 
 class Head:

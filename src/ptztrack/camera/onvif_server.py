@@ -60,7 +60,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from ptztrack.camera.onvif_head import Head
+from ptztrack.camera.onvif_head import Head, head_axes
 from ptztrack.camera.onvif_http import SNAPSHOT_PATH, HTTPAuth, HTTPServer, Served, make_server
 from ptztrack.camera.onvif_media import DeviceMediaService, MediaSettings
 from ptztrack.camera.onvif_ptz import PTZService
@@ -112,10 +112,8 @@ class VirtualONVIFCamera:
         f_min_px: float | None = None,
     ):
         width_px, height_px = (int(size) for size in image_size_px)
-        zoom_factors = [zoom for _, zoom in spaces.zoom_curve]
-        limits = np.array([sorted(spaces.pan_deg), sorted(spaces.tilt_deg), [zoom_factors[0], zoom_factors[-1]]])
+        limits, rates_per_s = head_axes(spaces, speeds)
         start_pose = np.asarray(start_pose, dtype=float)
-        rates_per_s = np.array([speeds.pan_deg_s, speeds.tilt_deg_s, speeds.zoom_per_s], dtype=float)
         if width_px <= 0 or height_px <= 0 or not frame_rate_hz > 0 or not np.all(rates_per_s > 0):
             raise ValueError("the image size, the frame rate and the axes' speeds must be positive")
         if f_min_px is not None and not f_min_px > 0:
