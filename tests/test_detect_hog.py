@@ -1,9 +1,11 @@
 from pathlib import Path
+from types import SimpleNamespace
 
 import cv2
 import numpy as np
 import pytest
 
+from ptztrack.builders.live import live_world, offline_counterpart, virtual_calibration
 from ptztrack.builders.world import build_world
 from ptztrack.camera.virtual import virtual_ptz
 from ptztrack.detect.hog import (
@@ -44,6 +46,21 @@ def test_hog_finds_the_people_of_a_zoomed_virtual_view_at_their_annotated_feet(e
     feet, _ = feet_and_height_px(boxes)
     nearest_px = np.linalg.norm(feet[:, None] - annotated[None], axis=-1).min(axis=1)
     assert np.sum(nearest_px < 4.0) >= 1
+
+
+def test_a_luma_detector_finds_in_a_picture_what_it_finds_in_its_grey_copy_and_the_colour_one_does_not(
+    excerpt_frames,
+):
+    virtual, whole_frame = virtual_ptz(load_pinhole(EXCERPT / "pinhole.json"))
+    view = virtual.render(excerpt_frames[10], whole_frame * [1, 1, 2])
+    grey = cv2.cvtColor(cv2.cvtColor(view, cv2.COLOR_BGR2GRAY), cv2.COLOR_GRAY2BGR)
+    found = {luma: [HogPeopleDetector(luma=luma).boxes(image) for image in (view, grey)] for luma in (False, True)}
+    (boxes, scores), (grey_boxes, grey_scores) = found[True]
+    assert len(boxes) >= 1
+    np.testing.assert_array_equal(boxes, grey_boxes)
+    np.testing.assert_array_equal(scores, grey_scores)
+    (colour_boxes, _), (colour_grey_boxes, _) = found[False]
+    assert colour_boxes.shape != colour_grey_boxes.shape or not np.array_equal(colour_boxes, colour_grey_boxes)
 
 
 def test_hog_finds_nobody_in_an_empty_image():
@@ -277,3 +294,21 @@ def test_the_search_is_planned_at_the_believed_pose_not_at_the_pose_the_camera_t
     believed_true = detector.detect(backend, 3, pose, np.random.default_rng(0), believed_pose=pose)
     assert len(found) >= 1 and len(believed_sky) == 0
     np.testing.assert_array_equal(believed_true.feet_px, found.feet_px)
+
+
+@pytest.mark.parametrize(("hog_luma", "reads_luma"), [(None, True), (False, False), (True, True)])
+def test_a_live_camera_and_its_offline_counterpart_read_the_luma_unless_the_scenario_says_colour(
+    tmp_path, excerpt_scenario, hog_luma, reads_luma
+):
+    scenario = excerpt_scenario(
+        tmp_path,
+        **{"detector.kind": "hog", "detector.hog_luma": hog_luma, "recording.video": str(EXCERPT / "View_001.avi")},
+    )
+    assert build_world(scenario, np.random.default_rng(0)).detector.luma is bool(hog_luma)
+    world = live_world(scenario, virtual_calibration(), 0)
+    assert world.detector.luma is reads_luma
+    # Pictures captured 1 s and 2 s after the recording's first shown step, shown at steps 3 and 7.
+    truth_log = np.array([[100.0, 3, 0, 0, 1], [101.5, 7, 0, 0, 1]])
+    live = SimpleNamespace(capture_time_s=np.array([101.0, 102.0]))
+    offline = offline_counterpart(scenario, world, live, truth_log)
+    assert offline.frames == 5 and offline.detector.hog_luma is reads_luma

@@ -138,12 +138,14 @@ def realistic_detector(scenario: Scenario, scene):
 
 def hog_detector(scenario: Scenario, scene) -> HogPeopleDetector:
     """OpenCV's HOG; with ``hog_search`` 'ground', only where the scene's camera can show a standing person
-    on its walkable area."""
+    on its walkable area; on the pictures' luma only where ``hog_luma`` says so."""
     detector = scenario.detector
     search = None
     if detector.hog_search == "ground":
         search = GroundSearch(scene.camera, scene.area_polygon_m, detector.hog_person_height_m)
-    return HogPeopleDetector(detector.hog_upsample, detector.hog_hit_threshold, detector.hog_nms_iou, search)
+    return HogPeopleDetector(
+        detector.hog_upsample, detector.hog_hit_threshold, detector.hog_nms_iou, search, bool(detector.hog_luma)
+    )
 
 
 def simulated_camera(scenario: Scenario, scene) -> SimulatedPTZ:

@@ -238,8 +238,9 @@ def live_world(
 ) -> World:
     """The world a live run decides in: the scenario's grid, detector and area, with the calibration's
     camera position and focal length where it gives them; its detector model draws from ``model_seed``
-    (default: the one-camera episode's stream)."""
-    world = episode_world(scenario, seed)
+    (default: the one-camera episode's stream); its HOG reads the luma unless the scenario says otherwise
+    (:func:`streamed`)."""
+    world = episode_world(streamed(scenario), seed)
     camera = world.camera
     if calibration.position_m is not None:
         camera = replace(camera, position_m=calibration.position_m)
@@ -247,6 +248,14 @@ def live_world(
         camera = replace(camera, f_min_px=calibration.f_min_px)
     model_seed = episode_seeds(seed)[5] if model_seed is None else model_seed
     return replace(world, camera=camera, detector_model=detector_model(scenario, camera, model_seed))
+
+
+def streamed(scenario: Scenario) -> Scenario:
+    """``scenario`` with its HOG reading the pictures' luma where it leaves that unset (``hog_luma``): a
+    camera's video stream keeps its colour at a quarter of the pixels, and compresses it."""
+    if scenario.detector.hog_luma is not None:
+        return scenario
+    return scenario.model_copy(update={"detector": scenario.detector.model_copy(update={"hog_luma": True})})
 
 
 def plan_ahead_of(scenario: Scenario) -> PlanAhead:
@@ -371,8 +380,8 @@ def run_live_network_episode(
 
 def offline_counterpart(scenario: Scenario, world: World, live: LiveEpisode, truth_log) -> Scenario:
     """``scenario`` narrowed to the recording's steps a live run against the virtual camera saw, from the
-    first its pictures showed to the last (within one play of the recording): the offline run to compare
-    it with."""
+    first its pictures showed to the last (within one play of the recording), with the live run's
+    detector (:func:`streamed`): the offline run to compare it with."""
     recording = scenario.required_recording("the offline counterpart of a live run")
     backend = world.backend
     assert isinstance(backend, RecordedPTZ)
@@ -382,4 +391,4 @@ def offline_counterpart(scenario: Scenario, world: World, live: LiveEpisode, tru
     steps = last_step - first_step + 1
     frame_range = (first, first + steps * recording.frame_step)
     narrowed = recording.model_copy(update={"frame_range": frame_range})
-    return scenario.model_copy(update={"recording": narrowed, "frames": steps})
+    return streamed(scenario).model_copy(update={"recording": narrowed, "frames": steps})

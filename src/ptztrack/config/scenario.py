@@ -88,6 +88,9 @@ class Detector(_Strict):
     hog_search : 'ground' scans only the windows where a standing person ``hog_person_height_m``
     (shortest, tallest) tall could be seen on the walkable area, at their sizes; 'image' scans every
     window of the pyramid, as OpenCV's ``detectMultiScale`` (:mod:`ptztrack.detect.hog`).
+    hog_luma : HOG reads only the pictures' luma (true) or the strongest gradient of their three colours
+    (false); unset, luma for a live camera's pictures (decoded from its video stream, whose colour has
+    half the resolution each way and its losses) and colour for a recording's views.
     """
 
     kind: Annotated[str, _registered("detectors")] = "realistic"
@@ -105,6 +108,7 @@ class Detector(_Strict):
     hog_nms_iou: float = Field(HogParameters.nms_iou, gt=0, le=1)
     hog_search: Literal["ground", "image"] = "ground"
     hog_person_height_m: tuple[_Height, _Height] = HogParameters.person_heights_m
+    hog_luma: bool | None = None
     model: str = "online"
     prior_shift_px: Annotated[float, Field(ge=-1000, le=1000)] = 0.0
 

@@ -156,18 +156,22 @@ class HogPeopleDetector:
     nms_iou : boxes overlapping more than this (intersection over union) are merged.
     search : where people can be in the views (:class:`GroundSearch`); None scans every window
         (OpenCV's ``detectMultiScale``).
+    luma : read only an image's luma, ``Y = 0.299 R + 0.587 G + 0.114 B`` (OpenCV's grey), instead of the
+        strongest gradient of its three colours: what a video stream keeps at full resolution (its
+        colour is at half the resolution each way).
     """
 
     upsample: float = HogParameters.upsample
     hit_threshold: float = HogParameters.hit_threshold
     nms_iou: float = HogParameters.nms_iou
     search: GroundSearch | None = None
+    luma: bool = False
     _hog: cv2.HOGDescriptor = field(init=False, repr=False)
 
     def __post_init__(self):
         self._hog = cv2.HOGDescriptor()
         self._hog.setSVMDetector(cv2.HOGDescriptor.getDefaultPeopleDetector())
-        self._settings = (self.upsample, self.hit_threshold, self.nms_iou, self.search and self.search.key)
+        self._settings = (self.upsample, self.hit_threshold, self.nms_iou, self.search and self.search.key, self.luma)
 
     def detect(
         self, camera: CameraBackend, step: int, pose, rng: np.random.Generator, believed_pose=None
@@ -196,6 +200,8 @@ class HogPeopleDetector:
     def boxes(self, image, pose=None) -> tuple[np.ndarray, np.ndarray]:
         """People in a BGR image taken at ``pose`` (needed with a search): boxes (K, 4) as (left, top,
         width, height) px and SVM scores (K,)."""
+        if self.luma and image.ndim == 3:
+            image = cv2.cvtColor(image, cv2.COLOR_BGR2GRAY)
         upsampled_size_px = (round(image.shape[1] * self.upsample), round(image.shape[0] * self.upsample))
         found: np.ndarray | Sequence
         weights: np.ndarray | Sequence
