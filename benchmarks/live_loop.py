@@ -7,10 +7,11 @@ drives the virtual camera of ``ptztrack serve-camera`` (PETS S2.L1 played at
 second), served by a process of its own on this machine's cores, with ``--policy`` and
 the HOG detector, for ``--steps`` pictures. It prints the rates (decisions
 and pictures used per second, the age of the picture each decision was made
-on), the policy's time (the first decision with tracks and the median, both
-among the decisions with a choice: a camera that moves, or has not yet
-taken a picture at rest where it went, is given its target alone), and the
-MOTA of the live run scored against the recording's truth beside the
+on, the choices and the new targets sent per second), the policy's time (the
+first decision with tracks and the median, both among the decisions with a
+choice: a camera that moves, or has not yet taken a picture at rest where it
+went, is given its target alone), and the MOTA of the live run scored
+against the recording's truth beside the
 offline virtual-PTZ run of the same recording steps. Each picture used is then found among the pictures the camera
 rendered (by its thumbnail), which gives what the live run paid: the
 stream's true delay, the pose error at capture (the pose the tracker used
@@ -215,6 +216,8 @@ def main() -> None:
         "first_decision_s": with_tracks[0] if with_tracks else float("nan"),
         "median_decision_s": float(np.median([seconds for seconds, _ in choices])),
         "decisions_with_a_choice": len(choices) / max(len(decisions), 1),
+        "choices_per_s": len(choices) / (live.ended_s - live.started_s),
+        "new_targets_per_s": float(np.sum(live.sent)) / (live.ended_s - live.started_s),
         "mota_live": live_metrics["mota"],
         "mota_offline": offline_metrics["mota"],
         "mota_replay_rendered": rendered_exactly["mota"],
