@@ -1,30 +1,25 @@
 """The live loop's pace against the virtual ONVIF camera on 127.0.0.1, its score beside the offline
 run of the same recording steps, and where the two differ.
 
-``ptztrack live``'s loop (:func:`ptztrack.builders.live.run_live_episode`)
-drives the virtual camera of ``ptztrack serve-camera`` (PETS S2.L1 played at
-``--time-scale``, 25 fps over RTSP, moving at 90 deg/s and 3 zoom per
-second), served by a process of its own on this machine's cores, with ``--policy`` and
-the HOG detector, for ``--steps`` pictures. It prints the rates (decisions
-and pictures used per second, the age of the picture each decision was made
-on, the choices and the new targets sent per second), the policy's time (the
-first decision with tracks and the median, both among the decisions with a
-choice: a camera that moves, or has not yet taken a picture at rest where it
-went, is given its target alone), and the MOTA of the live run scored
-against the recording's truth beside the
-offline virtual-PTZ run of the same recording steps. Each picture used is then found among the pictures the camera
-rendered (by its thumbnail), which gives what the live run paid: the
-stream's true delay, the pose error at capture (the pose the tracker used
-against the pose rendered, still and moving), the recording step it took
-the picture for against the one shown, and the detections per picture
-against the offline run's. The gap is then taken apart by replays through a
-fresh tracker, each changing one thing: the live run's pictures rendered
-exactly (the recording's view at the step and pose each showed, at its
-render time: no stream, no pose error), then one such picture per
-recording step (the offline run's rate, at the live camera's poses). What
-is left between the last and the offline run is where the camera looked.
-The offline run is also repeated over ``--offline-seeds`` seeds (its policy
-samples), for the spread of the figure the live run is held against.
+``ptztrack live``'s loop (:func:`ptztrack.builders.live.run_live_episode`) drives the virtual camera
+of ``ptztrack serve-camera`` (PETS S2.L1 played at ``--time-scale``, 25 fps over RTSP, moving at 90
+deg/s and 3 zoom per second), served by a process of its own on this machine's cores, with
+``--policy`` and the HOG detector, for ``--steps`` pictures. It prints the rates (decisions and
+pictures used per second, the age of the picture each decision was made on, the choices and the new
+targets sent per second), the policy's time (the first decision with tracks and the median, both
+among the decisions with a choice: a camera that moves, or has not yet taken a picture at rest where
+it went, is given its target alone), and the MOTA of the live run scored against the recording's
+truth beside the offline virtual-PTZ run of the same recording steps. Each picture used is then
+found among the pictures the camera rendered (by its thumbnail), which gives what the live run paid:
+the stream's true delay, the pose error at capture (the pose the tracker used against the pose
+rendered, still and moving), the recording step it took the picture for against the one shown, and
+the detections per picture against the offline run's. The gap is then taken apart by replays through
+a fresh tracker, each changing one thing: the live run's pictures rendered exactly (the recording's
+view at the step and pose each showed, at its render time: no stream, no pose error), then one such
+picture per recording step (the offline run's rate, at the live camera's poses). What is left
+between the last and the offline run is where the camera looked. The offline run is also repeated
+over ``--offline-seeds`` seeds (its policy samples), for the spread of the figure the live run is
+held against.
 
     python benchmarks/live_loop.py [--steps 700] [--time-scale 1] [--policy smpl] [--transport tcp]
                                    [--offline-seeds 5] [--json PATH]
@@ -199,7 +194,7 @@ def main() -> None:
     # A camera moving or not yet at rest where it went is given its target alone: no choice to time.
     choices = [(seconds, tracks) for seconds, tracks, reachable in decisions if reachable > 1]
     with_tracks = [seconds for seconds, tracks in choices if tracks > 0]
-    rates = live.rates()
+    rates, run_s = live.rates(), live.ended_s - live.started_s
     row = {
         "policy": args.policy,
         "time_scale": args.time_scale,
@@ -216,8 +211,8 @@ def main() -> None:
         "first_decision_s": with_tracks[0] if with_tracks else float("nan"),
         "median_decision_s": float(np.median([seconds for seconds, _ in choices])),
         "decisions_with_a_choice": len(choices) / max(len(decisions), 1),
-        "choices_per_s": len(choices) / (live.ended_s - live.started_s),
-        "new_targets_per_s": float(np.sum(live.sent)) / (live.ended_s - live.started_s),
+        "choices_per_s": len(choices) / run_s,
+        "new_targets_per_s": float(np.sum(live.sent)) / run_s,
         "mota_live": live_metrics["mota"],
         "mota_offline": offline_metrics["mota"],
         "mota_replay_rendered": rendered_exactly["mota"],
