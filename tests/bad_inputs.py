@@ -307,6 +307,12 @@ def cases(scratch: Path | None) -> list[Case]:
         _scenario("a camera network run as one camera", "cameras: [{position_m: [0, 0, 3]}]\n"),
         Case("network: no setting", ("experiment", "network")),
         Case("network: --max-ptz 0", ("experiment", "network", "synthetic", "--max-ptz", "0")),
+        Case("network: --first-sequence -1", ("experiment", "network", "synthetic", "--first-sequence", "-1")),
+        Case(
+            "network pets: the development sequences of the synthetic setting",
+            ("experiment", "network", "pets", "--first-sequence", "1000", *A_FEW_STEPS),
+            says=("--first-sequence",),
+        ),
         Case(
             "network pets: the synthetic setting's option",
             ("experiment", "network", "pets", "--max-ptz", "2", *A_FEW_STEPS),

@@ -77,3 +77,13 @@ def test_the_command_writes_one_row_per_configuration(tmp_path, capsys):
     difference = np.subtract(fixed["mota_per_sequence"], ptz["mota_per_sequence"]).mean()
     assert fixed["joint"] == "1ptz" and fixed["mota_minus_joint"] == pytest.approx(difference)
     assert "1fixed+wide" in capsys.readouterr().out
+
+
+def test_a_development_run_scores_the_sequences_it_names_as_the_table_would(tmp_path):
+    arguments = ["experiment", "network", "synthetic", "--frames", "4", "--max-ptz", "1", "--executor", "serial"]
+    table, development = tmp_path / "table.json", tmp_path / "development.json"
+    assert main([*arguments, "--sequences", "2", "--quiet", "--json", str(table)]) == 0
+    assert main([*arguments, "--sequences", "1", "--first-sequence", "1", "--quiet", "--json", str(development)]) == 0
+    for whole, later in zip(json.loads(table.read_text()), json.loads(development.read_text()), strict=True):
+        assert whole["seeds"] == [0, 1] and later["seeds"] == [1]
+        assert later["mota_per_sequence"] == whole["mota_per_sequence"][1:]

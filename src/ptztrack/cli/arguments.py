@@ -340,6 +340,11 @@ def _add_network_parser(experiments, detectors: list[str]) -> None:
     )
     _add_detector_model_arguments(network)
     network.add_argument("--sequences", type=_positive_int, help="synthetic: sequences (default 12)")
+    network.add_argument(
+        "--first-sequence",
+        type=_non_negative_int,
+        help="synthetic: the first sequence's seed (default 0, the table's; from 1000: development sequences)",
+    )
     network.add_argument("--frames", type=_positive_int, help="overrides the scenario's number of frames")
     network.add_argument("--max-ptz", type=_positive_int, help="synthetic: the most PTZ cameras (default 4)")
     network.add_argument("--seeds", type=_positive_int, help="pets: seeds of the runs with the PTZ camera (default 5)")

@@ -10,7 +10,7 @@ from ptztrack.experiments.network import format_network_table, network_cells, ne
 from ptztrack.files import write_json
 
 # The options of one setting only, and their defaults.
-SYNTHETIC_OPTIONS = {"sequences": 12, "max_ptz": 4}
+SYNTHETIC_OPTIONS = {"sequences": 12, "first_sequence": 0, "max_ptz": 4}
 PETS_OPTIONS = {"seeds": 5, "beta": 9.0}
 
 
@@ -28,10 +28,10 @@ def network_experiment_command(args: argparse.Namespace) -> int:
     scenario = build_scenario(
         "synthetic", args.detector or "realistic", args.frames, detector_model=args.detector_model, prior_shift_px=None
     )
-    cells = network_cells(scenario, args.sequences, args.max_ptz, args.method)
+    cells = network_cells(scenario, args.sequences, args.max_ptz, args.method, args.first_sequence)
     print(f"{len(cells)} episodes, {args.executor} executor", file=sys.stderr)
     summary = run_network_table(cells, Execution(args.executor, args.workers, args.quiet))
-    print(format_network_table(summary, network_title(scenario, args.sequences, args.method)))
+    print(format_network_table(summary, network_title(scenario, args.sequences, args.method, args.first_sequence)))
     return _write(args, summary)
 
 

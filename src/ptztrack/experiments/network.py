@@ -22,7 +22,8 @@ camera joint and independent are the same run, ``1ptz``. With the wide
 camera, the same with ``+wide``, and ``wide`` alone. On the mast, for
 ``N`` >= 2, ``Nptz-joint-mast`` and ``Nptz-independent-mast``.
 
-Every configuration runs the same sequences (seeds 0 .. n-1): the same
+Every configuration runs the same sequences (seeds 0 .. n-1, the table's;
+a development run starts further on, disjoint from them): the same
 people and, for a camera at the same place in the list (the wide one comes
 last), the same detector luck, so configurations pair up sequence by
 sequence. A configuration's ``mota_se`` is the standard error of its mean
@@ -121,16 +122,22 @@ def configurations(max_ptz: int) -> list[Configuration]:
 
 
 def network_cells(
-    scenario: Scenario, sequences: int, max_ptz: int = 4, method: Literal["intg", "smpl"] = "intg"
+    scenario: Scenario,
+    sequences: int,
+    max_ptz: int = 4,
+    method: Literal["intg", "smpl"] = "intg",
+    first_sequence: int = 0,
 ) -> list[NetworkCell]:
-    """Every configuration (:func:`configurations`) on the sequences 0 .. ``sequences`` - 1."""
+    """Every configuration (:func:`configurations`) on the sequences ``first_sequence`` .. ``first_sequence
+    + sequences - 1``."""
+    seeds = range(first_sequence, first_sequence + sequences)
     cells = []
     for configuration in configurations(max_ptz):
         network = network_scenario(
             scenario, configuration.ptz, configuration.mode == "fixed", configuration.wide, configuration.placement
         )
         coordination: Coordination = "independent" if configuration.mode == "independent" else "joint"
-        cells += [NetworkCell(network, coordination, method, seed, configuration) for seed in range(sequences)]
+        cells += [NetworkCell(network, coordination, method, seed, configuration) for seed in seeds]
     return cells
 
 
@@ -144,7 +151,7 @@ def run_network_cell(cell: NetworkCell) -> dict:
 
 def summarise_network(rows: Sequence[dict]) -> list[dict]:
     """One row per configuration, in order of first appearance: the means over its sequences of
-    :data:`SUMMARY_KEYS`, ``mota_se``, ``mota_per_sequence`` (by seed) and ``sequences``; and for a
+    :data:`SUMMARY_KEYS`, ``mota_se``, ``mota_per_sequence`` (by seed), ``seeds`` and ``sequences``; and for a
     configuration with a joint one to pair with, ``joint``, ``mota_minus_joint`` and its paired
     standard error ``mota_minus_joint_se``."""
     by_label: dict[str, list[dict]] = {}
@@ -160,6 +167,7 @@ def summarise_network(rows: Sequence[dict]) -> list[dict]:
             **{key: float(np.mean([row[key] for row in mine])) for key in SUMMARY_KEYS},
             "mota_se": standard_error(mota),
             "mota_per_sequence": mota,
+            "seeds": [row["seed"] for row in mine],
         }
         joint = mine[0]["joint"]
         if joint is not None and joint in by_label:
@@ -196,9 +204,10 @@ def format_network_table(summary: Sequence[dict], title: str = "") -> str:
     return "\n".join(lines)
 
 
-def network_title(scenario: Scenario, sequences: int, method: str) -> str:
+def network_title(scenario: Scenario, sequences: int, method: str, first_sequence: int = 0) -> str:
+    which = f"{sequences} sequences" + (f" from seed {first_sequence}" if first_sequence else "")
     return (
         f"camera network on the synthetic scene, {scenario.detector.kind} detector "
-        f"({scenario.detector.model} model), PTZ policies {method}, {sequences} sequences of "
+        f"({scenario.detector.model} model), PTZ policies {method}, {which} of "
         f"{scenario.frames} frames (MOTA +- standard error over sequences; - joint: paired)"
     )
