@@ -99,3 +99,28 @@ def test_each_cameras_picture_weighs_the_time_since_that_cameras_last_one():
         pose, detections = seen_at(camera, PERSON_M)
         belief.updater(index).update(detections, pose, lambda: None)
     np.testing.assert_allclose(weights, [0.25, 0.5, 0.5, 0.5])
+
+
+def test_a_track_only_one_camera_that_needs_a_second_has_detected_is_reported_once_another_detects_it():
+    """EAST needs a second camera: its person alone is not reported, SOUTH's is; after SOUTH detects
+    EAST's person once, both are. Two cameras that both need a second one report a person both detect."""
+    beside_m = PERSON_M + [4.0, 3.0]
+    plain, ruled, both = network(), network(), network()
+    ruled.needs_a_second_camera = frozenset({1})
+    both.needs_a_second_camera = frozenset({0, 1})
+    for _ in range(5):
+        for belief in (plain, ruled, both):
+            belief.predict()
+            for index, camera, person_m in ((1, EAST, PERSON_M), (0, SOUTH, beside_m)):
+                pose, detections = seen_at(camera, person_m)
+                belief.updater(index).update(detections, pose, lambda: None)
+    east_only, south_only = plain.tracks.ids.tolist()
+    assert sorted(plain.reported().ids.tolist()) == [east_only, south_only]
+    assert ruled.reported().ids.tolist() == [south_only]
+    assert both.reported().ids.tolist() == []
+    for belief in (ruled, both):
+        belief.predict()
+        pose, detections = seen_at(SOUTH, PERSON_M)
+        belief.updater(0).update(detections, pose, lambda: None)
+    assert sorted(ruled.reported().ids.tolist()) == [east_only, south_only]
+    assert both.reported().ids.tolist() == [east_only]

@@ -17,15 +17,16 @@ occupancy experiment's threshold for the same files
 (:attr:`ptztrack.occupancy.parameters.OccupancyParameters.min_box_score`) are not used. Every camera
 shares the PTZ camera's scene: its people (the annotations, scored) and its walkable area.
 
-The fixed cameras' tracker differs in three ways. Each view's calibration puts a person's feet on the
+The fixed cameras' tracker differs in four ways. Each view's calibration puts a person's feet on the
 ground somewhere else than the other views do, by an error that is unknown and, now and then, far
 larger than the pixel noise: under Gaussian noise such a detection falls outside the gate of the track
 the other cameras made certain, starts a second track of the same person, and keeps it. So the
 scenario's pixel noise is the scale of a Student-t noise of :data:`PUBLISHED_NOISE_DOF` degrees of
 freedom, which gates a far detection and lets it move its track less; a detection in the gate of a
-track starts no track (``TrackerParameters.birth`` 'outside_gates'); and what part of the error is
+track starts no track (``TrackerParameters.birth`` 'outside_gates'); what part of the error is
 common to a view's detections, its bias, is estimated as the run goes and taken off them
-(:mod:`ptztrack.track.sensor_bias`).
+(:mod:`ptztrack.track.sensor_bias`); and a track that only one fixed camera has detected is not reported
+until another camera detects it too (:attr:`~ptztrack.track.shared_belief.SharedBelief.needs_a_second_camera`).
 """
 
 from collections.abc import Sequence
@@ -136,6 +137,7 @@ def run_pets_network_episode(
         method,
     )
     tracker = belief_of_cameras([(scenario, camera) for camera in world.cameras])
+    tracker.needs_a_second_camera = frozenset(index for index, is_fixed in enumerate(fixed) if is_fixed)
     for camera, is_fixed in zip(tracker.cameras, fixed, strict=True):
         if is_fixed:
             camera.parameters = replace(camera.parameters, noise_dof=PUBLISHED_NOISE_DOF, birth="outside_gates")

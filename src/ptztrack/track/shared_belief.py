@@ -20,9 +20,18 @@ camera misses where it would have found the person loses existence by that
 camera's detection probability, and a track it does not look at keeps it
 (:mod:`ptztrack.track.tracker`), so the existence update is Bayes' rule for
 independent sensors too.
+
+Cameras in ``needs_a_second_camera`` do not get a track reported on their own:
+a track that only one of them has detected is reported once another camera
+has detected it too. A person stands where several cameras see, so a track
+that one camera alone keeps confirming is more likely its own duplicate of
+somebody (its calibration putting the feet elsewhere than the others') or
+its clutter than a person only it sees.
 """
 
 from dataclasses import dataclass, field
+
+import numpy as np
 
 from ptztrack.roles import ImageSource
 from ptztrack.track.tracker import EkfTracker
@@ -37,10 +46,15 @@ class SharedBelief:
 
     The motion model and what is reported are the first camera's tracker's parameters (a scenario gives
     every camera the same tracker section).
+
+    needs_a_second_camera : indices of the cameras whose detections alone do not get a track reported
+        (see the module's docstring); detected_by : each live track's id -> the cameras that have detected it.
     """
 
     cameras: tuple[EkfTracker, ...]
     tracks: Tracks = field(default_factory=Tracks.empty)
+    needs_a_second_camera: frozenset[int] = frozenset()
+    detected_by: dict[int, frozenset[int]] = field(default_factory=dict, repr=False)
 
     def __post_init__(self):
         if not self.cameras:
@@ -60,7 +74,15 @@ class SharedBelief:
     def reported(self) -> Tracks:
         first = self.cameras[0]
         first.tracks = self.tracks
-        return first.reported()
+        reported = first.reported()
+        if not self.needs_a_second_camera or len(self.cameras) < 2:
+            return reported
+        live = set(self.tracks.ids.tolist())
+        self.detected_by = {track: cameras for track, cameras in self.detected_by.items() if track in live}
+        found_by = [self.detected_by.get(int(track), frozenset()) for track in reported.ids]
+        return reported.select(
+            np.array([len(cameras) > 1 or not cameras <= self.needs_a_second_camera for cameras in found_by], bool)
+        )
 
 
 @dataclass(frozen=True)
@@ -79,4 +101,7 @@ class CameraUpdater:
         tracker.tracks = self.belief.tracks
         update = tracker.update(detections, pose, view, pose_sd)
         self.belief.tracks = update.tracks
+        detected_by = self.belief.detected_by
+        for track in update.track_ids.tolist():
+            detected_by[track] = detected_by.get(track, frozenset()) | {self.camera}
         return update
