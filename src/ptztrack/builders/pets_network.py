@@ -43,6 +43,7 @@ from ptztrack.camera.parameters import LandingError
 from ptztrack.camera.pose_feedback import commanded_pose
 from ptztrack.camera.virtual import virtual_ptz
 from ptztrack.config import Scenario, ScenarioError, pets_dataset
+from ptztrack.control.network_policy import NetworkInformationPolicy
 from ptztrack.detect.published import PublishedDetections
 from ptztrack.detect.simulated import RecallModel
 from ptztrack.loop import World, episode_seeds
@@ -50,6 +51,7 @@ from ptztrack.network_loop import NetworkEpisode, NetworkWorld, run_network_loop
 from ptztrack.occupancy.multiview import CameraView
 from ptztrack.occupancy.parameters import OccupancyParameters
 from ptztrack.track.sensor_bias import PixelBias
+from ptztrack.track.shared_belief import SharedBelief
 
 PUBLISHED_RECALL = 0.9
 """The fixed cameras' detector model: the probability that the published detector finds a person wholly
@@ -73,17 +75,21 @@ def published_views(scenario: Scenario) -> tuple[CameraView, ...]:
 
 
 def published_camera_world(
-    scenario: Scenario, scene: BuiltScene, view: CameraView, model_seed: np.random.SeedSequence | None = None
+    scenario: Scenario,
+    scene: BuiltScene,
+    view: CameraView,
+    video_frame: np.ndarray,
+    model_seed: np.random.SeedSequence | None = None,
 ) -> World:
-    """The fixed camera of ``view`` (its calibration and boxes) in the scene of ``scenario``'s recording
-    (see the module's docstring); model_seed : the stream of its detector model's draws."""
+    """The fixed camera of ``view`` (its calibration and boxes) in ``scene`` (see the module's docstring);
+    video_frame : (T,) the frame of the view's boxes each step shows; model_seed : the stream of its
+    detector model's draws."""
     if view.boxes is None or view.image_size_px is None:
         raise ScenarioError(f"{view.name}: a fixed camera of published detections needs its boxes and image size")
-    assert scene.recording is not None  # published_views asked for the recording
     virtual, pose = virtual_ptz(view.calibration, view.image_size_px, scenario.camera.image_size_px)
     grid = ActionGrid(pose[:1], pose[1:2], pose[2:])
     published = PublishedDetections(
-        virtual.camera, view.calibration, view.boxes, scene.recording.video_frame, OccupancyParameters.min_box_score
+        virtual.camera, view.calibration, view.boxes, video_frame, OccupancyParameters.min_box_score
     )
     return World(
         camera=virtual.camera,
@@ -111,8 +117,10 @@ def pets_network_world(scenario: Scenario, seed: int, ptz: bool, views: Sequence
     if ptz:
         worlds.append(camera_world(scenario, scene, tracker_seed=streams[4], model_seed=streams[5]))
     model_seeds = streams[5].spawn(len(views))
+    assert scene.recording is not None  # published_views asked for the recording
     worlds += [
-        published_camera_world(scenario, scene, view, seed) for view, seed in zip(views, model_seeds, strict=True)
+        published_camera_world(scenario, scene, view, scene.recording.video_frame, seed)
+        for view, seed in zip(views, model_seeds, strict=True)
     ]
     return NetworkWorld(tuple(worlds))
 
@@ -130,6 +138,21 @@ def run_pets_network_episode(
     information, one belief updated by every camera in turn (the fixed cameras' trackers as the module's
     docstring says; the PTZ camera's the one-camera run's)."""
     world = pets_network_world(scenario, seed, ptz, views)
+    policy, tracker = published_network_parts(scenario, world, ptz, coordination, method)
+    return run_network_loop(world, policy, tracker, seed)
+
+
+def published_network_parts(
+    scenario: Scenario,
+    world: NetworkWorld,
+    ptz: bool,
+    coordination: Coordination = "joint",
+    method: Literal["intg", "smpl"] = "intg",
+) -> tuple[NetworkInformationPolicy, SharedBelief]:
+    """The policy and the one belief of a network whose first camera is the PTZ camera (with ``ptz``)
+    and whose other cameras are fixed cameras of published boxes: every camera's information-gain
+    policy ``method`` deciding ``coordination``, and the fixed cameras' trackers as the module's
+    docstring says."""
     fixed = [index > 0 or not ptz for index in range(len(world.cameras))]
     policy = policy_of_cameras(
         [(scenario, camera, is_fixed) for camera, is_fixed in zip(world.cameras, fixed, strict=True)],
@@ -142,4 +165,4 @@ def run_pets_network_episode(
         if is_fixed:
             camera.parameters = replace(camera.parameters, noise_dof=PUBLISHED_NOISE_DOF, birth="outside_gates")
             camera.bias = PixelBias.centred(camera.V)
-    return run_network_loop(world, policy, tracker, seed)
+    return policy, tracker
