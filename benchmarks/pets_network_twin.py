@@ -59,6 +59,9 @@ MM_PER_M = 1000.0
 
 @dataclass(frozen=True)
 class TwinCell:
+    """One episode: configuration ``config`` ('ptz', '6fixed' or 'ptz+6fixed') on the walkers of ``seed``,
+    the fixed views' calibrations turned by N(0, ``sigma_deg``)."""
+
     config: str
     seed: int
     sigma_deg: float
