@@ -14,10 +14,10 @@ camera of boxes made from the walkers through the view's true calibration
 3 px of noise on feet and head, 0.1 ghost boxes a frame at a random point
 of the area), which its tracker reads through a calibration turned by
 N(0, sigma) about each axis: the views' disagreement of the real one.
-Every figure of the twin was fixed before it first ran. The fixed cameras'
-tracker is the PETS network's (:func:`ptztrack.builders.pets_network.published_network_parts`);
-``--report-single-view-tracks`` reports the tracks one fixed view alone
-has detected, as the network did before it withheld them.
+The fixed cameras' tracker is the PETS network's
+(:func:`ptztrack.builders.pets_network.published_network_parts`);
+``--report-single-view-tracks`` also reports the tracks one fixed view
+alone has detected (``SharedBelief.needs_a_second_camera`` empty).
 
 It prints MOTA (scored inside View_001's walkable area, as the PETS table
 is) per configuration and calibration error, and per seed.
@@ -46,7 +46,7 @@ from ptztrack.geometry.occlusion import occluded_fraction
 from ptztrack.loop import episode_seeds
 from ptztrack.network_loop import NetworkWorld, run_network_loop
 from ptztrack.occupancy.multiview import CameraView
-from ptztrack.occupancy.plaza import plaza_crowd
+from ptztrack.occupancy.plaza import camera_centre_m, plaza_crowd
 from ptztrack.scene.synthetic import walk_people
 from ptztrack.types import GroundTruth
 
@@ -80,7 +80,7 @@ def twin_walkers(people: int, steps: int, rate_hz: float, seed: int) -> GroundTr
 def turned_calibration(calibration: PinholeCalibration, sigma_deg: float, rng: np.random.Generator):
     """``calibration`` turned about its optical centre by N(0, sigma_deg) about each axis."""
     error = cv2.Rodrigues(np.deg2rad(rng.normal(0.0, sigma_deg, 3)))[0]
-    centre_mm = -calibration.R.T @ calibration.t
+    centre_mm = camera_centre_m(calibration) * MM_PER_M
     rotation = error @ calibration.R
     return replace(calibration, R=rotation, t=-rotation @ centre_mm)
 
@@ -90,7 +90,7 @@ def walker_boxes(truth: GroundTruth, calibration: PinholeCalibration, size_px, r
     in the calibrated view of ``size_px`` (width, height), and its ghosts (see the module's docstring)."""
     (x0, y0), (x1, y1) = plaza_layout().area_m
     width_px, height_px = size_px
-    centre_mm = -calibration.R.T @ calibration.t
+    centre_mm = camera_centre_m(calibration) * MM_PER_M
     boxes = []
     for positions_m in truth.positions_m:
         present = np.all(np.isfinite(positions_m), axis=1)

@@ -101,7 +101,9 @@ class CameraUpdater:
         tracker.tracks = self.belief.tracks
         update = tracker.update(detections, pose, view, pose_sd)
         self.belief.tracks = update.tracks
-        detected_by = self.belief.detected_by
-        for track in update.track_ids.tolist():
-            detected_by[track] = detected_by.get(track, frozenset()) | {self.camera}
+        # Only a belief that reads them keeps them: ``reported`` prunes them to the live tracks.
+        if self.belief.needs_a_second_camera:
+            detected_by = self.belief.detected_by
+            for track in update.track_ids.tolist():
+                detected_by[track] = detected_by.get(track, frozenset()) | {self.camera}
         return update
