@@ -102,6 +102,8 @@ def test_the_pets_network_rows_and_the_ptz_camera_alone_is_the_one_camera_run(tm
     assert [rows[label]["cameras"] for label in rows] == [7, 6, 1]
     for row in rows.values():
         assert {"mota", "mota_sd", "motp_m", "idf1", "mota_per_seed", "mota_all_tracks"} <= set(row)
+        in_area = {"mota_tracking_area", "idf1_tracking_area", "false_positives_tracking_area", "misses_tracking_area"}
+        assert in_area | {"mota_tracking_area_per_seed"} <= set(row)
         assert row["fixed_recall"] == PUBLISHED_RECALL
     scenario = pets_scenario("hog", frames=3, **{"control.beta": 9.0})
     alone = episode_metrics(run_episode(scenario, "intg", 0))

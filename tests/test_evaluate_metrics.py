@@ -1,7 +1,8 @@
 import numpy as np
 import pytest
 
-from ptztrack.evaluate.metrics import clear_metrics
+from ptztrack.evaluate.metrics import clear_metrics, truth_within
+from ptztrack.types import GroundTruth
 
 NAN = np.nan
 
@@ -44,3 +45,20 @@ def test_frames_without_tracks_count_as_misses():
     metrics = clear_metrics(truth, [np.zeros(0, int)] * 4, [np.zeros((0, 2))] * 4)
     assert metrics["misses"] == 8
     assert metrics["mota"] == pytest.approx(0.0)
+
+
+def test_truth_within_a_polygon_keeps_people_only_at_the_steps_their_feet_are_inside():
+    positions_m = np.array(
+        [
+            [[1.0, 1.0], [5.0, 1.0]],
+            [[1.5, 1.0], [np.nan, np.nan]],
+            [[2.5, 1.0], [1.0, 1.9]],
+        ]
+    )
+    truth = GroundTruth(positions_m, np.array([1.7, 1.8]), np.array([0.5, 0.5]), 5.0)
+    cut = truth_within(truth, [[0.0, 0.0], [2.0, 0.0], [2.0, 2.0], [0.0, 2.0]])
+    expected = positions_m.copy()
+    expected[0, 1] = expected[2, 0] = np.nan
+    np.testing.assert_array_equal(cut.positions_m, expected)
+    np.testing.assert_array_equal(cut.heights_m, truth.heights_m)
+    np.testing.assert_array_equal(truth.positions_m[0, 1], [5.0, 1.0])

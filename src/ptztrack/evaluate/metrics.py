@@ -7,6 +7,7 @@ figure's mean.
 """
 
 from collections.abc import Sequence
+from dataclasses import replace
 
 import motmetrics as mm
 import numpy as np
@@ -99,6 +100,16 @@ def tracks_within(tracks: list[Tracks], polygon_m) -> list[Tracks]:
     """Each step's tracks whose ground position lies inside the polygon (K, 2) m: the ones a truth
     annotated only there can score."""
     return [step.select(inside(polygon_m, step.mean[:, :2])) if len(step) else step for step in tracks]
+
+
+def truth_within(truth: GroundTruth, polygon_m) -> GroundTruth:
+    """``truth`` with every person absent (NaN) at the steps their feet lie outside the polygon (K, 2) m."""
+    positions_m = truth.positions_m.copy()
+    present = truth.present
+    outside = np.zeros_like(present)
+    outside[present] = ~inside(polygon_m, positions_m[present])
+    positions_m[outside] = np.nan
+    return replace(truth, positions_m=positions_m)
 
 
 def tracking_metrics(truth: GroundTruth, tracks: list[Tracks]) -> dict:

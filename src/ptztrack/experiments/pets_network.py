@@ -12,7 +12,11 @@ Scoring. The annotations are View_001's: they hold the people View_001 shows, no
 views see. So the tracks are scored where the annotations are, inside the walkable area (the ground
 the recorded View_001 shows, the area the PTZ camera's policies plan over); ``mota_all_tracks`` scores
 every track, as ``experiment pets`` does (for ``ptz`` it is that table's ``intg`` column of the same
-beta, seed by seed: ``mota_all_tracks_per_seed``).
+beta, seed by seed: ``mota_all_tracks_per_seed``). The walkable area reaches 40 m beyond where anybody
+is annotated, where the annotators marked nobody, not even people View_001 shows on the paths behind
+the plaza; the ``*_tracking_area`` figures score the tracks and the people inside S2.L1's published
+tracking area (:data:`ptztrack.config.PETS_TRACKING_AREA_M`), where the annotations are those of
+published tracking results.
 """
 
 from collections.abc import Sequence
@@ -22,19 +26,35 @@ from typing import Literal
 import numpy as np
 
 from ptztrack.builders.pets_network import run_pets_network_episode
-from ptztrack.config import Scenario
-from ptztrack.evaluate.metrics import DISPLAY, looking_metrics, tracking_metrics, tracks_within
+from ptztrack.config import PETS_TRACKING_AREA_M, Scenario
+from ptztrack.evaluate.metrics import DISPLAY, looking_metrics, tracking_metrics, tracks_within, truth_within
+from ptztrack.geometry.area import rectangle_m
 from ptztrack.experiments.cells import Execution, run_experiment_cells
 from ptztrack.occupancy.multiview import CameraView
 
 # (label, with the PTZ camera, with the fixed views), in the table's order.
 CONFIGURATIONS = (("ptz+6fixed", True, True), ("6fixed", False, True), ("ptz", True, False))
-SUMMARY_KEYS = ("mota", "motp_m", "idf1", "false_positives", "misses", "switches", "mota_all_tracks", "detections")
+TRACKING_AREA_KEYS = ("mota", "idf1", "false_positives", "misses")
+SUMMARY_KEYS = (
+    "mota",
+    "motp_m",
+    "idf1",
+    "false_positives",
+    "misses",
+    "switches",
+    "mota_all_tracks",
+    *(f"{key}_tracking_area" for key in TRACKING_AREA_KEYS),
+    "detections",
+)
 SHOWN = {
     "false_positives": ("FP", "{:.1f}"),
     "misses": ("Misses", "{:.1f}"),
     "switches": ("IDsw", "{:.1f}"),
     "mota_all_tracks": ("MOTA all", "{:.1%}"),
+    "mota_tracking_area": ("MOTA TA", "{:.1%}"),
+    "idf1_tracking_area": ("IDF1 TA", "{:.1%}"),
+    "false_positives_tracking_area": ("FP TA", "{:.1f}"),
+    "misses_tracking_area": ("Misses TA", "{:.1f}"),
 }
 
 
@@ -65,18 +85,28 @@ def pets_network_cells(
 
 def run_pets_network_cell(cell: PetsNetworkCell) -> dict:
     """One cell's figures: the tracks inside the walkable area scored (:func:`tracking_metrics`),
-    ``mota_all_tracks`` with every track, and the cameras' detections and zoom."""
+    ``mota_all_tracks`` with every track, the ``*_tracking_area`` figures of the tracks and people inside
+    the tracking area, and the cameras' detections and zoom."""
     episode = run_pets_network_episode(cell.scenario, cell.seed, cell.ptz, cell.views, "joint", cell.method)
     scored = tracking_metrics(episode.truth, tracks_within(episode.tracks, episode.area_polygon_m))
     every = tracking_metrics(episode.truth, episode.tracks)
+    (x0, y0), (x1, y1) = PETS_TRACKING_AREA_M
+    tracking_area = rectangle_m(x1 - x0, y1 - y0) + (x0, y0)
+    in_area = tracking_metrics(truth_within(episode.truth, tracking_area), tracks_within(episode.tracks, tracking_area))
     row = {"config": cell.config, "seed": cell.seed, "cameras": len(episode.cameras)}
-    return {**row, **scored, "mota_all_tracks": every["mota"], **looking_metrics(episode.cameras)}
+    return {
+        **row,
+        **scored,
+        "mota_all_tracks": every["mota"],
+        **{f"{key}_tracking_area": in_area[key] for key in TRACKING_AREA_KEYS},
+        **looking_metrics(episode.cameras),
+    }
 
 
 def summarise_pets_network(rows: Sequence[dict]) -> list[dict]:
     """One row per configuration, in order of first appearance: the means of :data:`SUMMARY_KEYS` and
-    ``zoom`` over its seeds, ``seeds``, ``mota_sd`` (over the seeds; 0 for one), ``mota_per_seed`` and
-    ``mota_all_tracks_per_seed``."""
+    ``zoom`` over its seeds, ``seeds``, ``mota_sd`` (over the seeds; 0 for one), ``mota_per_seed``,
+    ``mota_all_tracks_per_seed`` and ``mota_tracking_area_per_seed``."""
     summary = []
     for label in dict.fromkeys(row["config"] for row in rows):
         mine = sorted((row for row in rows if row["config"] == label), key=lambda row: row["seed"])
@@ -90,6 +120,7 @@ def summarise_pets_network(rows: Sequence[dict]) -> list[dict]:
                 "mota_sd": float(np.std(mota, ddof=1)) if len(mota) > 1 else 0.0,
                 "mota_per_seed": mota,
                 "mota_all_tracks_per_seed": [row["mota_all_tracks"] for row in mine],
+                "mota_tracking_area_per_seed": [row["mota_tracking_area"] for row in mine],
                 "objects": mine[0]["objects"],
             }
         )
@@ -105,7 +136,8 @@ def run_pets_network_table(cells: list[PetsNetworkCell], execution: Execution) -
 
 def format_pets_network_table(summary: Sequence[dict], title: str = "") -> str:
     """A row per configuration: MOTA +- its standard deviation over the seeds, MOTP, IDF1, false positives,
-    misses, identity switches, MOTA with every track scored, detections and zoom."""
+    misses, identity switches, MOTA with every track scored, the tracking area's MOTA, IDF1, false
+    positives and misses, detections and zoom."""
     shown = {**DISPLAY, **SHOWN}
     width = max(len(row["config"]) for row in summary) + 2
     keys = (*SUMMARY_KEYS[1:], "zoom")
@@ -123,5 +155,6 @@ def pets_network_title(scenario: Scenario, seeds: int, method: str, recall: floa
         f"camera network on PETS 2009 S2.L1: the virtual PTZ camera over View_001 ({scenario.detector.kind}, "
         f"{method} b{scenario.control.beta:g}, {scenario.detector.model} model) and the published detections of "
         f"View_003-008 as fixed cameras (recall {recall:g}), {scenario.frames} steps, {seeds} seeds with the PTZ "
-        "camera (MOTA +- standard deviation over seeds; tracks scored inside View_001's walkable area)"
+        "camera (MOTA +- standard deviation over seeds; tracks scored inside View_001's walkable area, TA: tracks "
+        "and people inside the tracking area)"
     )
