@@ -6,6 +6,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from ptztrack.config import PETS_TRACKING_AREA_M
 from ptztrack.geometry.calibration import (
     CalibrationError,
     imaged_radius,
@@ -18,7 +19,6 @@ from ptztrack.geometry.calibration import (
     project_pinhole,
     project_tsai,
 )
-from ptztrack.config import PETS_TRACKING_AREA_M
 from ptztrack.scene.pets import DatasetError, load_cvml, load_mot_ground_truth, read_video, recorded_scene
 
 EXCERPT = Path(__file__).parent / "data" / "pets_s2l1_excerpt"

@@ -28,8 +28,8 @@ import numpy as np
 from ptztrack.builders.pets_network import run_pets_network_episode
 from ptztrack.config import PETS_TRACKING_AREA_M, Scenario
 from ptztrack.evaluate.metrics import DISPLAY, looking_metrics, tracking_metrics, tracks_within, truth_within
-from ptztrack.geometry.area import rectangle_m
 from ptztrack.experiments.cells import Execution, run_experiment_cells
+from ptztrack.geometry.area import rectangle_m
 from ptztrack.occupancy.multiview import CameraView
 
 # (label, with the PTZ camera, with the fixed views), in the table's order.
