@@ -6,6 +6,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from ptztrack.camera.actions import ActionGrid
+from ptztrack.control.exploration import exploration_map
 from ptztrack.control.information_gain import detection_weight_integral
 from ptztrack.control.information_policy import InformationGainPolicy
 from ptztrack.control.network_policy import NetworkCamera, NetworkInformationPolicy, expected_posterior
@@ -135,7 +136,7 @@ def test_the_greedy_choice_is_within_half_of_the_best_joint_one(people, cameras,
     policies = (SOUTH, EAST, NORTH)[:cameras]
     rng = np.random.default_rng(seed)
     reachable = [np.sort(rng.choice(policy.grid.size, 5, replace=False)) for policy in policies]
-    network = NetworkInformationPolicy(tuple(NetworkCamera(policy) for policy in policies))
+    network = NetworkInformationPolicy(tuple(NetworkCamera(policy) for policy in policies), best_response_rounds=0)
     greedy = network.choose(contexts(tracks, policies, reachable))
     value = expected_information_nats(tracks, list(zip(policies, greedy, strict=True)))
     best = max(
@@ -154,10 +155,41 @@ def test_one_view_per_camera_can_leave_the_greedy_choice_below_1_minus_1_over_e(
     south, north = (replace(policy, recall=RecallModel(1.0, 0.0, perfect=True)) for policy in (SOUTH, NORTH))
     a_south, b_south = (nearest_view(south, person, 3.0) for person in (a_m, b_m))
     a_north = nearest_view(north, a_m, 3.0)
-    network = NetworkInformationPolicy((NetworkCamera(south), NetworkCamera(north)))
+    network = NetworkInformationPolicy((NetworkCamera(south), NetworkCamera(north)), best_response_rounds=0)
     reachable = [np.array([a_south, b_south]), np.array([a_north])]
     greedy = network.choose(contexts(tracks, (south, north), reachable))
     assert greedy == [a_south, a_north]
     value = expected_information_nats(tracks, [(south, a_south), (north, a_north)])
     best = expected_information_nats(tracks, [(south, b_south), (north, a_north)])
     assert 0.5 * best <= value < (1 - 1 / np.e) * best
+
+
+def test_a_round_of_best_responses_turns_the_first_camera_to_what_only_it_can_see():
+    """The case above: greedy, camera 1 takes A and leaves camera 2 A's leftovers; answering camera 2's
+    view of A, camera 1 turns to B, the best joint choice."""
+    a_m, b_m = [3.0, 8.0], [12.0, 8.0]
+    tracks = tracks_at([a_m, b_m], [1.5, 1.45])
+    south, north = (replace(policy, recall=RecallModel(1.0, 0.0, perfect=True)) for policy in (SOUTH, NORTH))
+    a_south, b_south = (nearest_view(south, person, 3.0) for person in (a_m, b_m))
+    a_north = nearest_view(north, a_m, 3.0)
+    network = NetworkInformationPolicy((NetworkCamera(south), NetworkCamera(north)), best_response_rounds=1)
+    reachable = [np.array([a_south, b_south]), np.array([a_north])]
+    assert network.choose(contexts(tracks, (south, north), reachable)) == [b_south, a_north]
+
+
+def test_best_responses_move_each_cameras_patrolling_map_once_a_step_by_its_final_view():
+    a_m, b_m = [3.0, 8.0], [12.0, 8.0]
+    tracks = tracks_at([a_m, b_m], [1.5, 1.45])
+    area_m = [[0.0, 0.0], [15.0, 0.0], [15.0, 15.0], [0.0, 15.0]]
+    policies = []
+    for policy in (SOUTH, NORTH):
+        perfect = RecallModel(1.0, 0.0, perfect=True)
+        patrol = exploration_map(policy.camera, policy.grid.poses, area_m, perfect, 1.75, 1.0, 1.0, 0.1, 0.2)
+        policies.append(replace(policy, recall=perfect, beta=0.1, exploration=patrol))
+    before = [policy.exploration.occupancy.copy() for policy in policies]
+    network = NetworkInformationPolicy(tuple(NetworkCamera(policy) for policy in policies), best_response_rounds=3)
+    choices = network.choose(contexts(tracks, policies))
+    for policy, occupancy, action in zip(policies, before, choices, strict=True):
+        once = replace(policy.exploration, occupancy=occupancy)
+        once.advance(action)
+        np.testing.assert_array_equal(policy.exploration.occupancy, once.occupancy)

@@ -119,14 +119,22 @@ class InformationGainPolicy:
         return RewardTerms(actions, tracks.ids, track_nats, patrol_nats)
 
     def choose(self, context: DecisionContext) -> int:
+        action = self.best_action(context)
+        self.advance_exploration(action, context.dt_s)
+        return action
+
+    def best_action(self, context: DecisionContext) -> int:
+        """The action of largest reward among ``context.reachable`` (staying where no other is strictly
+        better), without moving the patrolling map on: what :meth:`choose` would pick."""
         self.last_terms = self.reward_terms(context.reachable, context.tracks, context.rng)
         reward = self.last_terms.total_nats
         best = int(np.argmax(reward))
         staying = np.flatnonzero(context.reachable == context.current_action)
         if len(staying) and reward[staying[0]] >= reward[best]:
-            action = context.current_action
-        else:
-            action = int(context.reachable[best])
+            return context.current_action
+        return int(context.reachable[best])
+
+    def advance_exploration(self, action: int, dt_s: float | None = None) -> None:
+        """The patrolling map one step on, the camera having looked with ``action`` (none: nothing)."""
         if self.exploration is not None:
-            self.exploration.advance(action, context.dt_s)
-        return action
+            self.exploration.advance(action, dt_s)

@@ -1,4 +1,4 @@
-"""Where the cameras of a network look: together, greedily, by expected information.
+"""Where the cameras of a network look: together, greedily and then by best responses, by expected information.
 
 The objective. For a set of views ``S`` (one per camera) and a track of
 prior covariance ``P``, camera ``k``'s view detects the person with
@@ -47,6 +47,23 @@ view that localises an occluder changes whether another view can see the
 person behind it (complementary views), the value of a set of views is no
 longer a fixed mixture of diminishing returns at all, and no greedy bound holds.
 
+Best responses. In the greedy order the first camera takes what is worth
+most to it, though a later camera may see it better and have little else
+to see (two cameras facing each other across the area, each nearer some of
+the people). So after the greedy pass each PTZ camera in turn chooses
+again, on the tracks as every other camera's chosen view is expected to
+leave them,
+
+    P_-k = (P^-1 + sum_{j != k} alpha_j Phi_j)^-1,
+
+``alpha_j`` and ``C_j`` at the prior (so that the order of the others does
+not matter), in rounds until a round changes no choice, at most
+``best_response_rounds``. A response raises the responding camera's own
+reward given the others, not ``F`` itself (a camera scores a view as
+``alpha I`` on ``P_-k``, and ``F``'s marginal gain under the approximation
+is ``1/2 log det(I + alpha P_-k Phi)``), so no bound is claimed for it and
+the cap stops any cycle.
+
 Independent choice (``joint`` False): every PTZ camera chooses by its own
 policy on the prior, as if alone.
 """
@@ -84,16 +101,26 @@ def expected_posterior(tracks: Tracks, policy: InformationGainPolicy, action: in
     """
     if len(tracks) == 0:
         return tracks
-    geometry = policy.geometry
-    mean_m, position_cov_m2 = tracks.mean[:, :2], tracks.covariance[:, :2, :2]
-    alpha = detection_weight_integral(
-        policy.camera, geometry, policy.recall, mean_m, position_cov_m2, policy.V, actions=[action]
-    )[0]
+    alpha = view_detection_probability(tracks, policy, action)
     seen = np.flatnonzero(alpha > 0)
     # C = [dg/dx 0]: (k, 2, 4), the feet pixel's Jacobian at the predicted means, zero for the velocity.
-    position_block = homography_jacobian(geometry.ground_to_image[action], mean_m[seen])
+    position_block = homography_jacobian(policy.geometry.ground_to_image[action], tracks.mean[seen, :2])
     C = np.concatenate([position_block, np.zeros_like(position_block)], axis=-1)
     return expected_update(tracks, seen, alpha[seen], C, policy.V)
+
+
+def view_detection_probability(tracks: Tracks, policy: InformationGainPolicy, action: int) -> np.ndarray:
+    """The closed-form probability (n,) that the view of ``policy``'s grid action ``action`` detects each
+    track, were its person there (equation 8, no occlusion)."""
+    return detection_weight_integral(
+        policy.camera,
+        policy.geometry,
+        policy.recall,
+        tracks.mean[:, :2],
+        tracks.covariance[:, :2, :2],
+        policy.V,
+        actions=[action],
+    )[0]
 
 
 def expected_update(tracks: Tracks, seen, alpha, C, V) -> Tracks:
@@ -111,15 +138,32 @@ def expected_update(tracks: Tracks, seen, alpha, C, V) -> Tracks:
     return replace(tracks, covariance=covariance)
 
 
+def view_information(tracks: Tracks, policy: InformationGainPolicy, action: int) -> np.ndarray:
+    """(n, 4, 4) the expected information ``alpha C^T V^-1 C`` the view of ``policy``'s grid action
+    ``action`` adds to each track's information matrix ``P^-1`` (the module's approximation), alpha and
+    ``C = [dg/dx 0]`` at the tracks as given."""
+    information = np.zeros((len(tracks), 4, 4))
+    if len(tracks) == 0:
+        return information
+    alpha = view_detection_probability(tracks, policy, action)
+    seen = np.flatnonzero(alpha > 0)
+    position_block = homography_jacobian(policy.geometry.ground_to_image[action], tracks.mean[seen, :2])
+    C = np.concatenate([position_block, np.zeros_like(position_block)], axis=-1)
+    information[seen] = alpha[seen, None, None] * (np.swapaxes(C, -1, -2) @ np.linalg.solve(policy.V, C))
+    return information
+
+
 @dataclass
 class NetworkInformationPolicy:
     """Every camera's next action (:class:`ptztrack.roles.NetworkPolicy`): fixed cameras keep theirs; PTZ
     cameras choose by expected information, jointly (``joint``: greedily in the network's order, each on
-    the tracks the views before it are expected to leave; see the module's docstring) or each alone on
-    the prior."""
+    the tracks the views before it are expected to leave, then at most ``best_response_rounds`` rounds of
+    best responses; see the module's docstring) or each alone on the prior. Each camera's patrolling map
+    moves on once a step, by its final view."""
 
     cameras: tuple[NetworkCamera, ...]
     joint: bool = True
+    best_response_rounds: int = 3
 
     def choose(self, contexts) -> list[int | np.ndarray]:
         if len(contexts) != len(self.cameras):
@@ -134,11 +178,42 @@ class NetworkInformationPolicy:
             if camera.fixed_action is not None:
                 choices[k] = camera.fixed_action
             else:
-                choices[k] = camera.policy.choose(_with_tracks(context, tracks))
+                choices[k] = camera.policy.best_action(_with_tracks(context, tracks))
             # PTZ cameras come last: every camera but the last has one after it that will read the tracks.
             if self.joint and ptz and position < len(order) - 1:
                 tracks = expected_posterior(tracks, camera.policy, choices[k])
+        if self.joint and len(ptz) > 1 and self.best_response_rounds > 0:
+            self._respond(contexts, choices, ptz)
+        for k in ptz:
+            self.cameras[k].policy.advance_exploration(choices[k], contexts[k].dt_s)
         return [choices[k] for k in range(len(self.cameras))]
+
+    def _respond(self, contexts, choices: dict[int, int], ptz: list[int]) -> None:
+        """Rounds of best responses after the greedy pass: each PTZ camera in turn chooses again on the
+        tracks as every other camera's chosen view is expected to leave them, ``P_-k = (P^-1 + sum_{j != k}
+        alpha_j Phi_j)^-1`` (alpha and the Jacobians at the prior); until a round changes no choice, at
+        most ``best_response_rounds`` rounds. ``choices`` is updated in place."""
+        prior: Tracks = contexts[0].tracks
+        if len(prior) == 0:
+            return
+        added = {k: view_information(prior, self.cameras[k].policy, choices[k]) for k in choices}
+        total = np.linalg.inv(prior.covariance) + sum(added.values())
+        for _ in range(self.best_response_rounds):
+            changed = False
+            for k in ptz:
+                others = replace(prior, covariance=_symmetric(np.linalg.inv(total - added[k])))
+                action = self.cameras[k].policy.best_action(_with_tracks(contexts[k], others))
+                if action != choices[k]:
+                    choices[k], changed = action, True
+                    total = total - added[k]
+                    added[k] = view_information(prior, self.cameras[k].policy, action)
+                    total = total + added[k]
+            if not changed:
+                return
+
+
+def _symmetric(matrices: np.ndarray) -> np.ndarray:
+    return 0.5 * (matrices + np.swapaxes(matrices, -1, -2))
 
 
 def _with_tracks(context: DecisionContext, tracks: Tracks) -> DecisionContext:
