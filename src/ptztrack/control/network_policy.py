@@ -101,12 +101,17 @@ def expected_posterior(tracks: Tracks, policy: InformationGainPolicy, action: in
     """
     if len(tracks) == 0:
         return tracks
+    alpha, seen, C = _view_measurement(tracks, policy, action)
+    return expected_update(tracks, seen, alpha[seen], C, policy.V)
+
+
+def _view_measurement(tracks: Tracks, policy: InformationGainPolicy, action: int):
+    """The view's detection probabilities alpha (n,), the tracks it may detect ``seen`` (k,) and their
+    ``C = [dg/dx 0]`` (k, 2, 4): the feet pixel's Jacobian at the predicted means, zero for the velocity."""
     alpha = view_detection_probability(tracks, policy, action)
     seen = np.flatnonzero(alpha > 0)
-    # C = [dg/dx 0]: (k, 2, 4), the feet pixel's Jacobian at the predicted means, zero for the velocity.
     position_block = homography_jacobian(policy.geometry.ground_to_image[action], tracks.mean[seen, :2])
-    C = np.concatenate([position_block, np.zeros_like(position_block)], axis=-1)
-    return expected_update(tracks, seen, alpha[seen], C, policy.V)
+    return alpha, seen, np.concatenate([position_block, np.zeros_like(position_block)], axis=-1)
 
 
 def view_detection_probability(tracks: Tracks, policy: InformationGainPolicy, action: int) -> np.ndarray:
@@ -145,10 +150,7 @@ def view_information(tracks: Tracks, policy: InformationGainPolicy, action: int)
     information = np.zeros((len(tracks), 4, 4))
     if len(tracks) == 0:
         return information
-    alpha = view_detection_probability(tracks, policy, action)
-    seen = np.flatnonzero(alpha > 0)
-    position_block = homography_jacobian(policy.geometry.ground_to_image[action], tracks.mean[seen, :2])
-    C = np.concatenate([position_block, np.zeros_like(position_block)], axis=-1)
+    alpha, seen, C = _view_measurement(tracks, policy, action)
     information[seen] = alpha[seen, None, None] * (np.swapaxes(C, -1, -2) @ np.linalg.solve(policy.V, C))
     return information
 
