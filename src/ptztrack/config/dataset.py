@@ -203,7 +203,7 @@ PETS_OCCUPANCY = {"cell_m": 0.1, "kernel_sigma_m": 0.25}
 PETS_TRACKING_AREA_M = ((-14.0696, -14.274), (4.9813, 1.9615))
 """S2.L1's tracking area, ((x0, y0), (x1, y1)) m: the rectangle of published tracking results, whose
 annotated people are A. Milan's cropped annotations (``PETS2009-S2L1-cropped.xml.gz``, shipped with the
-data: exactly the rows of ``gt_mot15.txt`` whose feet lie in it)."""
+data: the rows of ``gt_mot15.txt`` whose feet lie in it, but for a few within 0.25 m of its edge)."""
 
 
 def pets_dataset(**overrides) -> MultiViewDataset:
