@@ -46,8 +46,7 @@ from ptztrack.geometry.occlusion import occluded_fraction
 from ptztrack.loop import episode_seeds
 from ptztrack.network_loop import NetworkWorld, run_network_loop
 from ptztrack.occupancy.multiview import CameraView
-from ptztrack.occupancy.plaza import camera_centre_m, plaza_crowd
-from ptztrack.scene.synthetic import walk_people
+from ptztrack.occupancy.plaza import camera_centre_m, plaza_truth
 from ptztrack.types import GroundTruth
 
 FIRST_SEED = 1000
@@ -67,14 +66,6 @@ class TwinCell:
     sigma_deg: float
     people: int
     report_single_view_tracks: bool
-
-
-def twin_walkers(people: int, steps: int, rate_hz: float, seed: int) -> GroundTruth:
-    """``people`` walkers over the plaza's area for ``steps`` steps at ``rate_hz``, drawn from ``seed``."""
-    layout = plaza_layout()
-    (x0, y0), (x1, y1) = layout.area_m
-    truth = walk_people(plaza_crowd(layout, people), (x1 - x0, y1 - y0), steps, rate_hz, np.random.default_rng(seed))
-    return replace(truth, positions_m=truth.positions_m + np.array([x0, y0]))
 
 
 def turned_calibration(calibration: PinholeCalibration, sigma_deg: float, rng: np.random.Generator):
@@ -145,7 +136,8 @@ def twin_episode(cell: TwinCell) -> dict:
     )
     streams = episode_seeds(cell.seed)
     recorded = build_scene(pets, np.random.default_rng(streams[0]))
-    truth = twin_walkers(cell.people, scenario.frames, scenario.frame_rate_hz, cell.seed)
+    at_step_rate = replace(plaza_layout(), frame_rate_hz=scenario.frame_rate_hz)
+    truth = plaza_truth(at_step_rate, cell.people, scenario.frames, cell.seed)
     scene = BuiltScene(recorded.camera, recorded.grid, truth, recorded.area_polygon_m)
     ptz = cell.config != "6fixed"
     worlds = []
