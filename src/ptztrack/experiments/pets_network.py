@@ -12,11 +12,10 @@ Scoring. The annotations are View_001's: they hold the people View_001 shows, no
 views see. So the tracks are scored where the annotations are, inside the walkable area (the ground
 the recorded View_001 shows, the area the PTZ camera's policies plan over); ``mota_all_tracks`` scores
 every track, as ``experiment pets`` does (for ``ptz`` it is that table's ``intg`` column of the same
-beta, seed by seed: ``mota_all_tracks_per_seed``). The walkable area reaches 40 m beyond where anybody
-is annotated, where the annotators marked nobody, not even people View_001 shows on the paths behind
-the plaza; the ``*_tracking_area`` figures score the tracks and the people inside S2.L1's published
-tracking area (:data:`ptztrack.config.PETS_TRACKING_AREA_M`), where the annotations are those of
-published tracking results.
+beta, seed by seed: ``mota_all_tracks_per_seed``). The walkable area reaches far beyond the ground the
+annotators covered, so the ``*_tracking_area`` figures score the tracks and the people inside S2.L1's
+published tracking area (:data:`ptztrack.config.PETS_TRACKING_AREA_M`), where the annotations are those
+of published tracking results.
 """
 
 from collections.abc import Sequence
