@@ -3,6 +3,8 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
+from hypothesis import assume, given, settings
+from hypothesis import strategies as st
 from scipy.stats import chi2
 
 from ptztrack.geometry.ptz import PTZCamera, apply_homography, feet_jacobian, ground_to_image, look_at
@@ -16,9 +18,11 @@ from ptztrack.track.tracker import (
     birth_exposure,
     existence_after_detection,
     existence_after_miss,
+    gate_in_front,
     innovation_likelihood,
     observation_matrix,
     predict_tracks,
+    start_ground_tracks,
     start_tracks,
     student_t_noise,
     update_own_tracks,
@@ -402,3 +406,58 @@ def test_the_tracker_reports_only_tracks_sure_enough_to_exist():
     tracker.predict()
     tracker.update(Detections(start, np.array([np.nan]), np.array([-1])), POSE, None)
     assert len(tracker.reported()) == 1 and tracker.tracks.existence[0] == pytest.approx(0.99)
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    x_m=st.floats(-20.0, 35.0),
+    y_m=st.floats(-12.0, 30.0),
+    sigma_x_m=st.floats(0.05, 20.0),
+    sigma_y_m=st.floats(0.05, 20.0),
+    rho=st.floats(-0.95, 0.95),
+    pan_deg=st.floats(-90.0, 90.0),
+    gate_probability=st.floats(0.5, 0.999),
+)
+def test_a_gate_lies_in_front_exactly_when_every_point_of_its_ellipse_does(
+    x_m, y_m, sigma_x_m, sigma_y_m, rho, pan_deg, gate_probability
+):
+    """The depth along the optical axis over the gate's ellipse, sampled on its boundary, has its least
+    value where :func:`gate_in_front` puts it, so the gate is in front exactly when the whole ellipse is."""
+    pose = POSE + np.array([pan_deg, 0.0, 0.0])
+    covariance = np.zeros((1, 4, 4))
+    covariance[0, :2, :2] = [
+        [sigma_x_m**2, rho * sigma_x_m * sigma_y_m],
+        [rho * sigma_x_m * sigma_y_m, sigma_y_m**2],
+    ]
+    mean = np.array([[x_m, y_m, 0.0, 0.0]])
+    angle = np.linspace(0.0, 2 * np.pi, 4001)
+    boundary = (
+        mean[0, :2]
+        + math.sqrt(chi2.ppf(gate_probability, df=2))
+        * (np.linalg.cholesky(covariance[0, :2, :2]) @ np.stack([np.cos(angle), np.sin(angle)])).T
+    )
+    h = ground_to_image(CAMERA, pose)[2]
+    least_depth = np.min(boundary @ h[:2] + h[2])
+    assume(abs(least_depth) > 1e-3 * np.linalg.norm(h[:2]) * max(sigma_x_m, sigma_y_m))
+    assert gate_in_front(CAMERA, pose, mean, covariance, gate_probability)[0] == (least_depth > 0)
+
+
+@pytest.mark.parametrize("sigma_m, paired", [(2.0, True), (15.0, False)])
+def test_a_detection_is_paired_only_with_a_track_whose_gate_lies_in_front_of_the_camera(sigma_m, paired):
+    """A track 10 m in front of the camera, 15 m uncertain: its gate reaches behind the camera, its feet
+    pixel's linearised innovation covariance is huge, and the pixel gate would hold a detection 20 px
+    from its predicted feet; that detection starts a track of its own and leaves the uncertain one as
+    it was (the detector is taken not to have seen it, so that it survives the step). The same track 2 m
+    uncertain is updated by it."""
+    tracks = start_ground_tracks(np.array([[7.5, 6.0]]), sigma_m**2 * np.eye(2)[None], 0.9, first_id=0)
+    detection = feet_px([[7.5, 6.0]]) + [[20.0, 0.0]]
+    C = observation_matrix(CAMERA, POSE, tracks.mean)
+    S = kalman.innovation_covariance(tracks.covariance, C, V)[0]
+    innovation = detection[0] - feet_px([[7.5, 6.0]])[0]
+    assert innovation @ np.linalg.solve(S, innovation) < chi2.ppf(CONFIG.gate_probability, df=2)
+    assert gate_in_front(CAMERA, POSE, tracks.mean, tracks.covariance, CONFIG.gate_probability)[0] == paired
+    updated = update_tracks(tracks, detection, CAMERA, POSE, V, CONFIG, detectable=np.zeros(1)).tracks
+    assert len(updated) == (1 if paired else 2)
+    if not paired:
+        np.testing.assert_array_equal(updated.covariance[0], tracks.covariance[0])
+        np.testing.assert_array_equal(updated.mean[0], tracks.mean[0])

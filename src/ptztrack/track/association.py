@@ -8,34 +8,35 @@ from scipy.optimize import linear_sum_assignment
 from scipy.stats import chi2, f
 
 
-def gated_innovations(predicted_px, in_front, S, feet_px, gate_probability: float):
+def gated_innovations(predicted_px, pairable, S, feet_px, gate_probability: float):
     """Innovations of every track w.r.t. every detection, and the chi-square gate.
 
-    predicted_px : (n, 2) and in_front : (n,) from :func:`~ptztrack.track.tracker.predicted_feet_px`;
+    predicted_px : (n, 2) from :func:`~ptztrack.track.tracker.predicted_feet_px`; pairable : (n,) the
+    tracks a detection may be paired with (:func:`~ptztrack.track.tracker.gate_in_front`);
     S : (n, 2, 2) innovation covariances; feet_px : (K, 2) detections.
     Returns the innovations (n, K, 2) ``feet - predicted``, their squared
     Mahalanobis distances (n, K), and which pairs are allowed (n, K): those
     within the chi-square quantile ``gate_probability`` (2 degrees of
-    freedom) of tracks in front of the camera.
+    freedom) of pairable tracks.
     """
     residual = feet_px[None, :, :] - predicted_px[:, None, :]
     distance2 = np.einsum("tdi,tij,tdj->td", residual, np.linalg.inv(S), residual)
-    allowed = in_front[:, None] & (distance2 <= chi2.ppf(gate_probability, df=2))
+    allowed = pairable[:, None] & (distance2 <= chi2.ppf(gate_probability, df=2))
     return residual, distance2, allowed
 
 
-def associate(predicted_px, in_front, S, feet_px, gate_probability: float) -> tuple[np.ndarray, np.ndarray]:
+def associate(predicted_px, pairable, S, feet_px, gate_probability: float) -> tuple[np.ndarray, np.ndarray]:
     """Hungarian assignment of detections to predicted tracks on the Mahalanobis distance.
 
-    predicted_px : (n, 2) and in_front : (n,) from :func:`~ptztrack.track.tracker.predicted_feet_px`;
+    predicted_px : (n, 2) and pairable : (n,) as for :func:`gated_innovations`;
     S : (n, 2, 2) innovation covariances; feet_px : (K, 2) detections.
     Pairs whose squared Mahalanobis distance exceeds the chi-square quantile
     ``gate_probability`` (2 degrees of freedom) are not allowed, nor are
-    tracks behind the camera. Returns matched (track_index, detection_index) arrays.
+    tracks that are not pairable. Returns matched (track_index, detection_index) arrays.
     """
     if len(predicted_px) == 0 or len(feet_px) == 0:
         return np.zeros(0, dtype=int), np.zeros(0, dtype=int)
-    _, distance2, allowed = gated_innovations(predicted_px, in_front, S, feet_px, gate_probability)
+    _, distance2, allowed = gated_innovations(predicted_px, pairable, S, feet_px, gate_probability)
     return assign_gated(distance2, allowed, gate_probability)
 
 

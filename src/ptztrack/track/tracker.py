@@ -109,6 +109,23 @@ def predicted_feet_px(camera: PTZCamera, pose, mean) -> tuple[np.ndarray, np.nda
     return apply_homography(H, mean[:, :2]), in_front
 
 
+def gate_in_front(camera: PTZCamera, pose, mean, covariance, gate_probability: float) -> np.ndarray:
+    """Whether each track's gate on the ground lies wholly in front of the camera at ``pose``; (n,) bool.
+
+    The gate is the ellipse ``(x - m)^T P^-1 (x - m) <= g`` of the predicted position (``mean`` (n, 4),
+    ``covariance`` (n, 4, 4); ``g`` the chi-square quantile ``gate_probability``, 2 degrees of freedom). A
+    ground point's depth along the optical axis is ``w = h . (x, y, 1)``, ``h`` the ground-to-image
+    homography's last row, and over the ellipse it is at least ``w(m) - sqrt(g h^T P h)``, so the gate lies
+    in front where that is positive. Only there is the feet pixel a smooth function of the position
+    over the gate: an ellipse that reaches the camera's principal plane (``w = 0``) projects to pixels
+    without bound, and its linearised innovation covariance, huge as well, would gate in any detection.
+    """
+    h = ground_to_image(camera, pose)[2]
+    depth = mean[:, :2] @ h[:2] + h[2]
+    depth_variance = np.einsum("i,nij,j->n", h[:2], covariance[:, :2, :2], h[:2])
+    return depth > np.sqrt(chi2.ppf(gate_probability, df=2) * depth_variance)
+
+
 def ground_points(feet_px, camera: PTZCamera, pose) -> tuple[np.ndarray, np.ndarray]:
     """The ground points (K, 2) m of feet pixels (K, 2) at ``pose``, and which lie in front of the
     camera (K,): a pixel at or above the horizon has no ground point (its row is then meaningless)."""
@@ -185,13 +202,14 @@ def update_tracks(
     C = observation_matrix(camera, pose, tracks.mean)
     S = kalman.innovation_covariance(tracks.covariance, C, V)
     gate = student_t_gate(parameters.gate_probability, parameters.noise_dof)
-    track_index, detection_index = associate(predicted_px, in_front, S, feet_px, gate)
+    pairable = gate_in_front(camera, pose, tracks.mean, tracks.covariance, gate)
+    track_index, detection_index = associate(predicted_px, pairable, S, feet_px, gate)
     innovation_px = feet_px[detection_index] - predicted_px[track_index]
     if parameters.association == "cjpdaf" and not np.isinf(parameters.noise_dof):
         raise ValueError("the CJPDAF assumes Gaussian pixel noise (noise_dof inf)")
     if parameters.association == "cjpdaf":
         innovation, distance2, gated = gated_innovations(
-            predicted_px, in_front, S, feet_px, parameters.gate_probability
+            predicted_px, pairable, S, feet_px, parameters.gate_probability
         )
         mean, covariance, detected = jpdaf.cjpdaf_step(
             tracks.mean, tracks.covariance, innovation, distance2, gated, S, C, V, parameters.clutter_density_per_px2
@@ -222,7 +240,7 @@ def update_tracks(
     else:
         unmatched = np.setdiff1d(np.arange(len(feet_px)), detection_index)
         if parameters.birth == "outside_gates":
-            _, _, gated = gated_innovations(predicted_px, in_front, S, feet_px, gate)
+            _, _, gated = gated_innovations(predicted_px, pairable, S, feet_px, gate)
             unmatched = np.intersect1d(unmatched, np.flatnonzero(~gated[keep].any(axis=0)))
     _, on_ground = ground_points(feet_px[unmatched], camera, pose)
     starting = unmatched[on_ground]
@@ -468,15 +486,17 @@ def birth_exposure(
         return 1.0
     surviving = np.isin(tracks.ids, update.tracks.ids)
     mean = tracks.mean[surviving]
-    predicted_px, in_front = predicted_feet_px(camera, pose, mean)
-    S = kalman.innovation_covariance(tracks.covariance[surviving], observation_matrix(camera, pose, mean), V)
+    covariance = tracks.covariance[surviving]
+    predicted_px, _ = predicted_feet_px(camera, pose, mean)
+    S = kalman.innovation_covariance(covariance, observation_matrix(camera, pose, mean), V)
     half = EXPOSURE_GRID_PX / 2
     u, v = np.meshgrid(
         np.arange(half, camera.image_width_px, EXPOSURE_GRID_PX),
         np.arange(half, camera.image_height_px, EXPOSURE_GRID_PX),
     )
     gate = student_t_gate(parameters.gate_probability, parameters.noise_dof)
-    _, _, gated = gated_innovations(predicted_px, in_front, S, np.c_[u.ravel(), v.ravel()], gate)
+    pairable = gate_in_front(camera, pose, mean, covariance, gate)
+    _, _, gated = gated_innovations(predicted_px, pairable, S, np.c_[u.ravel(), v.ravel()], gate)
     return float(1.0 - np.mean(gated.any(axis=0)))
 
 
