@@ -40,21 +40,25 @@ USER, PASSWORD = "operator", "s3cret-pass"
 # A pose of the virtual camera far from where a PETS run starts (pan 57 deg, tilt 17 deg, zoom 1).
 AWAY_POSE = (0.0, 0.0, 1.0)
 
+HALF_PACE = 0.5
+
 
 def _address(camera, password: str = PASSWORD) -> CameraAddress:
     return CameraAddress("127.0.0.1", camera.onvif_port, USER, password)
 
 
 @pytest.mark.slow
-def test_a_live_smpl_run_with_hog_at_the_recordings_pace_scores_near_the_offline_run(tmp_path):
+def test_a_live_smpl_run_with_hog_at_half_the_recordings_pace_scores_near_the_offline_run(tmp_path):
     """`ptztrack serve-camera` in a process of its own, as a camera is a machine of its own, the recording
-    at its own pace: the live run scores within 20 points of the offline run of the recording steps its
+    at half its pace: the live run scores within 20 points of the offline run of the recording steps its
     pictures showed (a live run's score depends on its timing, so the bound is looser than the spread of
     live runs in the docs' Real cameras page, while a run whose pictures are placed wrongly falls far
-    below zero; its pace and its score are measured by benchmarks/live_loop.py, not here)."""
+    below zero). Half the pace, so that a slower machine running the whole suite keeps up: what is
+    checked here is where the pictures are placed; the pace and the score at the recording's own pace
+    are measured by benchmarks/live_loop.py."""
     log = tmp_path / "truth.csv"
     command = [sys.executable, "-m", "ptztrack.cli", "serve-camera", "--port", "0", "--truth-log", str(log)]
-    command += ["--user", USER]
+    command += ["--user", USER, "--time-scale", str(HALF_PACE)]
     environment = {**os.environ, "PTZTRACK_CAMERA_PASSWORD": PASSWORD}
     server = subprocess.Popen(
         command,
@@ -69,7 +73,7 @@ def test_a_live_smpl_run_with_hog_at_the_recordings_pace_scores_near_the_offline
         port = int(re.search(r"onvif://127\.0\.0\.1:(\d+)", server.stdout.readline()).group(1))
         scenario = pets_scenario("hog")
         address = CameraAddress("127.0.0.1", port, USER, PASSWORD)
-        world, live = run_live_episode(scenario, virtual_calibration(), address, "smpl", 300, 1.0, 0)
+        world, live = run_live_episode(scenario, virtual_calibration(), address, "smpl", 300, HALF_PACE, 0)
     finally:
         server.send_signal(signal.SIGINT)
         server.communicate(timeout=30)
