@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from ptztrack.builders.episode import episode_world, run_episode
-from ptztrack.config import pets_scenario
+from ptztrack.builders.recording import pets_scenario
 from ptztrack.detect.detector_model import HEIGHT_BIN_EDGES_PX
 from ptztrack.detect.recall_fit import MATCH_FRACTION_OF_HEIGHT
 from ptztrack.evaluate.metrics import episode_metrics
@@ -34,8 +34,16 @@ def annotated_recall_trials(world, episode, scenario, occluded_above: float) -> 
     """The annotated people fully in view at each step's pose: their heights (K,) px, as the model
     measures a track's (a person of the policies' height standing at the annotated ground point), and
     whether a detection of that step found them (K,)."""
-    heights, found = [], []
-    for step, (pose, detections) in enumerate(zip(episode.poses, episode.detections, strict=True)):
+    views = zip(range(len(episode.poses)), episode.poses, episode.detections, strict=True)
+    return view_recall_trials(world, views, scenario, occluded_above)
+
+
+def view_recall_trials(world, views, scenario, occluded_above: float) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`annotated_recall_trials` over any views: ``views`` yields (step, pose, detections) of the
+    world's camera. A person is found by a detection whose feet lie within ``MATCH_FRACTION_OF_HEIGHT`` of
+    their annotated height of their annotated feet."""
+    heights, found = [np.zeros(0)], [np.zeros(0, dtype=bool)]
+    for step, pose, detections in views:
         people = world.backend.people(step, pose)
         visible = people.in_view & (people.hidden <= occluded_above)
         if not visible.any():
@@ -51,6 +59,13 @@ def annotated_recall_trials(world, episode, scenario, occluded_above: float) -> 
     return np.concatenate(heights), np.concatenate(found)
 
 
+def recall_by_bin(heights, found) -> list[tuple[int, float | None]]:
+    """Per height bin (``HEIGHT_BIN_EDGES_PX``): how many trials, and the share found (None without any)."""
+    which = np.digitize(heights, HEIGHT_BIN_EDGES_PX) - 1
+    counts = [int(np.sum(which == index)) for index in range(len(HEIGHT_BIN_EDGES_PX) - 1)]
+    return [(count, float(found[which == index].mean()) if count else None) for index, count in enumerate(counts)]
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--json", type=Path, help="write the bins here")
@@ -61,7 +76,7 @@ def main() -> None:
     model = world.detector_model.as_dict()
     occluded_above = scenario.required_recording("the annotated recall").occluded_above
     heights, found = annotated_recall_trials(world, episode, scenario, occluded_above)
-    which = np.digitize(heights, HEIGHT_BIN_EDGES_PX) - 1
+    annotated_bins = recall_by_bin(heights, found)
     print(f"smpl b1, seed 0: MOTA {episode_metrics(episode)['mota']:.1%}, mean zoom {episode.poses[:, 2].mean():.2f}")
     curve = model["curve"]
     print(
@@ -71,9 +86,7 @@ def main() -> None:
     )
     print(f"{'height [px]':>12}{'annotated':>10}{'annotated recall':>18}{'learned':>9}{'+-':>6}{'trials':>8}")
     bins = []
-    for index, centre in enumerate(model["height_px"]):
-        people = int(np.sum(which == index))
-        annotated = float(found[which == index].mean()) if people else None
+    for index, (centre, (people, annotated)) in enumerate(zip(model["height_px"], annotated_bins, strict=True)):
         row = {
             "height_px": centre,
             "annotated_people": people,

@@ -11,8 +11,8 @@ recall per height band, next to the paper's Caltech curve (Kd 0.0098, r0 21.29).
 
 import numpy as np
 
+from ptztrack.builders.recording import pets_scenario
 from ptztrack.builders.world import build_world
-from ptztrack.config import pets_scenario
 from ptztrack.detect.recall_fit import detection_trials, fit_recall
 from ptztrack.detect.simulated import realistic_recall
 

@@ -30,7 +30,7 @@ import cv2  # noqa: E402
 import numpy as np  # noqa: E402
 
 from ptztrack.builders.follow import initial_box, target_scenario, target_source  # noqa: E402
-from ptztrack.config import pets_follow_scenario  # noqa: E402
+from ptztrack.builders.recording import pets_follow_scenario  # noqa: E402
 from ptztrack.experiments.follow import FollowCell, follow_run  # noqa: E402
 from ptztrack.files import write_json  # noqa: E402
 from ptztrack.follow.target import box_corners_carried  # noqa: E402

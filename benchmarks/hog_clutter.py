@@ -15,8 +15,8 @@ C = lambda (1 - P_D P_G) / P_D with P_G = 0.99, the value of
 import numpy as np
 from scipy.spatial.distance import cdist
 
+from ptztrack.builders.recording import pets_scenario
 from ptztrack.builders.world import build_world
-from ptztrack.config import pets_scenario
 
 
 def main() -> None:

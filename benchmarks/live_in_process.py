@@ -36,10 +36,10 @@ from ptztrack.builders.live import (
     pose_timeline,
     virtual_calibration,
 )
+from ptztrack.builders.recording import pets_scenario
 from ptztrack.camera.live_camera import POLL_S
 from ptztrack.camera.onvif_head import Head, head_axes
 from ptztrack.camera.stream import LatestFrame
-from ptztrack.config import pets_scenario
 from ptztrack.evaluate.metrics import episode_metrics
 from ptztrack.files import write_json
 from ptztrack.live import run_live, warm_up

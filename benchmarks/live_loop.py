@@ -46,11 +46,11 @@ from ptztrack.builders.live import (
     virtual_calibration,
     virtual_onvif_camera,
 )
+from ptztrack.builders.recording import pets_scenario
 from ptztrack.camera.move_timing import measure_image_delay
 from ptztrack.camera.onvif_client import CameraAddress, ONVIFClient
 from ptztrack.camera.onvif_spaces import MoveTimes
 from ptztrack.camera.stream import FrameStream, rtsp_pictures, thumbnail
-from ptztrack.config import pets_scenario
 from ptztrack.evaluate.metrics import clear_metrics, episode_metrics
 from ptztrack.files import write_json
 from ptztrack.loop import track

@@ -36,17 +36,17 @@ import numpy as np
 
 from ptztrack.builders.occupancy import plaza_layout
 from ptztrack.builders.pets_network import published_camera_world, published_network_parts, published_views
+from ptztrack.builders.recording import pets_scenario
 from ptztrack.builders.world import BuiltScene, build_scene, camera_world, detector_model
-from ptztrack.config import pets_scenario
 from ptztrack.evaluate.executors import run_cells
 from ptztrack.evaluate.metrics import tracking_metrics, tracks_within
 from ptztrack.files import write_json
-from ptztrack.geometry.calibration import PinholeCalibration, project_pinhole
+from ptztrack.geometry.calibration import PinholeCalibration, camera_centre_m, project_pinhole
 from ptztrack.geometry.occlusion import occluded_fraction
 from ptztrack.loop import episode_seeds
 from ptztrack.network_loop import NetworkWorld, run_network_loop
 from ptztrack.occupancy.multiview import CameraView
-from ptztrack.occupancy.plaza import camera_centre_m, plaza_truth
+from ptztrack.occupancy.plaza import plaza_truth
 from ptztrack.types import GroundTruth
 
 FIRST_SEED = 1000

@@ -18,10 +18,10 @@ from pathlib import Path
 import cv2
 import numpy as np
 
+from ptztrack.builders.recording import pets_scenario
 from ptztrack.builders.registration import live_view_model, reference_index, registration_camera
 from ptztrack.builders.world import action_grid
 from ptztrack.camera.live_view import render_view
-from ptztrack.config import pets_scenario
 from ptztrack.experiments.registration import first_live_frame
 from ptztrack.files import write_json
 from ptztrack.geometry.registration import LIVE_FEATURES, register, sift_features, within_view_ratio_matches

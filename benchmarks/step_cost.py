@@ -72,8 +72,8 @@ import numpy as np  # noqa: E402
 from scipy.optimize import linear_sum_assignment  # noqa: E402
 
 from ptztrack.builders.episode import make_policy, make_tracker  # noqa: E402
+from ptztrack.builders.recording import pets_scenario  # noqa: E402
 from ptztrack.builders.world import build_world  # noqa: E402
-from ptztrack.config import pets_scenario  # noqa: E402
 from ptztrack.detect.hog import HogPeopleDetector, feet_and_height_px  # noqa: E402
 from ptztrack.detect.recall_fit import MATCH_FRACTION_OF_HEIGHT  # noqa: E402
 from ptztrack.files import write_json  # noqa: E402

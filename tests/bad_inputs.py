@@ -167,6 +167,31 @@ def _dataset(
     )
 
 
+def _ptz_dataset(
+    name: str,
+    scratch: Path | None,
+    view: str = "video: v.avi",
+    top: str = "ground_truth: gt.txt\n",
+    files: dict | None = None,
+    extra: tuple = (),
+    exit_status: int = 2,
+    says: tuple[str, ...] = (),
+    frame_rate: str = "10",
+) -> Case:
+    """A one-view dataset file for the PTZ tables (``view``: the view's fields besides its name, pinhole
+    calibration and image size; ``top``: the top-level lines besides its frame rate and area), a video of
+    four grey 768 x 576 frames and the first two frames' ground truth, at ``frame_rate`` fps; run by ``experiment pets
+    --dataset`` for two steps of ``fix``."""
+    document = (
+        f"frame_rate_hz: {frame_rate}\narea_m: [[-12, -13], [-3, -5]]\n{top}"
+        f"views:\n  - {{name: View_001, calibration: c.json, image_size_px: [768, 576], {view}}}\n"
+    )
+    given = {"d.yaml": document, "c.json": PINHOLE, "v.avi": video_bytes(4, (768, 576), scratch)}
+    given["gt.txt"] = _ground_truth(FIRST_TWO_FRAMES)
+    argv = ("experiment", "pets", "--dataset", "{dir}/d.yaml", "--strategies", "fix", *A_FEW_STEPS, *extra)
+    return Case(name, argv, {**given, **(files or {})}, exit_status, says)
+
+
 def _png(size_px: tuple[int, int]) -> bytes:
     """A grey PNG image of ``size_px`` (width, height)."""
     return cv2.imencode(".png", np.full((size_px[1], size_px[0], 3), 128, np.uint8))[1].tobytes()
@@ -319,9 +344,9 @@ def cases(scratch: Path | None) -> list[Case]:
             says=("--max-ptz",),
         ),
         Case(
-            "network pets: a simulated detector on the recording",
-            ("experiment", "network", "pets", "--detector", "realistic", *A_FEW_STEPS),
-            says=("realistic",),
+            "network pets: a view the dataset does not have",
+            ("experiment", "network", "pets", "--dataset-view", "View_009", *A_FEW_STEPS),
+            says=("no view 'View_009'", "View_001, View_003"),
         ),
         Case(
             "network: --json in a missing folder",
@@ -419,6 +444,47 @@ def cases(scratch: Path | None) -> list[Case]:
             says=("occupancy: canny_low (200) must be at most canny_high (150)",),
         ),
         _dataset("dataset samples 1e9", top="occupancy: {samples_per_height: 1000000000}\n"),
+        _ptz_dataset("pets --dataset: a well-formed one", scratch, exit_status=0),
+        _ptz_dataset(
+            "pets --dataset: a view without a video",
+            scratch,
+            view="detections: det.txt",
+            says=("d.yaml: no view with a video",),
+        ),
+        _ptz_dataset("pets --dataset: no ground truth", scratch, top="", says=("has no ground truth",)),
+        _ptz_dataset(
+            "pets --dataset: frames of another size than the file states",
+            scratch,
+            files={"v.avi": video_bytes(4, (640, 480), scratch)},
+            says=("v.avi: frames are 640x480 px, expected 768x576",),
+        ),
+        _ptz_dataset(
+            "pets --dataset: ground truth beyond the video",
+            scratch,
+            files={"gt.txt": _ground_truth([*FIRST_TWO_FRAMES, _with_field(FIRST_TWO_FRAMES[0], 0, "9")])},
+            says=(f"gt.txt: line {len(FIRST_TWO_FRAMES) + 1}: frame 9 is beyond the 4 frames of",),
+        ),
+        _ptz_dataset(
+            "pets --dataset: a view it does not have",
+            scratch,
+            extra=("--dataset-view", "View_9"),
+            says=("no view 'View_9'",),
+        ),
+        _ptz_dataset(
+            "pets --dataset: the detections detector on a view without boxes",
+            scratch,
+            extra=("--detector", "detections"),
+            says=("detector.kind 'detections' needs", "detections"),
+        ),
+        _ptz_dataset(
+            "pets --dataset: 12.5 fps give 6.25 Hz steps, warned",
+            scratch,
+            top="ground_truth: gt.txt\n",
+            frame_rate="12.5",
+            exit_status=0,
+            says=("its 12.5 fps give steps of 6.25 Hz (every 2 frames), not the protocol's 5 Hz",),
+        ),
+        _ptz_dataset("pets --dataset: no such file", scratch, files={"d.yaml": None}, says=("d.yaml",)),
         _dataset("dataset view without evidence", view="weight: 1"),
         _dataset("dataset view calibration missing", files={"c.xml": None}),
         _dataset("dataset area behind the view", area="[[-60, -60], [-40, -40]]"),
@@ -441,7 +507,7 @@ def cases(scratch: Path | None) -> list[Case]:
             "dataset calibration with K halved",
             0.5,
             ("--methods",),
-            says=("c.json: views.0 (View_001): the ground truth projects a median", "is this the view's calibration?"),
+            says=("c.json: views.0 (View_001): its detections stand a median", "is this the view's calibration?"),
         ),
         _dataset(
             "dataset ground truth frame 99999999",

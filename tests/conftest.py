@@ -48,6 +48,8 @@ detector: {{kind: ideal, pixel_noise_px: 0.0}}
 recording:
   ground_truth: {os.path.relpath(EXCERPT / "gt_mot15.txt", directory)}
   calibration: {EXCERPT / "pinhole.json"}
+  frame_step: 2
+  recorded_size_px: [768, 576]
 """
     )
     return load_scenario(path, **overrides)

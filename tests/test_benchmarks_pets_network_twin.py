@@ -4,7 +4,7 @@ from pathlib import Path
 import numpy as np
 
 from ptztrack.builders.pets_network import published_views
-from ptztrack.config import pets_scenario
+from ptztrack.builders.recording import pets_scenario
 from ptztrack.geometry.calibration import project_pinhole
 from ptztrack.types import GroundTruth
 

@@ -7,8 +7,9 @@ import numpy as np
 import pytest
 
 from ptztrack.builders.follow import follow_parameters, initial_box, target_scenario
+from ptztrack.builders.recording import pets_follow_scenario
 from ptztrack.cli import main
-from ptztrack.config import ScenarioError, pets_follow_scenario, scenario_from_dict
+from ptztrack.config import ScenarioError, scenario_from_dict
 from ptztrack.experiments.follow import FollowCell, follow_row, follow_run
 from ptztrack.geometry.ptz import project_people
 

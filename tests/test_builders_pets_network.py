@@ -6,9 +6,9 @@ import pytest
 from ptztrack.builders.episode import run_episode
 from ptztrack.builders.network import belief_of_cameras
 from ptztrack.builders.pets_network import PUBLISHED_RECALL, pets_network_world, published_views
+from ptztrack.builders.recording import pets_scenario
 from ptztrack.camera.virtual import virtual_ptz
 from ptztrack.cli import main
-from ptztrack.config import pets_scenario
 from ptztrack.control.information_gain import action_geometry, detection_weight_integral
 from ptztrack.detect.published import PublishedDetections
 from ptztrack.detect.simulated import RecallModel

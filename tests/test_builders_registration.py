@@ -5,10 +5,11 @@ import numpy as np
 import pytest
 
 from ptztrack.builders.episode import run_episode
+from ptztrack.builders.recording import pets_scenario
 from ptztrack.builders.registration import live_view_model, reference_index, registration_camera
 from ptztrack.builders.world import action_grid
 from ptztrack.camera import pose_feedback
-from ptztrack.config import LiveView, PoseError, ScenarioError, pets_scenario, scenario_from_dict
+from ptztrack.config import LiveView, PoseError, ScenarioError, scenario_from_dict
 from ptztrack.evaluate.metrics import episode_metrics
 from ptztrack.experiments.registration import live_view_settings, registration_views, summarise_registration
 from ptztrack.geometry.registration import register

@@ -3,9 +3,9 @@ from pathlib import Path
 import numpy as np
 
 from ptztrack.builders.episode import run_episode
+from ptztrack.builders.recording import pets_scenario
 from ptztrack.builders.world import build_world
 from ptztrack.camera.live_view import recorded_to_live, view_lens
-from ptztrack.config import pets_scenario
 from ptztrack.evaluate.metrics import episode_metrics
 from ptztrack.geometry.ptz import apply_homography, ground_to_image
 

@@ -2,8 +2,9 @@ from pathlib import Path
 
 import pytest
 
+from ptztrack.builders.recording import pets_scenario
 from ptztrack.builders.world import action_grid
-from ptztrack.config import Scenario, ScenarioError, load_scenario, pets_scenario, scenario_from_dict
+from ptztrack.config import Scenario, ScenarioError, load_scenario, scenario_from_dict
 
 EXAMPLE = Path(__file__).parent.parent / "examples" / "scenario.yaml"
 
@@ -26,7 +27,10 @@ def test_the_default_grid_is_the_papers_280_actions():
         ("area_m: [-15, 15]\n", "area_m.0: Input should be greater than 0 (got -15)"),
         ("frames: many\n", "frames: Input should be a valid integer"),
         ("people: {count: -1}\n", "people.count: Input should be greater than or equal to 0 (got -1)"),
-        ("detector: {kind: perfect}\n", "detector.kind: expected one of ideal, realistic, hog (got 'perfect')"),
+        (
+            "detector: {kind: perfect}\n",
+            "detector.kind: expected one of ideal, realistic, hog, detections (got 'perfect')",
+        ),
         ("people: {speed_m_s: [2.0, 1.0]}\n", "people: speed_m_s must be [low, high]"),
         ("actions: {zoom: [2, 1]}\n", "actions: zoom must be a non-empty increasing list"),
         ("camera: {live_view: {gain: [1.3, 0.7]}}\n", "camera.live_view: gain must be [low, high]"),

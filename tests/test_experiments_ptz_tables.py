@@ -151,8 +151,8 @@ def test_the_pets_experiment_has_a_column_per_strategy_and_beta(tmp_path, capsys
 
 
 def test_the_pets_experiment_refuses_a_detector_it_does_not_have(capsys):
-    assert main(["experiment", "pets", "--detector", "realistic"]) == 2
-    assert "detector 'realistic' is not available" in capsys.readouterr().err
+    assert main(["experiment", "pets", "--detector", "perfect"]) == 2
+    assert "detector.kind: expected one of ideal, realistic, hog, detections (got 'perfect')" in capsys.readouterr().err
 
 
 def test_a_priori_is_the_scenario_itself_and_two_fold_scores_each_half_with_the_other_halfs_fit(

@@ -52,7 +52,7 @@ FUZZ = settings(
 )
 PETS = resources.files("ptztrack.data") / "pets2009_s2l1"
 EXAMPLE_SCENARIO = Path(__file__).parents[1] / "examples" / "scenario.yaml"
-EXAMPLE_DATASET = Path(__file__).parents[1] / "examples" / "pets_occupancy.yaml"
+EXAMPLE_DATASET = PETS / "dataset.yaml"
 
 # Values a user might write by mistake: near the edges of every range, and of the wrong kind.
 NEAR_MISSES = st.one_of(

@@ -26,11 +26,12 @@ from ptztrack.builders.live import (
     virtual_calibration,
     virtual_onvif_camera,
 )
+from ptztrack.builders.recording import pets_scenario
 from ptztrack.camera.onvif_client import CameraAddress, CameraError, ONVIFClient
 from ptztrack.camera.stream import open_rtsp
 from ptztrack.cli import main
 from ptztrack.cli.camera import read_truth_log
-from ptztrack.config import load_camera_calibration, pets_scenario, write_camera_calibration
+from ptztrack.config import load_camera_calibration, write_camera_calibration
 from ptztrack.evaluate.metrics import episode_metrics
 
 pytest.importorskip("ipycam", reason="the virtual ONVIF camera needs ipycam (pip install --no-deps ipycam==1.3.0)")

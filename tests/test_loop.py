@@ -2,7 +2,8 @@ import numpy as np
 import pytest
 
 from ptztrack.builders.episode import episode_world, make_policy, run_episode
-from ptztrack.config import pets_scenario, scenario_from_dict
+from ptztrack.builders.recording import pets_scenario
+from ptztrack.config import scenario_from_dict
 from ptztrack.control.baselines import widest_view_action
 from ptztrack.evaluate.metrics import episode_metrics
 from ptztrack.loop import episode_seeds

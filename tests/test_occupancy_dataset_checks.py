@@ -8,10 +8,13 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
-from bad_inputs import calibration_fit_case, write_case
+from bad_inputs import _pinhole_with_k_scaled, calibration_fit_case, write_case
+from ptztrack.builders.occupancy import recording_from_dataset
 from ptztrack.cli import main
+from ptztrack.config import load_dataset
 
 PETS = Path(__file__).resolve().parents[1] / "src" / "ptztrack" / "data" / "pets2009_s2l1"
 DETECTIONS = "1,-1,300,200,40,100,0.9,-1,-1,-1\n2,-1,302,201,40,100,0.9,-1,-1,-1\n"
@@ -97,6 +100,39 @@ def test_a_calibration_that_projects_the_ground_truth_onto_the_views_detections_
     with caplog.at_level(logging.WARNING):
         assert main(write_case(case, tmp_path)) == 0
     assert [record.getMessage() for record in caplog.records if record.levelno >= logging.WARNING] == []
+
+
+@pytest.mark.parametrize("k_scale, warned", [(1.0, False), (0.5, True)])
+def test_a_detector_that_finds_only_the_nearest_people_does_not_pass_for_a_wrong_calibration(
+    tmp_path, caplog, k_scale, warned
+):
+    """View_001's shipped Keypoint R-CNN boxes cut to the tallest fifth of each frame (a detector that finds
+    only the nearest people, as HOG does in a far view): with the view's calibration no warning, since the
+    boxes that exist stand on projected people; with K halved, the warning."""
+    table = np.loadtxt(PETS / "View_001_det.txt.gz", delimiter=",")
+    table = table[table[:, 6] >= 0.5]
+    frames = table[:, 0]
+    tallest = np.concatenate(
+        [
+            np.flatnonzero(frames == frame)[table[frames == frame, 5] >= np.percentile(table[frames == frame, 5], 80)]
+            for frame in np.unique(frames)
+            if frame <= 100
+        ]
+    )
+    np.savetxt(tmp_path / "det.txt", table[np.sort(tallest)], delimiter=",", fmt="%g")
+    (tmp_path / "c.json").write_text(_pinhole_with_k_scaled(k_scale))
+    shutil.copy(PETS / "gt_mot15.txt", tmp_path / "gt.txt")
+    path = tmp_path / "nearest.yaml"
+    path.write_text(
+        "name: nearest\nframe_rate_hz: 10\nframes: 100\narea_m: [[-21.0, -17.5], [8.5, 9.0]]\nground_truth: gt.txt\n"
+        "views:\n  - {name: View_001, calibration: c.json, image_size_px: [768, 576], detections: det.txt}\n"
+    )
+    with caplog.at_level(logging.WARNING):
+        recording_from_dataset(load_dataset(path))
+    warnings = [
+        record.getMessage() for record in caplog.records if "is this the view's calibration" in record.getMessage()
+    ]
+    assert len(warnings) == int(warned)
 
 
 @pytest.mark.slow

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from ptztrack.cli import main
-from ptztrack.config import dataset_from_dict, load_dataset, pets_dataset
+from ptztrack.config import dataset_from_dict
 from ptztrack.experiments.occupancy import format_occupancy_table
 from ptztrack.geometry.calibration import project_pinhole
 from ptztrack.occupancy.evaluation import (
@@ -284,21 +284,6 @@ def test_pets_runs_with_seven_views(tmp_path):
     assert np.shape(pom["fitted_feet_sd_m"]) == (2, 7)
     assert all(sd is None or 0 < sd < 1.0 for half in pom["fitted_feet_sd_m"] for sd in half)
     assert any(sd is not None for half in pom["fitted_feet_sd_m"] for sd in half)
-
-
-def test_the_example_dataset_file_is_the_built_in_pets_dataset():
-    example = load_dataset(Path(__file__).resolve().parents[1] / "examples" / "pets_occupancy.yaml")
-    built_in = pets_dataset()
-    resolved = [
-        view.model_copy(update={k: str(Path(getattr(view, k)).resolve()) for k in ("calibration", "detections")})
-        for view in example.views
-    ]
-    assert [(v.name, Path(v.calibration).name, Path(v.detections).name, v.video is not None) for v in resolved] == [
-        (v.name, Path(v.calibration).name, Path(str(v.detections)).name, v.video is not None) for v in built_in.views
-    ]
-    assert all(Path(v.calibration).is_file() and Path(str(v.detections)).is_file() for v in resolved)
-    assert example.occupancy == built_in.occupancy and example.area_m == built_in.area_m
-    assert example.frame_rate_hz == built_in.frame_rate_hz and example.tracker == built_in.tracker
 
 
 def test_a_partial_tracker_section_keeps_the_occupancy_trackers_confirmation():

@@ -9,8 +9,8 @@ from ptztrack.builders.occupancy import ROOM_AREA_M, rendered_recording, room_re
 from ptztrack.occupancy.detectors import ClusteringDetector, LpomForegroundDetector, lpom_parameters
 from ptztrack.occupancy.foreground import ViewForeground, clean_silhouettes, silhouette_edges, view_foregrounds
 from ptztrack.occupancy.parameters import ForegroundParameters, OccupancyParameters
-from ptztrack.occupancy.render import draw_people
 from ptztrack.occupancy.room import RoomLayout, RoomRenderer, room_truth
+from ptztrack.scene.render import draw_people
 
 # The 3-person room long enough for the background model to have warmed up (its learning rate is
 # 1 / (2 n) at its n-th frame): the last frames are the ones checked.

@@ -3,6 +3,7 @@ keep their spacing, and the experiment's rows."""
 
 import json
 from dataclasses import replace
+from pathlib import Path
 
 import cv2
 import numpy as np
@@ -11,13 +12,13 @@ import pytest
 from ptztrack.builders.occupancy import plaza_layout, plaza_recording, plaza_renderer
 from ptztrack.cli import main
 from ptztrack.config import pets_dataset
-from ptztrack.geometry.calibration import in_image, load_tsai, pinhole_from_tsai, project_pinhole
-from ptztrack.occupancy.plaza import camera_centre_m, plaza_truth
-from ptztrack.occupancy.render import body_cones, draw_people, random_outfit
+from ptztrack.geometry.calibration import camera_centre_m, in_image, load_tsai, pinhole_from_tsai, project_pinhole
+from ptztrack.occupancy.plaza import plaza_truth
 from ptztrack.scene.pets import load_mot_ground_truth
+from ptztrack.scene.render import body_cones, draw_people, random_outfit
 
 FRAMES = 12
-CALIBRATIONS = {view.name: view.calibration for view in pets_dataset().views}
+CALIBRATIONS = {view.name: Path(view.calibration).with_name(f"{view.name}.xml") for view in pets_dataset().views}
 WHITE = replace(random_outfit(np.random.default_rng(0)), legs=(255, 255, 255), torso=(255, 255, 255))
 
 

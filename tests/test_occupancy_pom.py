@@ -8,7 +8,7 @@ from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 from scipy.special import expit
 
-from ptztrack.geometry.calibration import project_pinhole
+from ptztrack.geometry.calibration import aimed_pinhole, project_pinhole
 from ptztrack.occupancy.lpom import GroundGrid
 from ptztrack.occupancy.multiview import CameraView, MultiViewRecording
 from ptztrack.occupancy.parameters import PomParameters
@@ -26,7 +26,7 @@ from ptztrack.occupancy.pom import (
     scaled_about_feet,
     working_mask,
 )
-from ptztrack.occupancy.room import RoomLayout, RoomRenderer, look_at, room_cameras, room_truth
+from ptztrack.occupancy.room import RoomLayout, RoomRenderer, room_cameras, room_truth
 
 PARAMETERS = PomParameters()
 
@@ -202,7 +202,7 @@ def test_the_rectangle_bounds_the_projected_person():
 
 def test_rectangles_snap_to_blocks_and_cells_behind_or_beside_the_camera_have_none():
     # A camera at (0, 0, 2 m) looking along +x; cells behind it and far to its side are not seen.
-    camera = look_at((0.0, 0.0, 2.0), (5.0, 0.0, 1.0), 200.0, (320, 240))
+    camera = aimed_pinhole((0.0, 0.0, 2.0), (5.0, 0.0, 1.0), 200.0, (320, 240))
     grid = GroundGrid((-3.0, -10.0), 0.5, (40, 20))  # x from -3 to 7 m, y from -10 to 10 m
     boxes = person_boxes([(camera, (320, 240))], grid, 1.75, 0.5, block_px=4)
     assert boxes.shapes == ((60, 80),)
@@ -223,7 +223,7 @@ def test_rectangles_snap_to_blocks_and_cells_behind_or_beside_the_camera_have_no
 def test_a_lens_that_folds_back_gives_no_rectangle_to_the_cells_beyond_its_fold():
     # k1 = -0.3: r (1 - 0.3 r^2) grows up to r = 1 / sqrt(0.9) and folds back beyond it; a person at
     # r = 2 to the camera's side would otherwise be drawn inside the image, on the other side.
-    camera = look_at((0.0, 0.0, 2.0), (5.0, 0.0, 2.0), 200.0, (320, 240))
+    camera = aimed_pinhole((0.0, 0.0, 2.0), (5.0, 0.0, 2.0), 200.0, (320, 240))
     camera = replace(camera, dist=np.array([-0.3, 0.0, 0.0, 0.0, 0.0]))
     beside_m = np.array([[2.0, 4.0]])  # 4 m to the side at 2 m ahead: r = 2
     raw_px = project_pinhole(camera, 1000.0 * np.array([[2.0, 4.0, 1.0]]))

@@ -164,7 +164,9 @@ def test_another_package_adds_a_policy_and_a_detector_through_entry_points(tmp_p
 
 
 def test_an_unknown_name_is_one_clear_error_naming_the_choices():
-    with pytest.raises(ScenarioError, match=r"detector.kind: expected one of ideal, realistic, hog \(got 'blob'\)"):
+    with pytest.raises(
+        ScenarioError, match=r"detector.kind: expected one of ideal, realistic, hog, detections \(got 'blob'\)"
+    ):
         scenario_from_dict({"detector": {"kind": "blob"}})
     with pytest.raises(registry.UnknownName, match="unknown policy 'greedy'; expected one of fix, patrol"):
         run_episode(SCENARIO, "greedy", 0)

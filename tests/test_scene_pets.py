@@ -6,7 +6,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from ptztrack.config import PETS_TRACKING_AREA_M
+from ptztrack.config import pets_dataset
 from ptztrack.geometry.calibration import (
     CalibrationError,
     imaged_radius,
@@ -206,7 +206,7 @@ def test_the_tracking_area_holds_the_cropped_annotations_away_from_its_edge(tmp_
         cropped_xml.write_bytes(source.read())
     cropped = load_cvml(cropped_xml)
     full = load_mot_ground_truth(data / "gt_mot15.txt")
-    (x0, y0), (x1, y1) = PETS_TRACKING_AREA_M
+    (x0, y0), (x1, y1) = pets_dataset().tracking_area_m
     x_m, y_m = full.ground_m.T
     inside = (x0 <= x_m) & (x_m <= x1) & (y0 <= y_m) & (y_m <= y1)
     to_edge_m = np.min(np.abs([x_m - x0, x_m - x1, y_m - y0, y_m - y1]), axis=0)

@@ -105,7 +105,7 @@ def test_run_with_view_prints_the_address_starts_when_a_page_connects_and_sends_
 def test_live_with_view_sends_the_cameras_frames(tmp_path):
     pytest.importorskip("ipycam", reason="the virtual ONVIF camera needs ipycam (pip install --no-deps ipycam==1.3.0)")
     from ptztrack.builders.live import virtual_onvif_camera
-    from ptztrack.config import pets_scenario
+    from ptztrack.builders.recording import pets_scenario
 
     camera, _ = virtual_onvif_camera(pets_scenario("hog"), 0.5, 0)
     with camera:

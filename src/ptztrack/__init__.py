@@ -31,8 +31,10 @@ _HOME = {
     "ScenarioError": ".config",
     "load_scenario": ".config",
     "scenario_from_dict": ".config",
-    "pets_scenario": ".config",
-    "pets_follow_scenario": ".config",
+    "load_dataset": ".config",
+    "pets_scenario": ".builders.recording",
+    "pets_follow_scenario": ".builders.recording",
+    "dataset_scenario": ".builders.recording",
     # the roles and their data
     "CameraBackend": ".roles",
     "Detector": ".roles",
@@ -75,9 +77,10 @@ __all__ = ["__version__", *_HOME, *_RENAMED]
 if TYPE_CHECKING:
     from .builders.episode import episode_world, run_episode
     from .builders.network import run_network_episode
+    from .builders.recording import dataset_scenario, pets_follow_scenario, pets_scenario
     from .builders.world import BuiltScene, build_world
     from .camera.actions import ActionGrid
-    from .config import Scenario, ScenarioError, load_scenario, pets_follow_scenario, pets_scenario, scenario_from_dict
+    from .config import Scenario, ScenarioError, load_dataset, load_scenario, scenario_from_dict
     from .evaluate.executors import run_cells
     from .evaluate.metrics import episode_metrics, network_metrics
     from .evaluate.report import write_outputs

@@ -42,3 +42,6 @@ PASSWORD_VARIABLE = "PTZTRACK_CAMERA_PASSWORD"
 LOOPBACK = "127.0.0.1"
 """The one interface ptztrack's servers listen on (the web view, the virtual ONVIF camera): never
 another, as they show a camera's pictures to whoever connects."""
+PEOPLE_LOOKS = ("cones", "pets-cutouts")
+"""How ``ptztrack render`` draws the people: cone bodies, or pedestrians cut out of PETS 2009's View_001
+(:mod:`ptztrack.builders.render`); the first is the default."""

@@ -39,7 +39,7 @@ _BUILT_IN: dict[str, dict[str, str]] = {
         **{name: f"{_FACTORIES}:{name}_policy" for name in ("fix", "patrol", "random", "intg", "smpl")},
         "follow": f"{_FOLLOW}:follow_policy",
     },
-    "detectors": {name: f"{_FACTORIES}:{name}_detector" for name in ("ideal", "realistic", "hog")},
+    "detectors": {name: f"{_FACTORIES}:{name}_detector" for name in ("ideal", "realistic", "hog", "detections")},
     "cameras": {"simulated": f"{_FACTORIES}:simulated_camera", "virtual": f"{_FACTORIES}:virtual_camera"},
     "trackers": {
         "ekf": f"{_FACTORIES}:ekf_tracker",

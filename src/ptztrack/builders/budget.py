@@ -17,9 +17,12 @@ code (peak resident memory of ``run_episode`` at growing sizes, 2 steps unless s
 
 import math
 
+import numpy as np
 import psutil
 
 from ptztrack.config import Scenario, ScenarioError
+from ptztrack.scene.pets import load_mot_ground_truth
+from ptztrack.scene.trajectories import read_trajectories
 
 INTERPRETER_BYTES = 320e6
 HISTORY_BYTES_PER_STEP = 105e3
@@ -30,15 +33,24 @@ IMAGE_BYTES_PER_PIXEL = 12.0
 # The ground of a recording is known only once its calibration is read: a 100 m square bounds
 # what one camera's view covers in the recordings we know (PETS's View_001 sees about 40 x 30 m).
 RECORDING_AREA_M2 = 100.0 * 100.0
-RECORDING_PEOPLE = 20
-"""More than PETS 2009 S2.L1 ever shows in one frame (its crowd peaks at 8 annotated people)."""
 INFORMATION_POLICIES = ("intg", "smpl")
+
+
+def people_at_once(scenario: Scenario) -> int:
+    """The most people a scenario's scene holds at once: a recording's or a trajectory file's most in one
+    frame, else the synthetic crowd's count."""
+    if scenario.recording is not None:
+        frame = load_mot_ground_truth(scenario.recording.ground_truth).frame
+    elif scenario.people.trajectories is not None and scenario.people.trajectories_frame_rate_hz is not None:
+        frame = read_trajectories(scenario.people.trajectories, scenario.people.trajectories_frame_rate_hz).frame
+    else:
+        return scenario.people.count
+    return int(np.bincount(frame - frame.min()).max())
 
 
 def estimated_memory_bytes(scenario: Scenario, policies: tuple[str, ...]) -> dict[str, float]:
     """The estimated peak memory of one episode of ``scenario`` under the worst of ``policies``, by term."""
-    # A recording's people are its annotations', not yet read: tracks of up to RECORDING_PEOPLE at once.
-    people = scenario.people.count if scenario.recording is None else RECORDING_PEOPLE
+    people = people_at_once(scenario)
     actions = scenario.actions.pan_deg.count * scenario.actions.tilt_deg.count * len(scenario.actions.zoom)
     terms = {
         "interpreter": INTERPRETER_BYTES,

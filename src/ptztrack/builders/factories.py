@@ -13,14 +13,16 @@ from ptztrack.builders.registration import live_view_model
 from ptztrack.builders.world import recall_model
 from ptztrack.camera.recorded import RecordedPTZ
 from ptztrack.camera.simulated import SimulatedPTZ
-from ptztrack.config import Scenario
+from ptztrack.config import MAX_DATASET_FRAMES, Scenario, ScenarioError
 from ptztrack.control.baselines import FixPolicy, PatrolPolicy, RandomPolicy, patrol_route, widest_view_action
 from ptztrack.control.exploration import exploration_map
 from ptztrack.control.information_gain import expected_detection_probability
 from ptztrack.control.information_policy import InformationGainPolicy
 from ptztrack.detect.hog import GroundSearch, HogPeopleDetector
+from ptztrack.detect.published import PublishedDetections
 from ptztrack.detect.simulated import AnnotationDetector, RecallCurve, RecallDetector, RecallModel
 from ptztrack.loop import World
+from ptztrack.occupancy.multiview import load_mot_detections
 from ptztrack.track.parameters import TrackerParameters
 from ptztrack.track.templates import TemplateTracker
 from ptztrack.track.tracker import DetectionModel, EkfTracker, pixel_noise_covariance
@@ -43,8 +45,9 @@ def pixel_noise(scenario: Scenario):
 
 
 def people_can_leave(scenario: Scenario) -> bool:
-    """A recording's people come and go; the synthetic scene's only with ``people.enter_leave``."""
-    return scenario.recording is not None or scenario.people.enter_leave
+    """A recording's people and replayed trajectories come and go; the synthetic walkers only with
+    ``people.enter_leave``."""
+    return scenario.recording is not None or scenario.people.trajectories is not None or scenario.people.enter_leave
 
 
 def tracker_parameters(scenario: Scenario) -> TrackerParameters:
@@ -145,6 +148,22 @@ def hog_detector(scenario: Scenario, scene) -> HogPeopleDetector:
         search = GroundSearch(scene.camera, scene.area_polygon_m, detector.hog_person_height_m)
     return HogPeopleDetector(
         detector.hog_upsample, detector.hog_hit_threshold, detector.hog_nms_iou, search, bool(detector.hog_luma)
+    )
+
+
+def detections_detector(scenario: Scenario, scene) -> PublishedDetections:
+    """A recording's precomputed boxes (``recording.detections``, a dataset view's ``detections``) of each
+    step's frame, scored at least ``detector.box_min_score``, carried into the virtual PTZ camera's image
+    at its pose; those whose feet and head fall inside it."""
+    recording = scenario.required_recording("detector.kind 'detections'")
+    if recording.detections is None or scene.virtual is None or scene.recording is None:
+        raise ScenarioError(
+            "detector.kind 'detections' needs the recorded view's boxes (recording.detections; a dataset view's "
+            "detections)"
+        )
+    boxes = load_mot_detections(recording.detections, MAX_DATASET_FRAMES, scene.virtual.recorded_size_px)
+    return PublishedDetections(
+        scene.camera, scene.virtual.recording, boxes, scene.recording.video_frame, scenario.detector.box_min_score, True
     )
 
 

@@ -10,6 +10,7 @@ first step, moved into the view the camera is at before it.
 import numpy as np
 
 from ptztrack.builders.parameters import parameters_from
+from ptztrack.builders.recording import recorded_size_px
 from ptztrack.camera.recorded import RecordedPTZ
 from ptztrack.camera.virtual import virtual_ptz
 from ptztrack.config import Actions, Scenario, ScenarioError
@@ -148,7 +149,11 @@ def target_scenario(scenario: Scenario, target_id: int) -> Scenario:
     rows = rows[np.argsort(annotations.frame[rows])]
     first, last = int(annotations.frame[rows[0]]), int(annotations.frame[rows[-1]])
     calibration = load_calibration(recording.calibration, recording.view)
-    virtual, whole_frame_pose = virtual_ptz(calibration, recording.recorded_size_px, scenario.camera.image_size_px)
+    virtual, whole_frame_pose = virtual_ptz(
+        calibration,
+        recorded_size_px(recording),
+        scenario.camera.image_size_px,
+    )
     position_m = annotations.ground_m[rows[0]]
     parameters = follow_parameters(scenario, virtual.camera)
     middle_m = np.r_[position_m, parameters.person_height_m / 2]

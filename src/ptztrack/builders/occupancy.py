@@ -8,6 +8,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
+from scipy.optimize import linear_sum_assignment
 from scipy.spatial.distance import cdist
 
 from ptztrack.builders.budget import available_memory_bytes
@@ -33,7 +34,6 @@ from ptztrack.occupancy.multiview import (
 )
 from ptztrack.occupancy.parameters import ForegroundParameters, OccupancyParameters
 from ptztrack.occupancy.plaza import PlazaLayout, plaza_stage, plaza_truth
-from ptztrack.occupancy.render import SceneRenderer
 from ptztrack.occupancy.room import RoomLayout, RoomRenderer, room_truth
 from ptztrack.scene.pets import (
     FIT_BOX_HEIGHTS,
@@ -44,6 +44,7 @@ from ptztrack.scene.pets import (
     load_mot_ground_truth,
     refuse_rows_beyond,
 )
+from ptztrack.scene.render import SceneRenderer
 
 log = logging.getLogger(__name__)
 
@@ -365,10 +366,14 @@ def _calibration_misfit(
     annotations: Annotations,
     frames: int,
 ) -> str | None:
-    """A warning line if the ground truth's people, projected into a view with detections and a known
-    image size, stand a median of more than ``FIT_BOX_HEIGHTS`` box heights from the nearest box's feet
-    (the bottom centre) of the same frame: the calibration, most likely, is not this view's. Over the
-    first ``FIT_FRAMES`` of the ``frames`` used, once ``FIT_PEOPLE`` people are seen; else None."""
+    """A warning line if a view's detections stand a median of more than ``FIT_BOX_HEIGHTS`` box heights
+    from the ground truth's people projected into it: the calibration, most likely, is not this view's.
+
+    Each frame's boxes and projected people are paired one to one at the least total distance
+    (``scipy.optimize.linear_sum_assignment`` over the feet distances in each box's heights), so that
+    the median is over the boxes that exist when a detector finds few of the people (only the nearest),
+    and over the people when the boxes are many (people the annotators left out). Over the first
+    ``FIT_FRAMES`` of the ``frames`` used, once ``FIT_PEOPLE`` pairs are made; else None."""
     if boxes is None or size_px is None:
         return None
     checked = min(frames, len(boxes), FIT_FRAMES)
@@ -380,19 +385,19 @@ def _calibration_misfit(
     for index in np.unique(frame):
         found = boxes[index]
         if len(found):
-            distance_px = cdist(feet_px[frame == index], box_feet_px(found))
-            nearest = distance_px.argmin(axis=1)
-            misses.append(distance_px[np.arange(len(nearest)), nearest] / found[nearest, 3])
-    people = sum(len(miss) for miss in misses)
-    if people < FIT_PEOPLE:
+            box_heights = cdist(feet_px[frame == index], box_feet_px(found)) / found[:, 3]
+            people, paired = linear_sum_assignment(box_heights)
+            misses.append(box_heights[people, paired])
+    pairs = sum(len(miss) for miss in misses)
+    if pairs < FIT_PEOPLE:
         return None
     median = float(np.median(np.concatenate(misses)))
     if median <= FIT_BOX_HEIGHTS:
         return None
     return (
-        f"{view.calibration}: {field} ({view.name}): the ground truth projects a median {median:.2g} box heights "
-        f"from the nearest detection ({people} people, first {checked} frames; expected under {FIT_BOX_HEIGHTS:g}): "
-        "is this the view's calibration?"
+        f"{view.calibration}: {field} ({view.name}): its detections stand a median {median:.2g} box heights "
+        f"from the ground truth's people projected into it ({pairs} pairs, first {checked} frames; expected under "
+        f"{FIT_BOX_HEIGHTS:g}): is this the view's calibration?"
     )
 
 
@@ -463,16 +468,16 @@ def plaza_layout() -> PlazaLayout:
 
 
 def plaza_renderer(people: int, frames: int, seed: int) -> SceneRenderer:
-    """The synthetic plaza's renderer (:mod:`ptztrack.occupancy.plaza`): PETS 2009 S2.L1's seven
-    calibrated views (the built-in ``pets`` dataset's calibrations, in its order, at their image
-    sizes: 768 x 576 or 720 x 576 px) watching ``people`` walk for ``frames`` frames."""
-    pets, layout = pets_dataset(), plaza_layout()
+    """The synthetic plaza's renderer (:mod:`ptztrack.occupancy.plaza`): PETS 2009 S2.L1's seven views
+    (the built-in dataset's, in its order), each through its official Tsai calibration
+    (``View_00N.xml`` beside the dataset file, which states the image size: 768 x 576 or 720 x 576 px),
+    watching ``people`` walk for ``frames`` frames."""
+    layout = plaza_layout()
     cameras, sizes_px = [], []
-    for index, view in enumerate(pets.views):
-        calibration, size_px = _calibration(view, f"views.{index}")
-        assert size_px is not None  # a Tsai file states its image size
-        cameras.append(calibration)
-        sizes_px.append(size_px)
+    for view in pets_dataset().views:
+        tsai = load_tsai(Path(view.calibration).with_name(f"{view.name}.xml"))
+        cameras.append(pinhole_from_tsai(tsai))
+        sizes_px.append(tsai.image_size_px)
     truth = plaza_truth(layout, people, frames, seed)
     return SceneRenderer(cameras, sizes_px, plaza_stage(layout, cameras), truth, seed)
 

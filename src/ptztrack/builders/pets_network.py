@@ -42,7 +42,7 @@ from ptztrack.camera.actions import ActionGrid
 from ptztrack.camera.parameters import LandingError
 from ptztrack.camera.pose_feedback import commanded_pose
 from ptztrack.camera.virtual import virtual_ptz
-from ptztrack.config import Scenario, ScenarioError, pets_dataset
+from ptztrack.config import Scenario, ScenarioError, dataset_from_dict, load_dataset
 from ptztrack.control.network_policy import NetworkInformationPolicy
 from ptztrack.detect.published import PublishedDetections
 from ptztrack.detect.simulated import RecallModel
@@ -67,11 +67,26 @@ PUBLISHED_NOISE_DOF = 4.0
 
 
 def published_views(scenario: Scenario) -> tuple[CameraView, ...]:
-    """The built-in PETS dataset's views other than the scenario's recorded one (View_003 to View_008):
-    their calibrations and published boxes (:func:`~ptztrack.builders.occupancy.recording_from_dataset`)."""
-    recording = scenario.required_recording("a PETS camera network")
-    others = [view.model_dump() for view in pets_dataset().views if view.name != recording.view]
-    return recording_from_dataset(pets_dataset(views=others)).views
+    """The views of the recording's dataset file other than the recorded one that have boxes (the built-in
+    PETS dataset's View_003 to View_008): their calibrations and published boxes
+    (:func:`~ptztrack.builders.occupancy.recording_from_dataset`)."""
+    recording = scenario.required_recording("a camera network over a recording")
+    if recording.dataset is None:
+        raise ScenarioError(
+            "a camera network over a recording needs its dataset file (recording.dataset), whose other views' "
+            "detections are the fixed cameras"
+        )
+    dataset = load_dataset(recording.dataset)
+    others = [
+        view.model_dump()
+        for view in dataset.views
+        if view.name != recording.dataset_view and view.detections is not None
+    ]
+    if not others:
+        raise ScenarioError(
+            f"{recording.dataset}: no view but {recording.dataset_view} has detections: a network needs fixed cameras"
+        )
+    return recording_from_dataset(dataset_from_dict({**dataset.model_dump(), "views": others}, dataset.name)).views
 
 
 def published_camera_world(

@@ -5,6 +5,7 @@ its views depart from the pinhole model, its reference index and the registered 
 import numpy as np
 
 from ptztrack.builders.parameters import parameters_from
+from ptztrack.builders.recording import recorded_size_px
 from ptztrack.camera.live_view import k1_at_zoom
 from ptztrack.camera.parameters import LiveViewModel
 from ptztrack.camera.pose_feedback import RegisteredPose, build_reference_index, cached_reference_index, reference_poses
@@ -20,9 +21,9 @@ from ptztrack.scene.pets import RecordedVideo
 # 2nd frame from 0) never shows, so no live view is ever of a reference view's frame.
 REFERENCE_FIRST_FRAME = 1
 REFERENCE_FRAME_STEP = 2
-# The registration experiment's live views are of frames at least this many frames (30 s at PETS's
-# 10 frames/s) after the last reference view's: people have moved on, and the light has changed.
-LIVE_GAP_FRAMES = 300
+LIVE_GAP_S = 30.0
+"""The registration experiment's live views are of frames at least this long after the last reference
+view's: people have moved on, and the light has changed."""
 # The stream that draws how roughly the reference views' poses are known: one for all runs and seeds,
 # so that they share one reference index.
 REFERENCE_SEED = 20091
@@ -37,7 +38,11 @@ def registration_camera(
     """
     recording = scenario.required_recording("registration")
     calibration = calibration or load_calibration(recording.calibration, recording.view)
-    return virtual_ptz(calibration, recording.recorded_size_px, scenario.pose_feedback.image_size_px)
+    return virtual_ptz(
+        calibration,
+        recorded_size_px(recording),
+        scenario.pose_feedback.image_size_px,
+    )
 
 
 def live_view_model(scenario: Scenario, calibration: PinholeCalibration | None = None) -> LiveViewModel | None:
@@ -93,7 +98,11 @@ def reference_index(
 
     def build():
         numbers = reference_frames(len(poses))
-        source = video or RecordedVideo(video_path, recording.recorded_size_px, int(numbers[-1]) + 1)
+        source = video or RecordedVideo(
+            video_path,
+            recorded_size_px(recording),
+            int(numbers[-1]) + 1,
+        )
         frames = [source.frame(int(frame)) for frame in numbers]
         rng = np.random.default_rng(REFERENCE_SEED)
         return build_reference_index(

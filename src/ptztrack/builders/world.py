@@ -9,6 +9,7 @@ import numpy as np
 
 from ptztrack import registry
 from ptztrack.builders.parameters import parameters_from
+from ptztrack.builders.recording import recorded_size_px
 from ptztrack.builders.registration import registered_pose_source
 from ptztrack.camera.actions import ActionGrid
 from ptztrack.camera.parameters import LandingError
@@ -33,6 +34,13 @@ from ptztrack.scene.pets import (
     refuse_rows_beyond,
 )
 from ptztrack.scene.synthetic import walk_people
+from ptztrack.scene.trajectories import (
+    centring_offset_m,
+    read_trajectories,
+    replay_truth,
+    trajectories_outside_area,
+    trajectories_too_fast,
+)
 from ptztrack.types import GroundTruth
 
 log = logging.getLogger(__name__)
@@ -86,15 +94,18 @@ def crowd(scenario: Scenario) -> Crowd:
 
 
 def build_scene(scenario: Scenario, scene_rng: np.random.Generator) -> BuiltScene:
-    """The synthetic scene (walkers drawn from ``scene_rng``), or the recording seen by a virtual PTZ camera."""
+    """The synthetic scene (walkers drawn from ``scene_rng``, or the people of ``people.trajectories``
+    replayed: :func:`replayed_truth`), or the recording seen by a virtual PTZ camera."""
     if scenario.recording is None:
-        truth = walk_people(crowd(scenario), scenario.area_m, scenario.frames, scenario.frame_rate_hz, scene_rng)
+        if scenario.people.trajectories is not None:
+            truth = replayed_truth(scenario, scene_rng)
+        else:
+            truth = walk_people(crowd(scenario), scenario.area_m, scenario.frames, scenario.frame_rate_hz, scene_rng)
         return BuiltScene(ptz_camera(scenario), action_grid(scenario), truth, rectangle_m(*scenario.area_m))
     recording = scenario.recording
     calibration = load_calibration(recording.calibration, recording.view)
-    virtual, whole_frame_pose = virtual_ptz(
-        calibration, recording.recorded_size_px, scenario.camera.image_size_px, recording.map_grid_px
-    )
+    size_px = recorded_size_px(recording)
+    virtual, whole_frame_pose = virtual_ptz(calibration, size_px, scenario.camera.image_size_px, recording.map_grid_px)
     offsets = action_grid(scenario)
     grid = ActionGrid(
         offsets.pan_deg + whole_frame_pose[0], offsets.tilt_deg + whole_frame_pose[1], offsets.zoom, offsets.max_steps
@@ -112,7 +123,7 @@ def build_scene(scenario: Scenario, scene_rng: np.random.Generator) -> BuiltScen
         recording.ground_truth,
         annotations.select(np.isin(annotations.frame, scene.video_frame)),
         calibration,
-        recording.recorded_size_px,
+        size_px,
         recording.calibration,
     )
     if misfit is not None:
@@ -123,7 +134,7 @@ def build_scene(scenario: Scenario, scene_rng: np.random.Generator) -> BuiltScen
         area_polygon_m = visible_ground_m(scenario, virtual.camera, whole_frame_pose, grid)
     video = None
     if recording.video is not None:
-        video = RecordedVideo(recording.video, recording.recorded_size_px, int(scene.video_frame.max()) + 1)
+        video = RecordedVideo(recording.video, size_px, int(scene.video_frame.max()) + 1)
         refuse_rows_beyond(
             recording.ground_truth,
             annotations.frame,
@@ -132,6 +143,29 @@ def build_scene(scenario: Scenario, scene_rng: np.random.Generator) -> BuiltScen
             f"the {video.frame_count} frames of {recording.video}",
         )
     return BuiltScene(virtual.camera, grid, scene.truth, area_polygon_m, scene, virtual, calibration, video)
+
+
+def replayed_truth(scenario: Scenario, scene_rng: np.random.Generator) -> GroundTruth:
+    """The people of the file ``people.trajectories`` at the scenario's steps, moved by
+    ``people.trajectories_offset_m`` (None: centred on the area), each of a height drawn uniformly from
+    ``people.height_m`` with ``scene_rng`` (one per person of the file, in increasing id order);
+    positions far outside the area or too fast to be walking are logged as a warning."""
+    people = scenario.people
+    # The scenario's validation requires the rate with the file.
+    assert people.trajectories is not None and people.trajectories_frame_rate_hz is not None
+    trajectories = read_trajectories(people.trajectories, people.trajectories_frame_rate_hz)
+    if people.trajectories_offset_m is not None:
+        offset_m = np.asarray(people.trajectories_offset_m, dtype=float)
+    else:
+        offset_m = centring_offset_m(trajectories, scenario.area_m)
+    for warning in (
+        trajectories_outside_area(trajectories, offset_m, scenario.area_m),
+        trajectories_too_fast(trajectories),
+    ):
+        if warning is not None:
+            log.warning(warning)
+    heights_m = scene_rng.uniform(*people.height_m, size=len(trajectories.people))
+    return replay_truth(trajectories, scenario.frames, scenario.frame_rate_hz, heights_m, people.width_m, offset_m)
 
 
 def visible_ground_m(scenario: Scenario, camera: PTZCamera, whole_frame_pose, grid: ActionGrid) -> np.ndarray:

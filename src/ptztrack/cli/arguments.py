@@ -81,8 +81,14 @@ def parser() -> argparse.ArgumentParser:
     _add_executor_arguments(synthetic, "one row per strategy")
     synthetic.set_defaults(handler="ptztrack.cli.ptz_paper:synthetic_experiment_command")
 
-    pets = experiments.add_parser("pets", help="the PTZ paper's Tables 3-4 on PETS 2009 S2.L1")
-    pets.add_argument("--detector", default="ideal", help="ideal (the annotations) or hog")
+    pets = experiments.add_parser(
+        "pets", help="the PTZ paper's Tables 3-4 on a recording (default PETS 2009 S2.L1; --dataset for another)"
+    )
+    pets.add_argument(
+        "--detector",
+        default="ideal",
+        help="ideal (the annotations), hog, detections (the dataset view's own boxes) or a registered one",
+    )
     _add_detector_model_arguments(pets)
     pets.add_argument(
         "--beta",
@@ -96,8 +102,8 @@ def parser() -> argparse.ArgumentParser:
         "--protocol",
         choices=PROTOCOLS,
         default="a-priori",
-        help="a-priori: every parameter fixed before looking at S2.L1; two-fold: the detector's model fitted on "
-        "one half of the frames, the table scored on the other, both ways",
+        help="a-priori: every parameter fixed before looking at the recording; two-fold: the detector's model "
+        "fitted on one half of the frames, the table scored on the other, both ways",
     )
     pets.add_argument("--seeds", type=_positive_int, default=5, help="runs of a strategy whose run depends on its seed")
     _add_tracker_arguments(pets)
@@ -154,7 +160,43 @@ def parser() -> argparse.ArgumentParser:
     _add_occupancy_parser(experiments)
     _add_network_parser(experiments, detectors)
     _add_camera_commands(commands, policies)
+    _add_render_parser(commands)
     return root
+
+
+def _add_render_parser(commands) -> None:
+    """``ptztrack render``: a scenario's people and cameras rendered into a multi-view dataset folder."""
+    from ptztrack.names import PEOPLE_LOOKS
+
+    render = commands.add_parser(
+        "render", help="render a scenario's people and cameras into a dataset: videos, calibration, ground truth"
+    )
+    render.add_argument(
+        "--scenario",
+        required=True,
+        help="a scenario YAML file without a recording (its cameras, or its one camera, aimed at the area's "
+        "centre; its area, frames, frame rate and people), or 'synthetic' (built in)",
+    )
+    render.add_argument(
+        "--out",
+        type=Path,
+        required=True,
+        help="the dataset folder: dataset.yaml, calibration.json, a video and a gt_*.txt per view; written whole or "
+        "not at all",
+    )
+    render.add_argument(
+        "--seed", type=_non_negative_int, default=0, help="draws the people's walks, textures and clothes (default 0)"
+    )
+    render.add_argument("--overwrite", action="store_true", help="replace a non-empty --out folder")
+    render.add_argument(
+        "--people-look",
+        choices=PEOPLE_LOOKS,
+        default=PEOPLE_LOOKS[0],
+        help="the people drawn as textured cone bodies, or as pedestrians cut out of PETS 2009 View_001 "
+        f"(default {PEOPLE_LOOKS[0]}: to HOG, the closer to real people)",
+    )
+    _add_quiet_argument(render)
+    render.set_defaults(handler="ptztrack.cli.render:render_command")
 
 
 def _add_camera_commands(commands, policies: list[str]) -> None:
@@ -182,6 +224,7 @@ def _add_camera_commands(commands, policies: list[str]) -> None:
     )
     live.add_argument("--policy", choices=policies, default="smpl")
     live.add_argument("--scenario", default="pets", help="'pets' (built in) or a scenario YAML file")
+    _add_recording_arguments(live, files=False)
     live.add_argument("--detector", default="hog", help="the scenario's detector (default hog)")
     _add_detector_model_arguments(live)
     live.add_argument(
@@ -213,12 +256,15 @@ def _add_camera_commands(commands, policies: list[str]) -> None:
     )
     calibrate.set_defaults(handler="ptztrack.cli.camera:calibrate_camera_command")
 
-    serve = commands.add_parser("serve-camera", help="serve the PETS virtual PTZ camera over ONVIF on 127.0.0.1")
+    serve = commands.add_parser(
+        "serve-camera", help="serve a recording's virtual PTZ camera over ONVIF on 127.0.0.1 (default PETS 2009 S2.L1)"
+    )
     serve.add_argument("--port", type=_port, default=8080, help="the first camera's port (0: any free port each)")
     serve.add_argument(
         "--cameras", type=_positive_int, default=1, help="serve this many cameras, on --port and the ports after it"
     )
     serve.add_argument("--scenario", default="pets", help="'pets' (built in) or a recording scenario YAML file")
+    _add_recording_arguments(serve, files=False)
     serve.add_argument("--time-scale", type=_positive_float, default=1.0, help="the recording's speed")
     serve.add_argument("--user", help=f"require this user (password: --credentials or ${PASSWORD_VARIABLE})")
     serve.add_argument("--credentials", type=Path, help="a YAML file with username and password to require")
@@ -330,8 +376,8 @@ def _add_network_parser(experiments, detectors: list[str]) -> None:
     network.add_argument(
         "setting",
         choices=("synthetic", "pets"),
-        help="synthetic: 1 to --max-ptz cameras around the area; pets: the virtual PTZ camera over View_001 and "
-        "the published detections of View_003-008 as fixed cameras",
+        help="synthetic: 1 to --max-ptz cameras around the area; pets: the virtual PTZ camera over a dataset's "
+        "view (--dataset, --view; default PETS 2009 S2.L1's View_001) and its other views' detections as fixed cameras",
     )
     network.add_argument(
         "--detector",
@@ -354,6 +400,7 @@ def _add_network_parser(experiments, detectors: list[str]) -> None:
     network.add_argument(
         "--method", choices=("intg", "smpl"), default="intg", help="the PTZ cameras' expected information"
     )
+    _add_recording_arguments(network, files=False)
     _add_executor_arguments(network, "one row per configuration")
     network.set_defaults(handler="ptztrack.cli.network:network_experiment_command")
 
@@ -419,10 +466,20 @@ def _add_association_argument(command: argparse.ArgumentParser) -> None:
     )
 
 
-def _add_recording_arguments(command: argparse.ArgumentParser) -> None:
-    """Files of a recording that replace the scenario's (the built-in PETS ones with ``pets``)."""
-    recording = command.add_argument_group("recording files (replace the scenario's)")
-    recording.add_argument("--video", type=Path, help="the recorded video")
+def _add_recording_arguments(command: argparse.ArgumentParser, files: bool = True) -> None:
+    """The recording: a dataset file's view (the built-in PETS 2009 S2.L1's View_001 by default), and with
+    ``files`` the single files that replace the scenario's."""
+    recording = command.add_argument_group("recording (default: the built-in PETS 2009 S2.L1, View_001)")
+    recording.add_argument(
+        "--dataset",
+        help="a dataset YAML file (docs: dataset files; 'pets': the built-in one) whose view the camera runs on",
+    )
+    recording.add_argument(
+        "--dataset-view", metavar="NAME", help="the dataset's view (default: its first view with a video)"
+    )
+    if not files:
+        return
+    recording.add_argument("--video", type=Path, help="the recorded video (replaces the scenario's)")
     recording.add_argument("--calibration", type=Path, help="pinhole JSON or Tsai XML calibration of the recording")
     recording.add_argument("--gt", type=Path, help="MOTChallenge ground truth with world positions in metres")
 

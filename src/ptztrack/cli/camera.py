@@ -54,7 +54,9 @@ def _credentials(args: argparse.Namespace) -> dict | None:
 
 
 def live_command(args: argparse.Namespace) -> int:
-    scenario = build_scenario(args.scenario, args.detector, detector_model=args.detector_model)
+    scenario = build_scenario(
+        args.scenario, args.detector, detector_model=args.detector_model, dataset=args.dataset, view=args.dataset_view
+    )
     calibrations = _calibrations(args)
     addresses = [camera_address(url, _credentials(args)) for url in args.camera]
     truth_log = None if args.truth is None else read_truth_log(args.truth)
@@ -205,7 +207,7 @@ def calibrate_camera_command(args: argparse.Namespace) -> int:
 
 
 def serve_camera_command(args: argparse.Namespace) -> int:
-    scenario = build_scenario(args.scenario)
+    scenario = build_scenario(args.scenario, dataset=args.dataset, view=args.dataset_view)
     credentials = _credentials(args) or {}
     username = args.user or credentials.get("username", "")
     password = credentials.get("password") or os.environ.get(PASSWORD_VARIABLE, "")

@@ -4,10 +4,11 @@ import argparse
 import sys
 from pathlib import Path
 
+from ptztrack.builders.recording import FOLLOW_PROTOCOL, pets_follow_scenario
 from ptztrack.cli.arguments import RUN_FOLDER_FILES
-from ptztrack.cli.scenario import recording_overrides, recording_paths
+from ptztrack.cli.scenario import build_scenario, recording_overrides, recording_paths
 from ptztrack.cli.watch import Watch
-from ptztrack.config import Scenario, load_scenario, pets_follow_scenario
+from ptztrack.config import Scenario, load_scenario
 from ptztrack.evaluate.executors import Progress
 from ptztrack.evaluate.report import write_outputs
 from ptztrack.evaluate.video import view_renderer
@@ -30,12 +31,18 @@ from ptztrack.files import check_output_folder, run_folder, write_json
 
 
 def _follow_scenario(args: argparse.Namespace, tracker: str = "particle") -> Scenario:
-    """The follow camera's scenario: the built-in PETS one or a YAML file, with the command line's changes."""
+    """The follow camera's scenario: the built-in PETS one, a dataset file's view or a YAML file, with the
+    command line's changes."""
     overrides = recording_overrides(recording_paths(args))
     if args.achromatic_bins:
         overrides["follow.achromatic_bins"] = True
     if getattr(args, "target_point_px", None) is not None:
         overrides["follow.target_point_px"] = tuple(args.target_point_px)
+    if args.dataset is not None or args.dataset_view is not None:
+        overrides["tracker.kind"] = tracker
+        return build_scenario(
+            args.scenario, dataset=args.dataset, view=args.dataset_view, protocol=FOLLOW_PROTOCOL, overrides=overrides
+        )
     if args.scenario == "pets":
         return pets_follow_scenario(tracker, **overrides)
     return load_scenario(args.scenario, **overrides, **{"tracker.kind": tracker})

@@ -11,7 +11,7 @@ from ptztrack.files import write_json
 
 # The options of one setting only, and their defaults.
 SYNTHETIC_OPTIONS = {"sequences": 12, "first_sequence": 0, "max_ptz": 4}
-PETS_OPTIONS = {"seeds": 5, "beta": 9.0}
+PETS_OPTIONS = {"seeds": 5, "beta": 9.0, "dataset": None, "dataset_view": None}
 
 
 def network_experiment_command(args: argparse.Namespace) -> int:
@@ -44,7 +44,14 @@ def _pets_command(args: argparse.Namespace) -> int:
         run_pets_network_table,
     )
 
-    scenario = build_scenario("pets", args.detector or "hog", args.frames, detector_model=args.detector_model)
+    scenario = build_scenario(
+        "pets",
+        args.detector or "hog",
+        args.frames,
+        detector_model=args.detector_model,
+        dataset=args.dataset,
+        view=args.dataset_view,
+    )
     scenario = scenario.model_copy(update={"control": scenario.control.model_copy(update={"beta": args.beta})})
     cells = pets_network_cells(scenario, published_views(scenario), args.seeds, args.method)
     print(f"{len(cells)} episodes, {args.executor} executor", file=sys.stderr)

@@ -7,9 +7,9 @@ from ptztrack.cli.scenario import build_scenario, command_scenario
 from ptztrack.experiments.cells import Execution
 from ptztrack.experiments.ptz_tables import (
     format_report,
-    pets_title,
     protocol_folds,
     recording_cells,
+    recording_title,
     run_table,
     shared_views_key,
     synthetic_cells,
@@ -47,7 +47,7 @@ def pets_experiment_command(args: argparse.Namespace) -> int:
         for fold in folds
         for cell in recording_cells(fold.scenario, betas, args.strategies, args.seeds, fold.index)
     ]
-    title = pets_title(scenario, args.protocol, args.seeds)
+    title = recording_title(scenario, args.protocol, args.seeds)
     extra = {
         "protocol": args.protocol,
         "fitted": [fold.fitted for fold in folds],

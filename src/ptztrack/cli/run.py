@@ -36,7 +36,8 @@ def run_command(args: argparse.Namespace) -> int:
         episode = run_episode(scenario, policy, args.seed, world, observer=watch.observe(world, policy))
     metrics = episode_metrics(episode)
     print(
-        f"scenario {args.scenario}, policy {args.policy}, detector {scenario.detector.kind}, "
+        f"scenario {args.scenario if scenario.recording is None else scenario.recording.name}, "
+        f"policy {args.policy}, detector {scenario.detector.kind}, "
         f"seed {args.seed}, {len(episode.actions)} steps, {episode.truth.positions_m.shape[1]} people"
     )
     print(format_metrics(metrics))

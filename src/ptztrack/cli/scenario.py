@@ -2,7 +2,8 @@
 
 import argparse
 
-from ptztrack.config import Scenario, load_scenario, pets_scenario, scenario_from_dict
+from ptztrack.builders.recording import dataset_scenario, pets_scenario
+from ptztrack.config import PETS_DATASET_FILE, Scenario, load_dataset, load_scenario, pets_dataset, scenario_from_dict
 
 
 def build_scenario(
@@ -14,15 +15,23 @@ def build_scenario(
     measurement_source: str | None = None,
     detector_model: str | None = None,
     prior_shift_px: float | None = None,
+    dataset: str | None = None,
+    view: str | None = None,
+    protocol: dict | None = None,
+    overrides: dict | None = None,
 ) -> Scenario:
     """The built-in synthetic or PETS scene or a YAML file, with command-line overrides applied.
+
+    dataset, view : a dataset file's view as the recording ('pets': the built-in one), under the
+    built-in ``protocol`` (default the PTZ tables'), or under the scenario file's own settings.
+    overrides : further scenario overrides (``"section.field": value``).
 
     recording_paths : {'video' | 'calibration' | 'ground_truth': path} replacing the recording's files.
     association : 'hungarian' or 'cjpdaf', replacing ``tracker.association``.
     measurement_source : 'detector' or 'spatiogram', replacing ``tracker.measurement_source``.
     detector_model, prior_shift_px : replacing ``detector.model`` and ``detector.prior_shift_px``.
     """
-    overrides = recording_overrides(recording_paths or {})
+    overrides = {**recording_overrides(recording_paths or {}), **(overrides or {})}
     options = {
         "detector.model": detector_model,
         "detector.prior_shift_px": prior_shift_px,
@@ -32,11 +41,27 @@ def build_scenario(
         "frames": frames,
     }
     overrides.update({field: value for field, value in options.items() if value is not None})
+    if dataset is not None or view is not None:
+        return _dataset_scenario(name_or_path, dataset, view, protocol, overrides)
     if name_or_path == "synthetic":
         return scenario_from_dict({}, "synthetic", **overrides)
     if name_or_path == "pets":
         return pets_scenario(str(overrides.pop("detector.kind", "ideal")), **overrides)
     return load_scenario(name_or_path, **overrides)
+
+
+def _dataset_scenario(
+    name_or_path: str, dataset: str | None, view: str | None, protocol: dict | None, overrides: dict
+) -> Scenario:
+    """The view ``view`` of ``dataset`` (None or 'pets': the built-in one), under the built-in protocol for
+    'synthetic' and 'pets', else under the scenario file's settings (its recording replaced)."""
+    if dataset in (None, "pets"):
+        loaded, path = pets_dataset(), str(PETS_DATASET_FILE)
+    else:
+        loaded, path = load_dataset(dataset), dataset
+    if name_or_path not in ("synthetic", "pets"):
+        protocol = load_scenario(name_or_path).model_dump(exclude_unset=True, exclude={"recording"})
+    return dataset_scenario(loaded, view, protocol, path, **overrides)
 
 
 def command_scenario(args: argparse.Namespace, name_or_path: str) -> Scenario:
@@ -51,6 +76,8 @@ def command_scenario(args: argparse.Namespace, name_or_path: str) -> Scenario:
         args.measurement_source,
         args.detector_model,
         getattr(args, "prior_shift_px", None),
+        args.dataset,
+        args.dataset_view,
     )
 
 

@@ -23,7 +23,9 @@ class DatasetView(_Strict):
     image_size_px : (width, height); read from a Tsai XML, checked against it when given; needed with
     a pinhole JSON. video (a file) or images (a folder, frames in sorted name order) : the frames,
     for motion edges; detections : a MOTChallenge detection file (``frame,-1,left,top,width,height,score,...``,
-    frames from 1), for views without frames and for the clustering baseline. weight : ``w_c``.
+    frames from 1), for views without frames, the clustering baseline and the PTZ camera's ``detections``
+    detector. ground_truth : the view's own annotations (MOTChallenge rows, boxes in its pixels, world x, y
+    in metres), where the dataset's boxes are another view's. weight : ``w_c``.
     """
 
     name: str
@@ -33,6 +35,7 @@ class DatasetView(_Strict):
     video: str | None = None
     images: str | None = None
     detections: str | None = None
+    ground_truth: str | None = None
     weight: Annotated[PositiveFloat, at_most(1e6, "a relative weight")] = 1.0
 
     @model_validator(mode="after")
@@ -117,6 +120,8 @@ class MultiViewDataset(_Strict):
     dataset file are relative to it.
 
     area_m : [[x0, y0], [x1, y1]] the ground the map covers, metres (people outside it are not scored);
+    tracking_area_m : [[x0, y0], [x1, y1]] m where the annotations are complete, if the recording has such
+    a rectangle (the camera network's table scores there too, its TA columns);
     frames : how many frames to use (default: all that every view and the ground truth have);
     ground_truth : MOTChallenge rows with world x, y in metres in columns 8-9 (frames from 1).
     """
@@ -127,6 +132,7 @@ class MultiViewDataset(_Strict):
         Annotated[int, Field(ge=1), at_most(MAX_DATASET_FRAMES, "memory: every frame's map and modes are kept")] | None
     ) = None
     area_m: tuple[tuple[float, float], tuple[float, float]]
+    tracking_area_m: tuple[tuple[float, float], tuple[float, float]] | None = None
     ground_truth: str | None = None
     views: Annotated[list[DatasetView], Field(min_length=1), at_most_items(64, "time: every view's loci, every frame")]
     occupancy: Occupancy = Occupancy()
@@ -158,7 +164,7 @@ class MultiViewDataset(_Strict):
         return self
 
 
-DATASET_PATH_FIELDS = ("calibration", "video", "images", "detections")
+DATASET_PATH_FIELDS = ("calibration", "video", "images", "detections", "ground_truth")
 
 
 def dataset_from_dict(data: Any, source: str = "dataset") -> MultiViewDataset:
@@ -193,38 +199,14 @@ def load_dataset(path: str | Path) -> MultiViewDataset:
     return dataset_from_dict(data, str(path))
 
 
-# PETS 2009 S2.L1 as a multi-view dataset: the seven views with published detections (View_002 has
-# none), their official Tsai calibrations, View_001's video. The area holds every annotated
-# position with a margin of about a metre. A person in these views is 0.1-0.4 m on the ground per
-# 4-15 px of feet error (the detections' median, README of the data), hence the wider kernel and
-# cells than in the room; 10 fps as in the PETS scenario.
-PETS_VIEWS = ("View_001", "View_003", "View_004", "View_005", "View_006", "View_007", "View_008")
-PETS_OCCUPANCY = {"cell_m": 0.1, "kernel_sigma_m": 0.25}
-PETS_TRACKING_AREA_M = ((-14.0696, -14.274), (4.9813, 1.9615))
-"""S2.L1's tracking area, ((x0, y0), (x1, y1)) m: the rectangle of published tracking results, whose
-annotated people are A. Milan's cropped annotations (``PETS2009-S2L1-cropped.xml.gz``, shipped with the
-data: the rows of ``gt_mot15.txt`` whose feet lie in it, but for a few within 0.25 m of its edge)."""
+PETS_DATASET_FILE = Path(str(resources.files("ptztrack.data") / "pets2009_s2l1" / "dataset.yaml"))
+"""The built-in recording, PETS 2009 S2.L1 (seven views with published detections; View_002 has none)."""
 
 
 def pets_dataset(**overrides) -> MultiViewDataset:
-    """The built-in PETS 2009 S2.L1 dataset (seven views), from the files shipped with ptztrack."""
-    data_dir = resources.files("ptztrack.data") / "pets2009_s2l1"
-    views = [
-        {
-            "name": view,
-            "calibration": str(data_dir / f"{view}.xml"),
-            "detections": str(data_dir / f"{view}_det.txt.gz"),
-            **({"video": str(data_dir / "View_001.avi")} if view == "View_001" else {}),
-        }
-        for view in PETS_VIEWS
-    ]
-    data = {
-        "name": "pets",
-        "frame_rate_hz": 10.0,
-        "area_m": ((-21.0, -17.5), (8.5, 9.0)),
-        "ground_truth": str(data_dir / "gt_mot15.txt"),
-        "views": views,
-        "occupancy": PETS_OCCUPANCY,
-        **overrides,
-    }
-    return dataset_from_dict(data, "pets")
+    """The built-in PETS 2009 S2.L1 dataset (:data:`PETS_DATASET_FILE`), with top-level fields replaced by
+    ``overrides``."""
+    dataset = load_dataset(PETS_DATASET_FILE)
+    if not overrides:
+        return dataset
+    return dataset_from_dict({**dataset.model_dump(), **overrides}, dataset.name)

@@ -1,11 +1,10 @@
 """One validated configuration object per run, loadable from YAML: the scenario, its people, detector,
-tracker, control and recording sections, and the built-in PETS 2009 S2.L1 scenarios.
+tracker, control and recording sections.
 
 The defaults are the synthetic scene of the paper's section 5.1 with the
 camera mounting chosen in :mod:`ptztrack.scene.synthetic`.
 """
 
-from importlib import resources
 from pathlib import Path
 from typing import Annotated, Literal
 
@@ -28,7 +27,7 @@ from ptztrack.config.fields import (
 from ptztrack.config.follow import Follow
 from ptztrack.config.reading import ScenarioError, _first_error_line, read_yaml
 from ptztrack.control.parameters import ControlParameters
-from ptztrack.detect.parameters import DetectorPrior, HogParameters
+from ptztrack.detect.parameters import BoxDetectorParameters, DetectorPrior, HogParameters
 from ptztrack.scene.parameters import Crowd
 from ptztrack.track.parameters import TrackerParameters
 
@@ -40,7 +39,19 @@ _Stay = Annotated[PositiveFloat, at_most(86_400, "seconds: a day")]
 class People(_Strict):
     """The synthetic crowd (:class:`~ptztrack.scene.parameters.Crowd`, whose defaults it takes).
     paired_fraction : the share of the ``count`` people who walk in pairs, side by side
-    ``pair_spacing_m`` apart (pairs: the fraction of count / 2, rounded)."""
+    ``pair_spacing_m`` apart (pairs: the fraction of count / 2, rounded).
+
+    trajectories : a file of recorded people's positions in metres to replay instead of the walkers
+    (:mod:`ptztrack.scene.trajectories`: MOTChallenge rows with metres in columns 8-9, or ``frame id x
+    y`` lines), relative to the scenario file; its people are the crowd, so ``count``, ``speed_m_s``,
+    the turning, ``enter_leave``, ``stay_s`` and the pairs do not apply: each person gets a height drawn
+    from ``height_m`` and the width ``width_m``. Not with a ``recording``, whose people are its own.
+    trajectories_frame_rate_hz : frames per second of the file's frame numbers (neither format says it;
+    a sample of frame f is at (f - the file's first frame) / this rate seconds, the run's step 0 at
+    its first frame). Required with ``trajectories``.
+    trajectories_offset_m : (dx, dy) metres added to the file's positions; None: the translation that
+    puts the centre of the bounding box of all its positions at the centre of ``area_m``.
+    """
 
     count: Annotated[int, Field(ge=0), at_most(1000, "time: the policies score every person under every action")] = (
         Crowd.count
@@ -57,6 +68,9 @@ class People(_Strict):
     pair_spacing_m: Annotated[PositiveFloat, at_most(10, "metres between two people walking together")] = (
         Crowd.pair_spacing_m
     )
+    trajectories: str | None = None
+    trajectories_frame_rate_hz: Annotated[PositiveFloat, at_most(1000, "frames per second")] | None = None
+    trajectories_offset_m: tuple[_Coordinate, _Coordinate] | None = None
 
     @model_validator(mode="after")
     def _intervals_ordered(self):
@@ -64,6 +78,19 @@ class People(_Strict):
             low, high = getattr(self, name)
             if high < low:
                 raise ValueError(f"{name} must be [low, high] with low <= high (got {[low, high]})")
+        return self
+
+    @model_validator(mode="after")
+    def _trajectories_with_their_rate(self):
+        if self.trajectories is not None and self.trajectories_frame_rate_hz is None:
+            raise ValueError(
+                "trajectories_frame_rate_hz is required with trajectories: the frames per second of the "
+                f"file's frame numbers, which it does not say (trajectories {self.trajectories!r})"
+            )
+        if self.trajectories is None:
+            for name in ("trajectories_frame_rate_hz", "trajectories_offset_m"):
+                if getattr(self, name) is not None:
+                    raise ValueError(f"{name} is set but trajectories, the file it is for, is not")
         return self
 
 
@@ -88,6 +115,8 @@ class Detector(_Strict):
     hog_search : 'ground' scans only the windows where a standing person ``hog_person_height_m``
     (shortest, tallest) tall could be seen on the walkable area, at their sizes; 'image' scans every
     window of the pyramid, as OpenCV's ``detectMultiScale`` (:mod:`ptztrack.detect.hog`).
+    box_min_score : 'detections' (the recording's precomputed boxes, ``recording.detections``) reports the
+    boxes scored at least this.
     hog_luma : HOG reads only the pictures' luma (true) or the strongest gradient of their three colours
     (false); unset, luma for a live camera's pictures (decoded from its video stream, whose colour has
     half the resolution each way and its losses) and colour for a recording's views.
@@ -109,6 +138,7 @@ class Detector(_Strict):
     hog_search: Literal["ground", "image"] = "ground"
     hog_person_height_m: tuple[_Height, _Height] = HogParameters.person_heights_m
     hog_luma: bool | None = None
+    box_min_score: float = Field(BoxDetectorParameters.min_score, ge=0, le=1)
     model: str = "online"
     prior_shift_px: Annotated[float, Field(ge=-1000, le=1000)] = 0.0
 
@@ -217,32 +247,46 @@ _VideoFrame = Annotated[int, Field(ge=0), at_most(10_000_000, "video frames: 4 d
 
 
 class Recording(_Strict):
-    """A calibrated recording with ground truth, seen through a virtual PTZ camera (paper section 5.2).
+    """A calibrated recording with ground truth, seen through a virtual PTZ camera (paper section 5.2):
+    usually one view of a dataset file (:func:`ptztrack.builders.recording.dataset_scenario` fills this
+    section from it).
 
     With a recording, the camera's position and focal length come from the
     calibration (``camera.image_size_px`` sets the virtual view), and the
     action grid's pan and tilt are offsets from the pose that shows the whole
     recorded frame. Relative paths in a scenario file are relative to it.
+    view : the view's key in a pinhole JSON calibration (None: its only view).
+    recorded_size_px : the recorded frames' (width, height) (None: read from a Tsai calibration or the video).
+    frame_step : the recorded frames between two steps (the scenario's ``frame_rate_hz`` is the step rate).
     frame_range : [first, stop) video frames (0-based) to run on; default all.
     area_m : the walkable area, a polygon of [x, y] points in metres; default the ground the
     recorded view shows (see :func:`ptztrack.builders.world.visible_ground_m`).
     map_grid_px : the virtual camera computes where each pixel reads the recording exactly every
     ``map_grid_px`` pixels and interpolates in between (1: every pixel; see
     :class:`ptztrack.camera.virtual.VirtualPTZ`).
+    detections : the view's precomputed boxes (MOTChallenge detections), for ``detector.kind`` 'detections'.
+    dataset, dataset_view : the dataset file and its view the recording is (the other views are a camera
+    network's fixed cameras); name : the recording in titles (the dataset's name and the view);
+    tracking_area_m : the dataset's rectangle [[x0, y0], [x1, y1]] m where its annotations are complete.
     """
 
     ground_truth: str
     calibration: str
-    view: str = "View_001"
+    view: str | None = None
     video: str | None = None
-    recorded_size_px: tuple[Pixels, Pixels] = (768, 576)
-    frame_step: Annotated[int, Field(ge=1), at_most(_MAX_FRAMES, "video frames")] = 2
+    recorded_size_px: tuple[Pixels, Pixels] | None = None
+    frame_step: Annotated[int, Field(ge=1), at_most(_MAX_FRAMES, "video frames")] = 1
     occluded_above: float = Field(0.25, ge=0, le=1)
     frame_range: tuple[_VideoFrame, _VideoFrame] | None = None
     area_m: (
         Annotated[tuple[tuple[_Coordinate, _Coordinate], ...], at_most_items(1000, "corners of a polygon")] | None
     ) = None
     map_grid_px: Annotated[int, Field(ge=1), at_most(64, "pixels between the sampling map's grid points")] = 1
+    detections: str | None = None
+    dataset: str | None = None
+    dataset_view: str | None = None
+    tracking_area_m: tuple[tuple[float, float], tuple[float, float]] | None = None
+    name: str = "recording"
 
     @model_validator(mode="after")
     def _range_and_area(self):
@@ -317,12 +361,26 @@ class Scenario(_Strict):
         return self
 
     @model_validator(mode="after")
+    def _one_source_of_people(self):
+        if self.recording is not None and self.people.trajectories is not None:
+            raise ValueError(
+                "people.trajectories replays a file as the synthetic scene's crowd; a recording's people are "
+                f"its recording.ground_truth (got both, people.trajectories {self.people.trajectories!r})"
+            )
+        return self
+
+    @model_validator(mode="after")
     def _images_need_a_video(self):
         has_video = self.recording is not None and self.recording.video is not None
         if self.detector.kind == "hog" and not has_video:
             raise ValueError("detector.kind 'hog' needs a recording with a video (recording.video)")
         if self.pose_feedback.source == "registered" and not has_video:
             raise ValueError("pose_feedback.source 'registered' needs a recording with a video (recording.video)")
+        if self.detector.kind == "detections" and (self.recording is None or self.recording.detections is None):
+            raise ValueError(
+                "detector.kind 'detections' needs the recorded view's boxes (recording.detections; a dataset "
+                "view's detections)"
+            )
         if self.tracker.measurement_source == "spatiogram" and not has_video:
             raise ValueError("tracker.measurement_source 'spatiogram' needs a recording with a video (recording.video)")
         return self
@@ -361,75 +419,6 @@ def scenario_from_dict(data: dict, source: str = "scenario", **overrides) -> Sce
         raise ScenarioError(_first_error_line(error, source)) from None
 
 
-def _pets_recording() -> dict:
-    """The files of the PETS 2009 S2.L1 recording that ship with the package."""
-    data_dir = resources.files("ptztrack.data") / "pets2009_s2l1"
-    return {
-        "ground_truth": str(data_dir / "gt_mot15.txt"),
-        "calibration": str(data_dir / "pinhole.json"),
-        "video": str(data_dir / "View_001.avi"),
-    }
-
-
-def pets_scenario(detector: str = "ideal", **overrides) -> Scenario:
-    """The built-in PETS 2009 S2.L1 scenario: the paper's realistic experiment (section 5.2), with every
-    parameter fixed a priori (the defaults; :func:`ptztrack.experiments.ptz_tables.protocol_folds` fits the
-    detector's model on frames a table does not score).
-
-    detector : 'ideal' (annotated boxes) or 'hog' (OpenCV's people detector on the view).
-    """
-    if detector not in ("ideal", "hog"):
-        raise ScenarioError(f"pets: detector {detector!r} is not available; expected ideal or hog")
-    recording = _pets_recording()
-    data = {
-        "frames": 398,
-        "frame_rate_hz": 5.0,
-        "camera": {"image_size_px": (160, 120)},
-        "actions": {
-            "pan_deg": {"start": -14.0, "stop": 14.0, "count": 7},
-            "tilt_deg": {"start": -10.0, "stop": 10.0, "count": 5},
-            "zoom": (1.0, 2.0, 3.0, 4.0),
-        },
-        "detector": {"kind": detector},
-        # A person's box as the policies see it: the Caltech benchmark's standardised pedestrian aspect
-        # ratio, width = 0.41 x height (Dollar et al., "Pedestrian detection: an evaluation of the state
-        # of the art", 2012), at the policies' 1.75 m.
-        "people": {"width_m": 0.41 * 1.75},
-        # People come and go here (section 5.2): the patrolling term looks for them.
-        "control": {"beta": 1.0},
-        "recording": recording,
-    }
-    return scenario_from_dict(data, "pets", **overrides)
-
-
-def pets_follow_scenario(tracker: str = "particle", **overrides) -> Scenario:
-    """The follow camera on PETS 2009 S2.L1: every recorded frame (10 Hz), seen by a 640 x 480 virtual view.
-
-    640 x 480 is the paper's camera (section IV). The camera starts at the view of the whole recorded
-    frame (the action grid's only pose). tracker : 'particle', 'csrt' or 'mil'. The person
-    is ``follow.target_id``; :func:`ptztrack.builders.follow.target_scenario` narrows the steps to
-    their annotated frames. The virtual camera interpolates its sampling map over 8 px, which keeps a
-    view's rendering at a few milliseconds (see ``recording.map_grid_px``).
-    """
-    data = {
-        "frames": 795,
-        "frame_rate_hz": 10.0,
-        "camera": {"image_size_px": (640, 480)},
-        # One action: the view of the whole recorded frame, where the camera starts; the policy
-        # commands every other pose itself.
-        "actions": {
-            "pan_deg": {"start": 0.0, "stop": 0.0, "count": 1},
-            "tilt_deg": {"start": 0.0, "stop": 0.0, "count": 1},
-            "zoom": (1.0,),
-        },
-        # The annotations lie about 2 px from the calibrated feet in the 768 px frame (0.5 px at 160 px).
-        "detector": {"kind": "ideal", "pixel_noise_px": 0.5},
-        "tracker": {"kind": tracker},
-        "recording": {**_pets_recording(), "frame_step": 1, "map_grid_px": 8},
-    }
-    return scenario_from_dict(data, "pets follow", **overrides)
-
-
 def load_scenario(path: str | Path, **overrides) -> Scenario:
     """Read and validate a YAML scenario file (docs: scenario files, for the format)."""
     path = Path(path)
@@ -441,6 +430,9 @@ def load_scenario(path: str | Path, **overrides) -> Scenario:
     recording = data.get("recording")
     if isinstance(recording, dict):
         data = {**data, "recording": {**recording, **_resolved_paths(recording, path.parent)}}
+    people = data.get("people")
+    if isinstance(people, dict) and isinstance(people.get("trajectories"), str):
+        data = {**data, "people": {**people, "trajectories": str(path.parent / people["trajectories"])}}
     return scenario_from_dict(data, str(path), **overrides)
 
 
@@ -448,5 +440,5 @@ def _resolved_paths(recording: dict, base: Path) -> dict:
     return {
         key: str(base / value)
         for key, value in recording.items()
-        if key in ("ground_truth", "calibration", "video") and isinstance(value, str)
+        if key in ("ground_truth", "calibration", "video", "detections", "dataset") and isinstance(value, str)
     }

@@ -21,6 +21,18 @@ class DetectorPrior:
 
 
 @dataclass(frozen=True)
+class BoxDetectorParameters:
+    """A recording's precomputed boxes as the PTZ camera's detector
+    (:class:`ptztrack.detect.published.PublishedDetections`).
+
+    min_score : boxes scored lower are not reported (0.5: the usual operating threshold of a person
+        detector's score, fixed a priori).
+    """
+
+    min_score: float = 0.5
+
+
+@dataclass(frozen=True)
 class HogParameters:
     """OpenCV's HOG people detector as ptztrack runs it (:class:`ptztrack.detect.hog.HogPeopleDetector`).
 

@@ -51,6 +51,8 @@ class PublishedDetections:
     boxes : per recorded frame, the boxes (K, 5) ``(left, top, width, height, score)`` px of the view.
     video_frame : (T,) the recorded frame of each step.
     min_score : boxes scored lower are not reported.
+    within_image : report only the boxes whose feet and head fall inside ``camera``'s image at the pose
+    (a PTZ camera looking at part of the recorded view); False reports every box in front of it.
     """
 
     camera: PTZCamera
@@ -58,6 +60,7 @@ class PublishedDetections:
     boxes: Sequence[np.ndarray]
     video_frame: np.ndarray
     min_score: float
+    within_image: bool = False
 
     def image(self, step: int, pose) -> None:
         return None
@@ -69,7 +72,8 @@ class PublishedDetections:
         self, camera: CameraBackend, step: int, pose, rng: np.random.Generator, believed_pose=None
     ) -> Detections:
         """The boxes of ``step``'s recorded frame scored at least ``min_score``, as feet and heights in the
-        virtual camera's image at ``pose``; boxes whose feet or head ray points away from it are left out.
+        virtual camera's image at ``pose``; boxes whose feet or head ray points away from it are left out,
+        and with ``within_image`` those whose feet or head fall outside its image.
         Draws nothing from ``rng``: the boxes are the published ones."""
         frame = int(self.video_frame[step])
         found = self.boxes[frame] if frame < len(self.boxes) else np.zeros((0, 5))
@@ -79,6 +83,10 @@ class PublishedDetections:
         points = recorded_to_view(self.calibration, self.camera, pose, np.concatenate([box_feet_px(found), heads_px]))
         feet, heads = points[: len(found)], points[len(found) :]
         seen = np.all(np.isfinite(feet), axis=1) & np.all(np.isfinite(heads), axis=1)
+        if self.within_image:
+            size_px = (self.camera.image_width_px, self.camera.image_height_px)
+            with np.errstate(invalid="ignore"):
+                seen &= np.all((feet >= 0) & (feet <= size_px) & (heads >= 0) & (heads <= size_px), axis=1)
         return Detections(
             feet[seen],
             feet[seen, 1] - heads[seen, 1],

@@ -166,17 +166,20 @@ def write_episode_video(path: str | Path, episode: Episode, render_view: RenderV
     write_video(path, episode_frames(episode, render_view, label), episode.truth.frame_rate_hz, FRAME_SIZE_PX)
 
 
-def write_video(path: str | Path, frames: Iterable[np.ndarray], frame_rate_hz: float, size_px) -> None:
-    """Write ``frames`` ((height, width, 3) uint8 BGR of ``size_px`` (width, height)) to ``path`` (.mp4,
-    MPEG-4 Part 2) through a temporary file beside it and a rename."""
+def write_video(
+    path: str | Path, frames: Iterable[np.ndarray], frame_rate_hz: float, size_px, fourcc: str = "mp4v"
+) -> None:
+    """Write ``frames`` ((height, width, 3) uint8 BGR of ``size_px`` (width, height)) to ``path`` through a
+    temporary file beside it and a rename. fourcc : the codec ('mp4v': MPEG-4 Part 2, for .mp4; 'MJPG':
+    Motion JPEG, for .avi), which OpenCV's FFmpeg encodes; the container is the path's suffix's."""
     path = Path(path)
-    handle, temporary = open_temporary_beside(path, ".mp4")  # OpenCV picks the container by the suffix
+    handle, temporary = open_temporary_beside(path, path.suffix or ".mp4")  # OpenCV picks the container by it
     os.close(handle)
     try:
-        writer = cv2.VideoWriter(str(temporary), cv2.VideoWriter.fourcc(*"mp4v"), frame_rate_hz, tuple(size_px))
+        writer = cv2.VideoWriter(str(temporary), cv2.VideoWriter.fourcc(*fourcc), frame_rate_hz, tuple(size_px))
         try:
             if not writer.isOpened():
-                raise RuntimeError(f"{path}: OpenCV cannot write MPEG-4 video here")
+                raise RuntimeError(f"{path}: OpenCV cannot write {fourcc} video here")
             for frame in frames:
                 writer.write(frame)
         finally:

@@ -17,6 +17,7 @@ import numpy as np
 
 from ptztrack.builders.episode import episode_world, make_policy, run_episode
 from ptztrack.builders.follow import follow_parameters, refuse_unknown_people, target_scenario, target_source
+from ptztrack.builders.recording import recorded_size_px
 from ptztrack.camera.recorded import RecordedPTZ
 from ptztrack.config import Scenario, ScenarioError
 from ptztrack.follow.evaluation import follow_metrics, one_pass_scores, target_in_views
@@ -45,7 +46,7 @@ OTB_FIGURES = ("success_auc", "precision_20px", "fps")
 @dataclass(frozen=True)
 class FollowCell:
     """One person (``target_id``) followed by one tracker ('particle', 'csrt', 'mil') in ``scenario``
-    (a follow scenario, :func:`ptztrack.config.pets_follow_scenario`); ``seed`` fixes the run's draws."""
+    (a follow scenario, :func:`ptztrack.builders.recording.pets_follow_scenario`); ``seed`` fixes the run's draws."""
 
     scenario: Scenario
     tracker: str
@@ -175,7 +176,9 @@ def run_otb_cell(cell: OnePassCell) -> dict:
     frames = np.arange(mine.min(), mine.max() + 1)
     boxes = _boxes_by_frame(annotations, cell.target_id, frames)
     video = RecordedVideo(
-        cell.scenario.required_video("the one-pass benchmark"), recording.recorded_size_px, int(frames[-1]) + 1
+        cell.scenario.required_video("the one-pass benchmark"),
+        recorded_size_px(recording),
+        int(frames[-1]) + 1,
     )
     rng = np.random.default_rng(episode_seeds(cell.seed)[4])
     source = target_source(cell.scenario, cell.tracker, rng)

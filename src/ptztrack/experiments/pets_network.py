@@ -1,8 +1,9 @@
-"""``ptztrack experiment network pets``: the PETS virtual PTZ camera with the published detections of the
-six other views as fixed cameras (:mod:`ptztrack.builders.pets_network`), one shared belief.
+"""``ptztrack experiment network pets``: the virtual PTZ camera over a dataset's view with the published
+detections of its other views as fixed cameras (:mod:`ptztrack.builders.pets_network`), one shared belief;
+on the built-in PETS 2009 S2.L1, View_001 and six fixed views.
 
-Configurations: ``ptz+6fixed`` (the PTZ camera deciding jointly with the fixed views' expected
-information, :mod:`ptztrack.control.network_policy`), ``6fixed`` (the fixed views alone) and ``ptz``
+Configurations (N fixed views): ``ptz+Nfixed`` (the PTZ camera deciding jointly with the fixed views'
+expected information, :mod:`ptztrack.control.network_policy`), ``Nfixed`` (the fixed views alone) and ``ptz``
 (the PTZ camera alone: ``experiment pets --detector hog``'s information-gain run of the same beta and
 seeds, step for step). A run with the PTZ camera depends on its seed (its online detector model's
 draws), so it runs on seeds 0 .. n-1, as the PETS table does; the fixed views alone do not depend on it
@@ -13,9 +14,9 @@ views see. So the tracks are scored where the annotations are, inside the walkab
 the recorded View_001 shows, the area the PTZ camera's policies plan over); ``mota_all_tracks`` scores
 every track, as ``experiment pets`` does (for ``ptz`` it is that table's ``intg`` column of the same
 beta, seed by seed: ``mota_all_tracks_per_seed``). The walkable area reaches far beyond the ground the
-annotators covered, so the ``*_tracking_area`` figures score the tracks and the people inside S2.L1's
-published tracking area (:data:`ptztrack.config.PETS_TRACKING_AREA_M`), where the annotations are those
-of published tracking results.
+annotators covered, so the ``*_tracking_area`` figures score the tracks and the people inside the
+dataset's ``tracking_area_m`` (S2.L1's published tracking area, where the annotations are those of
+published tracking results; the walkable area for a dataset without one).
 """
 
 from collections.abc import Sequence
@@ -25,14 +26,14 @@ from typing import Literal
 import numpy as np
 
 from ptztrack.builders.pets_network import run_pets_network_episode
-from ptztrack.config import PETS_TRACKING_AREA_M, Scenario
+from ptztrack.config import Scenario
 from ptztrack.evaluate.metrics import DISPLAY, looking_metrics, tracking_metrics, tracks_within, truth_within
 from ptztrack.experiments.cells import Execution, run_experiment_cells
 from ptztrack.geometry.area import rectangle_m
 from ptztrack.occupancy.multiview import CameraView
 
-# (label, with the PTZ camera, with the fixed views), in the table's order.
-CONFIGURATIONS = (("ptz+6fixed", True, True), ("6fixed", False, True), ("ptz", True, False))
+# (label, with the PTZ camera, with the fixed views), in the table's order; N: the number of fixed views.
+CONFIGURATIONS = (("ptz+Nfixed", True, True), ("Nfixed", False, True), ("ptz", True, False))
 TRACKING_AREA_KEYS = ("mota", "idf1", "false_positives", "misses")
 SUMMARY_KEYS = (
     "mota",
@@ -76,7 +77,7 @@ def pets_network_cells(
     """Every configuration (:data:`CONFIGURATIONS`): on seeds 0 .. ``seeds`` - 1 with the PTZ camera, once
     (seed 0) without it."""
     return [
-        PetsNetworkCell(scenario, label, ptz, tuple(views) if fixed else (), seed, method)
+        PetsNetworkCell(scenario, label.replace("N", str(len(views))), ptz, tuple(views) if fixed else (), seed, method)
         for label, ptz, fixed in CONFIGURATIONS
         for seed in range(seeds if ptz else 1)
     ]
@@ -89,8 +90,11 @@ def run_pets_network_cell(cell: PetsNetworkCell) -> dict:
     episode = run_pets_network_episode(cell.scenario, cell.seed, cell.ptz, cell.views, "joint", cell.method)
     scored = tracking_metrics(episode.truth, tracks_within(episode.tracks, episode.area_polygon_m))
     every = tracking_metrics(episode.truth, episode.tracks)
-    (x0, y0), (x1, y1) = PETS_TRACKING_AREA_M
-    tracking_area = rectangle_m(x1 - x0, y1 - y0) + (x0, y0)
+    tracking_area = episode.area_polygon_m
+    rectangle = cell.scenario.required_recording("the camera network's table").tracking_area_m
+    if rectangle is not None:
+        (x0, y0), (x1, y1) = rectangle
+        tracking_area = rectangle_m(x1 - x0, y1 - y0) + (x0, y0)
     in_area = tracking_metrics(truth_within(episode.truth, tracking_area), tracks_within(episode.tracks, tracking_area))
     row = {"config": cell.config, "seed": cell.seed, "cameras": len(episode.cameras)}
     return {
@@ -150,10 +154,11 @@ def format_pets_network_table(summary: Sequence[dict], title: str = "") -> str:
 
 
 def pets_network_title(scenario: Scenario, seeds: int, method: str, recall: float) -> str:
+    recording = scenario.required_recording("a camera network's table")
     return (
-        f"camera network on PETS 2009 S2.L1: the virtual PTZ camera over View_001 ({scenario.detector.kind}, "
+        f"camera network on {recording.name}: the virtual PTZ camera ({scenario.detector.kind}, "
         f"{method} b{scenario.control.beta:g}, {scenario.detector.model} model) and the published detections of "
-        f"View_003-008 as fixed cameras (recall {recall:g}), {scenario.frames} steps, {seeds} seeds with the PTZ "
-        "camera (MOTA +- standard deviation over seeds; tracks scored inside View_001's walkable area, TA: tracks "
-        "and people inside the tracking area)"
+        f"the dataset's other views as fixed cameras (recall {recall:g}), {scenario.frames} steps, {seeds} seeds "
+        "with the PTZ camera (MOTA +- standard deviation over seeds; tracks scored inside the recorded view's "
+        "walkable area, TA: tracks and people inside the dataset's tracking area)"
     )

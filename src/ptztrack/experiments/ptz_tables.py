@@ -1,12 +1,13 @@
-"""The PTZ paper's Tables 1-4: its strategies on the synthetic scene and on PETS 2009 S2.L1.
+"""The PTZ paper's Tables 1-4: its strategies on the synthetic scene and on a recording (PETS 2009 S2.L1
+built in, any dataset file's view).
 
 The cells are (scenario, strategy, seed), one episode each (:class:`~ptztrack.experiments.cells.Cell`);
 a table is, per column (a strategy, with its beta where the table has several), the mean over its runs
 of the paper's figures (MOTA, MOTP in m, height in px, detections, zoom).
 
-The PETS tables' protocols (the paper's section 5.2), nothing learnt from the frames a table scores:
+The recording tables' protocols (the paper's section 5.2), nothing learnt from the frames a table scores:
 
-* ``a-priori``: every parameter as fixed before looking at S2.L1: the
+* ``a-priori``: every parameter as fixed before looking at the recording: the
   scenario's defaults, the paper's Caltech recall curve (Kd 0.0098, r0
   21.29 px) for the policies' model of HOG, and the walkable area from the
   calibrated view (:func:`ptztrack.builders.world.visible_ground_m`).
@@ -41,6 +42,8 @@ from ptztrack.scene.pets import load_mot_ground_truth
 
 # The strategies that draw from their random stream (the others are deterministic given the detections).
 RANDOM_STRATEGIES = ("rnd", "smpl")
+# The detectors that find the same people in the same view: OpenCV's HOG, a recording's precomputed boxes.
+DETERMINISTIC_DETECTORS = ("hog", "detections")
 # The paper's rows.
 SUMMARY_KEYS = ("mota", "motp_m", "height_px", "detections", "zoom")
 
@@ -70,12 +73,12 @@ def synthetic_cells(
 
 def seed_matters(scenario: Scenario, strategy: PolicySpec) -> bool:
     """Whether a run of ``strategy`` depends on its seed: a strategy that draws, a detector that does
-    (every one but OpenCV's HOG, which finds the same people in the same image), or an information-gain
+    (every one but :data:`DETERMINISTIC_DETECTORS`, which find the same people in the same view), or an information-gain
     strategy planning with draws of a detector model it learns."""
     learning = scenario.detector.model not in ("a-priori", "true") and scenario.detector.kind != "ideal"
     return (
         strategy in RANDOM_STRATEGIES
-        or scenario.detector.kind != "hog"
+        or scenario.detector.kind not in DETERMINISTIC_DETECTORS
         or (strategy in INFORMATION_STRATEGIES and learning)
     )
 
@@ -295,11 +298,13 @@ def synthetic_title(scenario_name: str, scenario: Scenario, sequences: int) -> s
     )
 
 
-def pets_title(scenario: Scenario, protocol: str, seeds: int) -> str:
-    """The title of a PETS table under ``protocol``, with ``seeds`` runs where a run depends on its seed."""
+def recording_title(scenario: Scenario, protocol: str, seeds: int) -> str:
+    """The title of a recording's table under ``protocol``, with ``seeds`` runs where a run depends on its seed."""
+    recording = scenario.required_recording("a recording's table")
+    every = "every frame" if recording.frame_step == 1 else f"a step every {recording.frame_step} frames"
     return (
-        f"PETS 2009 S2.L1 View_001, {scenario.detector.kind} detector ({scenario.detector.model} model), every 2nd "
-        f"frame, protocol {protocol}, "
+        f"{recording.name}, {scenario.detector.kind} detector ({scenario.detector.model} model), {every} "
+        f"({scenario.frame_rate_hz:.4g} Hz steps), protocol {protocol}, "
         f"{seeds} seeds where a run depends on its seed (MOTA +- standard deviation over seeds and folds)"
     )
 

@@ -8,14 +8,16 @@ per pose source (:func:`closed_loop_cells`), the camera landing off its commands
 (:func:`format_closed_loop`).
 """
 
+import math
 from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
 
 from ptztrack.builders.episode import run_episode
+from ptztrack.builders.recording import recorded_size_px
 from ptztrack.builders.registration import (
-    LIVE_GAP_FRAMES,
+    LIVE_GAP_S,
     live_view_model,
     reference_frames,
     registration_camera,
@@ -64,11 +66,14 @@ def registration_views(
     if first_frame > last_frame:
         raise ScenarioError(
             f"the recording ends at frame {last_frame}, before the first live frame {first_frame} "
-            f"({LIVE_GAP_FRAMES} frames after the last reference view's)"
+            f"({live_gap_frames(scenario)} frames, {LIVE_GAP_S:g} s, after the last reference view's): the "
+            "experiment needs a longer recording"
         )
     frames = np.sort(rng.integers(first_frame, last_frame + 1, views))
     video = RecordedVideo(
-        scenario.required_video("the registration experiment"), recording.recorded_size_px, int(frames[-1]) + 1
+        scenario.required_video("the registration experiment"),
+        recorded_size_px(recording),
+        int(frames[-1]) + 1,
     )
     ground_m = np.c_[x.ravel(), y.ravel()]
     return registration_errors(virtual, index, video, poses, frames, ground_m, live_view_model(scenario), progress)
@@ -88,15 +93,22 @@ def live_view_settings(scenario: Scenario) -> dict:
         **camera,
         "reference_frames": [int(sweep[0]), int(sweep[-1])],
         "reference_frame_step": int(sweep[1] - sweep[0]) if len(sweep) > 1 else None,
-        "min_gap_frames": LIVE_GAP_FRAMES,
+        "min_gap_frames": live_gap_frames(scenario),
         "first_live_frame": first_live_frame(scenario, whole_frame_pose),
     }
 
 
+def live_gap_frames(scenario: Scenario) -> int:
+    """``LIVE_GAP_S`` in the recording's frames (its frame rate: the step rate times the frame step)."""
+    recording = scenario.required_recording("the registration experiment")
+    return math.ceil(LIVE_GAP_S * scenario.frame_rate_hz * recording.frame_step)
+
+
 def first_live_frame(scenario: Scenario, whole_frame_pose) -> int:
-    """The first frame a live view of the registration experiment may show: ``LIVE_GAP_FRAMES``
+    """The first frame a live view of the registration experiment may show: :func:`live_gap_frames`
     after the last reference view's frame."""
-    return int(reference_frames(len(scenario_reference_poses(scenario, whole_frame_pose)))[-1] + LIVE_GAP_FRAMES)
+    sweep = reference_frames(len(scenario_reference_poses(scenario, whole_frame_pose)))
+    return int(sweep[-1] + live_gap_frames(scenario))
 
 
 def closed_loop_cells(

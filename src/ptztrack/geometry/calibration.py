@@ -70,6 +70,35 @@ class PinholeCalibration:
     t: np.ndarray
 
 
+def camera_centre_m(calibration: PinholeCalibration) -> np.ndarray:
+    """The camera's centre (3,) m in the world: -R^T t, t in mm."""
+    return -calibration.R.T @ calibration.t / 1000.0
+
+
+def aimed_pinhole(centre_m, target_m, focal_px: float, image_size_px) -> PinholeCalibration:
+    """A distortion-free pinhole camera at ``centre_m`` (x, y, z) m whose optical axis points at
+    ``target_m`` ((x, y) on the ground, or (x, y, z)) m, with no roll (the image's x axis level with
+    the ground), focal length ``focal_px``, and its principal point at the centre of its image
+    ``image_size_px`` (width, height). A camera looking straight down has the world's x axis as its
+    image's x axis. t is in mm, as the calibration files have it."""
+    centre_m = np.asarray(centre_m, dtype=float)
+    target_m = np.asarray(target_m, dtype=float)
+    if target_m.shape == (2,):
+        target_m = np.append(target_m, 0.0)
+    forward = target_m - centre_m
+    if not np.linalg.norm(forward) > 0:
+        raise ValueError(f"the camera at {centre_m.tolist()} m cannot look at its own centre")
+    forward /= np.linalg.norm(forward)
+    right = np.cross(forward, [0.0, 0.0, 1.0])
+    if np.linalg.norm(right) < 1e-9:  # straight down (or up)
+        right = np.array([1.0, 0.0, 0.0])
+    right /= np.linalg.norm(right)
+    R = np.stack([right, np.cross(forward, right), forward])
+    width_px, height_px = image_size_px
+    K = np.array([[focal_px, 0.0, width_px / 2], [0.0, focal_px, height_px / 2], [0.0, 0.0, 1.0]])
+    return PinholeCalibration(K=K, dist=np.zeros(5), R=R, t=-R @ centre_m * 1000.0)
+
+
 def project_tsai(calibration: TsaiCalibration, points_mm) -> np.ndarray:
     """World points (N, 3) mm to distorted image pixels (N, 2).
 
@@ -127,8 +156,7 @@ def pixel_rays(calibration: PinholeCalibration, pixels_px) -> tuple[np.ndarray, 
         normalised = np.zeros((0, 2))
     in_camera = np.concatenate([normalised, np.ones((len(normalised), 1))], axis=-1)
     direction = in_camera @ calibration.R  # R^T d for each row d
-    centre_m = -calibration.R.T @ calibration.t / 1000.0
-    return centre_m, direction / np.linalg.norm(direction, axis=-1, keepdims=True)
+    return camera_centre_m(calibration), direction / np.linalg.norm(direction, axis=-1, keepdims=True)
 
 
 def imaged_radius(calibration: PinholeCalibration) -> float:
@@ -218,8 +246,9 @@ def pinhole_from_tsai(calibration: TsaiCalibration) -> PinholeCalibration:
     )
 
 
-def load_calibration(path: str | Path, view: str = "View_001") -> PinholeCalibration:
-    """A recording's calibration as a pinhole camera: a Tsai XML (``.xml``) or one view of a pinhole JSON."""
+def load_calibration(path: str | Path, view: str | None = None) -> PinholeCalibration:
+    """A recording's calibration as a pinhole camera: a Tsai XML (``.xml``) or one view of a pinhole JSON
+    (``view``; None: its only view)."""
     if Path(path).suffix.lower() == ".xml":
         return pinhole_from_tsai(load_tsai(path))
     return load_pinhole(path, view)
@@ -276,10 +305,22 @@ def load_tsai(path: str | Path) -> TsaiCalibration:
     )
 
 
-def load_pinhole(path: str | Path, view: str = "View_001") -> PinholeCalibration:
-    """Read one view of a pinhole calibration JSON (``{view: {K, dist, R, t}}``)."""
+def pinhole_document(calibration: PinholeCalibration) -> dict:
+    """One view of a pinhole calibration JSON (``{view: {K, dist, R, t}}``, :func:`load_pinhole` reads
+    it): {K, dist, R, t [mm]} as lists."""
+    return {name: np.asarray(getattr(calibration, name), dtype=float).tolist() for name in ("K", "dist", "R", "t")}
+
+
+def load_pinhole(path: str | Path, view: str | None = None) -> PinholeCalibration:
+    """Read one view of a pinhole calibration JSON (``{view: {K, dist, R, t}}``; None: its only view)."""
     path = Path(path)
     views = read_json(path, "calibration", CALIBRATION_MAX_BYTES, CalibrationError)
+    if isinstance(views, dict) and view is None:
+        if len(views) != 1:
+            raise CalibrationError(
+                f"{path}: {len(views)} views ({', '.join(map(str, list(views)[:8]))}); name the one to use"
+            )
+        view = next(iter(views))
     if not isinstance(views, dict) or view not in views:
         raise CalibrationError(f"{path}: no view {shown(view)}")
     shapes = {"K": (3, 3), "dist": (5,), "R": (3, 3), "t": (3,)}

@@ -17,8 +17,9 @@ the "detector and clustering" baseline of the multi-view literature.
 * :mod:`~ptztrack.occupancy.clustering`: the baseline (box feet on the ground, clustered, blob boxes);
 * :mod:`~ptztrack.occupancy.detectors`: both detectors run over a recording, frame by frame;
 * :mod:`~ptztrack.occupancy.multiview`: multi-view recordings and their files;
-* :mod:`~ptztrack.occupancy.render`: people among calibrated cameras, rendered (a stage, cone bodies, noise);
-* :mod:`~ptztrack.occupancy.room`: the paper's lab, rendered (the synthetic room);
+* :mod:`~ptztrack.occupancy.room`: the paper's lab, rendered (the synthetic room) by the scene's renderer
+  (:mod:`ptztrack.scene.render`), and :mod:`~ptztrack.occupancy.plaza`: PETS's far, shallow cameras over
+  a rendered plaza;
 * :mod:`~ptztrack.occupancy.evaluation`: scoring (MODA, MODP), threshold fitting, tracking on the ground;
 * :mod:`~ptztrack.occupancy.output`: the experiment's files, pictures and video.
 

@@ -5,7 +5,7 @@ are far and shallow: three stand 8-70 m outside the area people walk in, 6-7 m h
 edge about 2 m high, all looking down at 3-21 degrees. The plaza renders any calibrated cameras
 (the builders pass S2.L1's seven, with its ground area and frame rate:
 :func:`ptztrack.builders.occupancy.plaza_recording`) with the shared renderer
-(:mod:`ptztrack.occupancy.render`): paving of 1 m slabs over the whole ground, facades 15 m high
+(:mod:`ptztrack.scene.render`): paving of 1 m slabs over the whole ground, facades 15 m high
 standing 5 m beyond the area and every camera, a plain sky above. People walk over the area as in
 :mod:`ptztrack.scene.synthetic`, most of them in pairs side by side 0.6 m apart, as S2.L1's groups
 walk 0.5-0.7 m apart.
@@ -16,12 +16,10 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ptztrack.geometry.calibration import PinholeCalibration
-from ptztrack.occupancy.render import Stage
 from ptztrack.scene.parameters import Crowd
+from ptztrack.scene.render import Stage, stage_around
 from ptztrack.scene.synthetic import walk_people
 from ptztrack.types import GroundTruth
-
-SKY_BGR = (235.0, 215.0, 195.0)
 
 
 @dataclass(frozen=True)
@@ -47,21 +45,11 @@ class PlazaLayout:
     pair_spacing_m: float = 0.6
 
 
-def camera_centre_m(calibration: PinholeCalibration) -> np.ndarray:
-    """The camera's centre (3,) m in the world: -R^T t, t in mm."""
-    return -calibration.R.T @ calibration.t / 1000.0
-
-
 def plaza_stage(layout: PlazaLayout, cameras: list[PinholeCalibration]) -> Stage:
-    """The stage around the area and the cameras: its box is their bounding box, widened by margin_m
-    on every side, and at least margin_m higher than the highest camera (the renderer needs every
-    camera inside the box); paving of tile_m slabs; the lid is the sky."""
-    centres_m = np.array([camera_centre_m(camera) for camera in cameras]).reshape(-1, 3)
-    footprint_m = np.concatenate([np.asarray(layout.area_m, dtype=float), centres_m[:, :2]])
-    low, high = footprint_m.min(axis=0) - layout.margin_m, footprint_m.max(axis=0) + layout.margin_m
-    height_m = max(layout.facade_height_m, float(centres_m[:, 2].max(initial=0.0)) + layout.margin_m)
-    bounds_m = ((float(low[0]), float(low[1])), (float(high[0]), float(high[1])))
-    return Stage(bounds_m=bounds_m, height_m=height_m, tile_m=layout.tile_m, lid_bgr=SKY_BGR)
+    """The stage around the area and the cameras (:func:`~ptztrack.scene.render.stage_around`): facades
+    margin_m beyond both, facade_height_m high (at least margin_m above the highest camera), paving of
+    tile_m slabs, the sky above."""
+    return stage_around(layout.area_m, cameras, layout.margin_m, layout.facade_height_m, layout.tile_m)
 
 
 def plaza_crowd(layout: PlazaLayout, people: int) -> Crowd:

@@ -3,7 +3,7 @@
 The paper's experiments (section 5) ran in "a lab of about 5 x 6 metres with
 four cameras mounted in the four corners", 1024 x 768 px at 15 Hz, with one
 and with three people. Here the people walk as in :mod:`ptztrack.scene.synthetic`
-and are drawn by the shared renderer (:mod:`ptztrack.occupancy.render`: textured
+and are drawn by the shared renderer (:mod:`ptztrack.scene.render`: textured
 cone models over a textured floor, textured walls and a plain ceiling). The
 cameras (mounting not given by the paper) hang 2.8 m high, 0.1 m inside each
 corner, aimed at the room's centre 0.9 m above the floor, with a 1024 x 768
@@ -15,9 +15,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ptztrack.geometry.calibration import PinholeCalibration
-from ptztrack.occupancy.render import SceneRenderer, Stage
+from ptztrack.geometry.calibration import PinholeCalibration, aimed_pinhole
 from ptztrack.scene.parameters import Crowd
+from ptztrack.scene.render import SceneRenderer, Stage
 from ptztrack.scene.synthetic import walk_people
 from ptztrack.types import GroundTruth
 
@@ -41,24 +41,14 @@ class RoomLayout:
     frame_rate_hz: float = 15.0
 
 
-def look_at(centre_m, target_m, focal_px: float, image_size_px) -> PinholeCalibration:
-    """A distortion-free pinhole camera at ``centre_m`` looking at ``target_m``, image x level with the floor."""
-    forward = np.asarray(target_m, dtype=float) - np.asarray(centre_m, dtype=float)
-    forward /= np.linalg.norm(forward)
-    right = np.cross(forward, [0.0, 0.0, 1.0])
-    right /= np.linalg.norm(right)
-    R = np.stack([right, np.cross(forward, right), forward])
-    width_px, height_px = image_size_px
-    K = np.array([[focal_px, 0.0, width_px / 2], [0.0, focal_px, height_px / 2], [0.0, 0.0, 1.0]])
-    return PinholeCalibration(K=K, dist=np.zeros(5), R=R, t=-R @ np.asarray(centre_m, dtype=float) * 1000.0)
-
-
 def room_cameras(layout: RoomLayout) -> list[PinholeCalibration]:
     """The four corner cameras, counter-clockwise from the origin's corner."""
     (width_m, depth_m), inset = layout.size_m, layout.camera_inset_m
     corners = [(inset, inset), (width_m - inset, inset), (width_m - inset, depth_m - inset), (inset, depth_m - inset)]
     target = (width_m / 2, depth_m / 2, layout.aim_height_m)
-    return [look_at((x, y, layout.camera_height_m), target, layout.focal_px, layout.image_size_px) for x, y in corners]
+    return [
+        aimed_pinhole((x, y, layout.camera_height_m), target, layout.focal_px, layout.image_size_px) for x, y in corners
+    ]
 
 
 def room_stage(layout: RoomLayout) -> Stage:
@@ -70,7 +60,7 @@ class RoomRenderer(SceneRenderer):
     """The frames of the room's four cameras: ``image(view, frame)`` (height, width, 3) uint8 BGR.
 
     layout : the room; truth : the people (positions, heights, widths); seed : fixes the textures,
-    outfits and sensor noise (:class:`~ptztrack.occupancy.render.SceneRenderer`).
+    outfits and sensor noise (:class:`~ptztrack.scene.render.SceneRenderer`).
     """
 
     def __init__(self, layout: RoomLayout, truth: GroundTruth, seed: int):

@@ -6,6 +6,7 @@ and CVML XML with pixel boxes (``<frame number>`` from 0). Any problem gets a
 :class:`DatasetError` naming the file and what is wrong.
 """
 
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -100,7 +101,7 @@ def load_mot_ground_truth(path: str | Path) -> Annotations:
     """
     table, line = read_mot_rows(path, "ground-truth")
     frame, person_id = table[:, 0].astype(np.int64), table[:, 1].astype(np.int64)
-    _refuse_repeated_annotations(Path(path), frame, person_id)
+    refuse_repeated_annotations(Path(path), frame, person_id, line)
     return Annotations(frame - 1, person_id, table[:, 2:6], table[:, 7:9], line)
 
 
@@ -108,14 +109,34 @@ def read_mot_rows(path: str | Path, what: str) -> tuple[np.ndarray, np.ndarray]:
     """The rows (K, 10) of a MOTChallenge file (ground truth or detections; ``.gz`` compressed or not),
     checked: ten finite numbers a line, whole frames and ids, frames from 1; and the line (K,) of each
     in the file. ``what`` names the kind of file in errors."""
+    text = read_text(path, what, GROUND_TRUTH_MAX_BYTES, DatasetError)
+    return number_rows(path, text, what, MOT_COLUMNS, 1, "in MOTChallenge files")
+
+
+def number_rows(
+    path: str | Path,
+    text: str,
+    what: str,
+    columns: int,
+    first_frame: int,
+    numbered: str,
+    separator: str = ",",
+    layout: str = "",
+) -> tuple[np.ndarray, np.ndarray]:
+    """The rows (K, ``columns``) of the ``text`` of the file ``path``, whose lines are a frame, an id and
+    more numbers, split at the regular expression ``separator`` (blank lines skipped), checked:
+    ``columns`` finite numbers a line, whole frames and ids, frames from ``first_frame``; and the line
+    (K,) of each in the file. ``what`` names the kind of file in errors, ``numbered`` the files whose
+    frames are counted from ``first_frame`` (e.g. "in MOTChallenge files"), ``layout`` (e.g.
+    " (frame id x y)") follows the count of columns expected."""
     path = Path(path)
     rows, lines = [], []
-    for number, line in enumerate(read_text(path, what, GROUND_TRUTH_MAX_BYTES, DatasetError).splitlines(), 1):
+    for number, line in enumerate(text.splitlines(), 1):
         if not line.strip():
             continue
-        fields = line.split(",")
-        if len(fields) != MOT_COLUMNS:
-            raise DatasetError(f"{path}: line {number} has {len(fields)} fields, expected {MOT_COLUMNS}")
+        fields = re.split(separator, line.strip())
+        if len(fields) != columns:
+            raise DatasetError(f"{path}: line {number} has {len(fields)} fields, expected {columns}{layout}")
         try:
             values = [float(field) for field in fields]
         except ValueError:
@@ -127,9 +148,9 @@ def read_mot_rows(path: str | Path, what: str) -> tuple[np.ndarray, np.ndarray]:
                 f"{path}: line {number}: frame and id must be whole numbers "
                 f"(got {shown(fields[0])}, {shown(fields[1])})"
             )
-        if values[0] < 1:
+        if values[0] < first_frame:
             raise DatasetError(
-                f"{path}: line {number}: frame {shown(fields[0])}; frames are numbered from 1 in MOTChallenge files"
+                f"{path}: line {number}: frame {shown(fields[0])}; frames are numbered from {first_frame} {numbered}"
             )
         rows.append(values)
         lines.append(number)
@@ -148,13 +169,19 @@ def refuse_rows_beyond(path: str | Path, frame, line, frames: int, recording: st
         raise DatasetError(f"{path}: line {line[first]}: frame {frame[first] + 1} is beyond {recording}")
 
 
-def _refuse_repeated_annotations(path: Path, frame: np.ndarray, person_id: np.ndarray) -> None:
-    """A DatasetError if a person is annotated twice in a frame (numbered as in the file)."""
-    pairs, counts = np.unique(np.c_[frame, person_id], axis=0, return_counts=True)
+def refuse_repeated_annotations(
+    path: str | Path, frame: np.ndarray, person_id: np.ndarray, line: np.ndarray | None = None
+) -> None:
+    """A :class:`DatasetError` if a person is annotated twice in a frame: frame (K,) numbered as in the
+    file, person_id (K,); line (K,) each row's line, if the file has rows, to name the second one."""
+    pairs, inverse, counts = np.unique(np.c_[frame, person_id], axis=0, return_inverse=True, return_counts=True)
     if np.any(counts > 1):
-        repeated_frame, repeated_id = pairs[np.argmax(counts > 1)]
+        first = int(np.argmax(counts > 1))
+        repeated_frame, repeated_id = pairs[first]
+        where = "" if line is None else f" line {np.sort(line[inverse.ravel() == first])[1]}:"
         raise DatasetError(
-            f"{path}: person {repeated_id} is annotated {counts.max()} times in frame {repeated_frame}, expected once"
+            f"{path}:{where} person {repeated_id} is annotated {counts[first]} times in frame {repeated_frame}, "
+            "expected once"
         )
 
 
@@ -180,7 +207,7 @@ def load_cvml(path: str | Path) -> Annotations:
     if not np.all(np.isfinite(table)) or np.any(table[:, 0] < 0):
         raise DatasetError(f"{path}: a frame number below 0 or a NaN or infinite box; expected finite boxes")
     frame, person_id = table[:, 0].astype(np.int64), table[:, 1].astype(np.int64)
-    _refuse_repeated_annotations(path, frame, person_id)
+    refuse_repeated_annotations(path, frame, person_id)
     centre, size = table[:, 2:4], table[:, 4:6]
     return Annotations(
         frame=frame,

@@ -1,14 +1,15 @@
-"""People walking among fixed calibrated cameras, rendered: the synthetic room's and plaza's one renderer.
+"""People walking among fixed calibrated cameras, rendered: the one renderer of the synthetic room, the
+plaza and ``ptztrack render``.
 
 The *stage* is the static surroundings (:class:`Stage`): an axis-aligned box standing on the ground
 plane z = 0, whose floor is laid with square tiles of random shade under a texture, whose four walls
 carry another texture and a dark skirting band at their foot, and whose lid is plain (a ceiling, or
 the sky). Every pixel's ray is cast to the nearest of the box's six planes, so any calibrated camera
-inside the box gets its background (:func:`stage_background`). The people walk as in
-:mod:`ptztrack.scene.synthetic` and are drawn as textured cone models (legs swinging with the gait,
-torso, shoulders, neck and head: a more detailed body than the detector's model) by the painter's
-algorithm with OpenCV, lit from above (:func:`draw_people`). Each frame gets sensor noise
-(:class:`SceneRenderer`).
+inside the box gets its background (:func:`stage_background`); :func:`stage_around` builds one
+around an area and its cameras. The people walk as in :mod:`ptztrack.scene.synthetic` and are drawn
+as textured cone models (legs swinging with the gait, torso, shoulders, neck and head: a more
+detailed body than the detector's model) by the painter's algorithm with OpenCV, lit from above
+(:func:`draw_people`). Each frame gets sensor noise (:class:`SceneRenderer`).
 """
 
 from collections.abc import Sequence
@@ -17,7 +18,15 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from ptztrack.geometry.calibration import PinholeCalibration, imaged_radius, pixel_rays, project_pinhole
+from ptztrack.geometry.calibration import (
+    PinholeCalibration,
+    camera_centre_m,
+    imaged_radius,
+    in_image,
+    pixel_rays,
+    project_pinhole,
+)
+from ptztrack.scene.cutouts import CutoutTrack, paste_people
 from ptztrack.types import GroundTruth
 
 FACETS = 16  # facets around each cone
@@ -32,6 +41,7 @@ SKIRTING_M = 0.12
 FLOOR_TINT, WALL_TINT = np.array([0.95, 1.0, 1.05]), np.array([1.05, 1.0, 0.9])  # BGR
 NEAREST_FACET_M = 0.05  # facets nearer the camera's image plane than this are not drawn
 MAX_PIXEL = 1e5  # facet corners are clamped to +- this many pixels: cv2's fixed-point int32 stays in range
+WALK_PROBE_M = 0.1  # which way a person walks across an image: their feet and this far ahead, projected
 
 
 @dataclass(frozen=True)
@@ -48,6 +58,29 @@ class Stage:
     tile_m: float = 0.5
     texture_m: float = 4.0
     lid_bgr: tuple[float, float, float] = (200.0, 200.0, 200.0)
+
+
+SKY_BGR = (235.0, 215.0, 195.0)
+
+
+def stage_around(
+    area_m,
+    cameras: Sequence[PinholeCalibration],
+    margin_m: float = 5.0,
+    height_m: float = 15.0,
+    tile_m: float = 1.0,
+    lid_bgr: tuple[float, float, float] = SKY_BGR,
+) -> Stage:
+    """An open place around an area and its cameras: the box is their bounding box on the ground
+    (area_m ((x0, y0), (x1, y1)) m and every camera's centre), widened by ``margin_m`` on every side, and
+    ``height_m`` high but at least ``margin_m`` above the highest camera (the renderer needs every
+    camera inside the box); the floor is paved in ``tile_m`` slabs and the lid is the sky."""
+    centres_m = np.array([camera_centre_m(camera) for camera in cameras]).reshape(-1, 3)
+    footprint_m = np.concatenate([np.asarray(area_m, dtype=float), centres_m[:, :2]])
+    low, high = footprint_m.min(axis=0) - margin_m, footprint_m.max(axis=0) + margin_m
+    height_m = max(height_m, float(centres_m[:, 2].max(initial=0.0)) + margin_m)
+    bounds_m = ((float(low[0]), float(low[1])), (float(high[0]), float(high[1])))
+    return Stage(bounds_m=bounds_m, height_m=height_m, tile_m=tile_m, lid_bgr=lid_bgr)
 
 
 def _texture(rng: np.random.Generator, size: int, grains: int) -> np.ndarray:
@@ -199,7 +232,7 @@ def draw_people(background, calibration: PinholeCalibration, people_cones: list,
     image = background.copy()
     if not people_cones:
         return image
-    centre_m = -calibration.R.T @ calibration.t / 1000.0
+    centre_m = camera_centre_m(calibration)
     corner_list, shade_list, depth_list = [], [], []
     for (cones, radii, parts), outfit in zip(people_cones, outfits, strict=True):
         corners, normals, centres = cone_facets(cones, radii)
@@ -236,7 +269,9 @@ class SceneRenderer:
     cameras : the views' calibrations (world in mm); image_sizes_px : per view, (width, height);
     stage : the surroundings, every camera inside its box; truth : the people (positions (T, N, 2) m,
     heights and widths (N,) m); seed : fixes the textures, outfits and sensor noise (a frame's noise
-    is the same however often it is rendered).
+    is the same however often it is rendered). people_cutouts : real pedestrians to draw the people as
+    (:mod:`ptztrack.scene.cutouts`) instead of cone bodies: each person walks as one of them, drawn at
+    random, from a random frame of its walk on, one frame of it per frame.
     """
 
     def __init__(
@@ -246,6 +281,7 @@ class SceneRenderer:
         stage: Stage,
         truth: GroundTruth,
         seed: int,
+        people_cutouts: Sequence[CutoutTrack] | None = None,
     ):
         self.cameras = list(cameras)
         self.image_sizes_px = [(int(width), int(height)) for width, height in image_sizes_px]
@@ -266,6 +302,15 @@ class SceneRenderer:
         height_px = max(size[1] for size in self.image_sizes_px)
         self.noise = noise_rng.normal(0, NOISE_SIGMA, (NOISE_FRAMES, height_px, width_px, 1)).astype(np.float32)
         self.heading_rad, self.phase_rad = _gait(truth)
+        self.people_cutouts = list(people_cutouts) if people_cutouts is not None else None
+        if self.people_cutouts is not None:
+            if not self.people_cutouts:
+                raise ValueError("people_cutouts: no pedestrian to draw the people as")
+            # A fourth stream: the first three are those above, whatever follows.
+            cutout_rng = np.random.default_rng(np.random.SeedSequence(seed).spawn(4)[3])
+            people = truth.positions_m.shape[1]
+            self.cutout_track = cutout_rng.integers(len(self.people_cutouts), size=(people,))
+            self.cutout_offset = cutout_rng.integers(0, 2**31, size=(people,))
 
     def people_cones(self, frame: int) -> list:
         """The cones (:func:`body_cones`) of every person present at ``frame``."""
@@ -284,16 +329,41 @@ class SceneRenderer:
     def image(self, view: int, frame: int) -> np.ndarray:
         """View ``view``'s image at ``frame``: the people over its background, plus one of the noise images."""
         present = np.flatnonzero(self.truth.present[frame])
-        drawn = draw_people(
-            self.backgrounds[view],
-            self.cameras[view],
-            self.people_cones(frame),
-            [self.outfits[person] for person in present],
-        )
+        if self.people_cutouts is not None:
+            drawn = self._pasted(view, frame, present)
+        else:
+            drawn = draw_people(
+                self.backgrounds[view],
+                self.cameras[view],
+                self.people_cones(frame),
+                [self.outfits[person] for person in present],
+            )
         rng = np.random.default_rng([self.seed, view, frame])
         width_px, height_px = self.image_sizes_px[view]
         noise = self.noise[rng.integers(NOISE_FRAMES), :height_px, :width_px]
         return np.clip(drawn + noise, 0, 255).astype(np.uint8)
+
+    def _pasted(self, view: int, frame: int, present: np.ndarray) -> np.ndarray:
+        """The view's background with the people ``present`` at ``frame`` pasted as their cutouts, each
+        mirrored where it walked the other way across the image than the person walks across this one."""
+        assert self.people_cutouts is not None
+        truth, camera = self.truth, self.cameras[view]
+        feet_m = truth.positions_m[frame, present]
+        boxes, _ = person_boxes(
+            camera, self.image_sizes_px[view], feet_m, truth.heights_m[present], truth.widths_m[present]
+        )
+        shown = np.isfinite(boxes[:, 0])
+        heading = self.heading_rad[frame, present[shown]]
+        ahead_m = feet_m[shown] + WALK_PROBE_M * np.stack([np.cos(heading), np.sin(heading)], axis=-1)
+        ahead_px = project_pinhole(camera, 1000.0 * np.c_[ahead_m, np.zeros(len(ahead_m))])
+        moving_right = ahead_px[:, 0] > boxes[shown, 0] + boxes[shown, 2] / 2
+        tracks = [self.people_cutouts[index] for index in self.cutout_track[present[shown]]]
+        cutouts = [
+            track.cutouts[(offset + frame) % len(track.cutouts)]
+            for track, offset in zip(tracks, self.cutout_offset[present[shown]], strict=True)
+        ]
+        mirrored = [track.moving_right != right for track, right in zip(tracks, moving_right, strict=True)]
+        return paste_people(self.backgrounds[view], camera, boxes[shown], feet_m[shown], cutouts, mirrored)
 
 
 def _gait(truth: GroundTruth) -> tuple[np.ndarray, np.ndarray]:
@@ -303,3 +373,39 @@ def _gait(truth: GroundTruth) -> tuple[np.ndarray, np.ndarray]:
     heading = np.arctan2(step_m[..., 1], step_m[..., 0])
     walked_m = np.nancumsum(np.linalg.norm(np.nan_to_num(step_m), axis=-1), axis=0)
     return heading, 2 * np.pi * walked_m / STRIDE_M
+
+
+def person_boxes(
+    calibration: PinholeCalibration, image_size_px: tuple[int, int], positions_m, heights_m, widths_m
+) -> tuple[np.ndarray, np.ndarray]:
+    """People's boxes in a calibrated view, as an annotator would draw them: boxes (N, 4) (left, top,
+    width, height) px and whether each person's feet are in the image (N,) bool (in front of the camera
+    and inside (width, height) = ``image_size_px``; :func:`~ptztrack.geometry.calibration.in_image`).
+
+    positions_m : (N, 2) feet on the ground; heights_m, widths_m : (N,). A box's bottom centre is the
+    feet's projection and its top the head's (the point ``heights_m`` above the feet); its width is the
+    distance between the projections of the two points ``widths_m`` / 2 either side of the feet along
+    the camera's horizontal axis. The boxes of people whose feet or head are not ahead of the camera by
+    NEAREST_FACET_M, or beyond the radius its distortion maps outwards, are NaN.
+    """
+    positions_m = np.asarray(positions_m, dtype=float).reshape(-1, 2)
+    count = len(positions_m)
+    feet_mm = 1000.0 * np.c_[positions_m, np.zeros(count)]
+    head_mm = feet_mm + 1000.0 * np.c_[np.zeros((count, 2)), np.asarray(heights_m, dtype=float).reshape(-1)]
+    across = np.array([*calibration.R[0, :2], 0.0])  # the image's x axis on the ground
+    across /= np.linalg.norm(across)
+    half_mm = 500.0 * np.asarray(widths_m, dtype=float).reshape(-1)[:, None] * across
+    boxes = np.full((count, 4), np.nan)
+    ends = np.stack([feet_mm, head_mm, feet_mm - half_mm, feet_mm + half_mm], axis=1)  # (N, 4, 3)
+    camera_m = (ends @ calibration.R.T + calibration.t) / 1000.0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        radius = np.hypot(camera_m[..., 0], camera_m[..., 1]) / camera_m[..., 2]
+    drawn = np.all(camera_m[..., 2] > NEAREST_FACET_M, axis=1) & np.all(radius < imaged_radius(calibration), axis=1)
+    if drawn.any():
+        feet_px, head_px, left_px, right_px = (
+            project_pinhole(calibration, ends[drawn].reshape(-1, 3)).reshape(-1, 4, 2).transpose(1, 0, 2)
+        )
+        width_px = np.linalg.norm(right_px - left_px, axis=-1)
+        height_px = feet_px[:, 1] - head_px[:, 1]
+        boxes[drawn] = np.c_[feet_px[:, 0] - width_px / 2, feet_px[:, 1] - height_px, width_px, height_px]
+    return boxes, in_image(calibration, image_size_px, feet_mm) & drawn
