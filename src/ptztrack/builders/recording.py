@@ -11,7 +11,8 @@ the detector. From both follow
   step, so that the tracker predicts over the time that really passes, and a rate that differs from
   the protocol's is warned of in one line;
 * the steps, the annotated frames (up to the last one annotated) at that step;
-* the virtual camera's image, the protocol's width at the recording's aspect ratio.
+* the virtual camera's image, and the image registration reads (``pose_feedback.image_size_px``), each the
+  protocol's width at the recording's aspect ratio.
 
 The built-in recording, PETS 2009 S2.L1, is one such file
 (:data:`~ptztrack.config.dataset.PETS_DATASET_FILE`).
@@ -25,6 +26,7 @@ from ptztrack.config import (
     PETS_DATASET_FILE,
     DatasetView,
     MultiViewDataset,
+    PoseFeedback,
     Recording,
     Scenario,
     ScenarioError,
@@ -170,6 +172,7 @@ def dataset_scenario(
         )
     recorded_width_px, recorded_height_px = size_px
     view_width_px = protocol.get("camera", {}).get("image_size_px", TABLES_PROTOCOL["camera"]["image_size_px"])[0]
+    registered_width_px = protocol.get("pose_feedback", {}).get("image_size_px", PoseFeedback().image_size_px)[0]
     calibration_view = chosen.calibration_view or chosen.name
     recording = {
         **protocol.get("recording", {}),
@@ -192,6 +195,10 @@ def dataset_scenario(
         "camera": {
             **protocol.get("camera", {}),
             "image_size_px": (view_width_px, round(view_width_px * recorded_height_px / recorded_width_px)),
+        },
+        "pose_feedback": {
+            **protocol.get("pose_feedback", {}),
+            "image_size_px": (registered_width_px, round(registered_width_px * recorded_height_px / recorded_width_px)),
         },
         "recording": recording,
     }
