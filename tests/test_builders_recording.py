@@ -46,7 +46,7 @@ def test_the_built_in_pets_scenario_is_its_dataset_files_first_view_under_the_ta
     # The paper's protocol on S2.L1: every 2nd of its 795 frames (10 fps) at 5 Hz, a 160 x 120 view.
     assert (recording.frame_step, scenario.frame_rate_hz, scenario.frames) == (2, 5.0, 398)
     assert scenario.camera.image_size_px == (160, 120) and recording.recorded_size_px == (768, 576)
-    assert scenario.pose_feedback.image_size_px == (640, 480)
+    assert scenario.pose_feedback.image_size_px == (640, 480) and scenario.actions.zoom == (1.0, 2.0, 3.0, 4.0)
     assert Path(str(recording.detections)).name == "View_001_det.txt.gz"
     follow = pets_follow_scenario("csrt")
     assert (follow.recording.frame_step, follow.frame_rate_hz, follow.frames) == (1, 10.0, 795)
@@ -86,6 +86,8 @@ def test_a_recording_of_another_size_and_pace_sets_the_view_and_the_step_and_war
     assert recording is not None and recording.recorded_size_px == (1024, 576)
     # 160 px wide at the recording's 16:9, a step every 2 of its 30 annotated frames at 6.25 Hz.
     assert scenario.camera.image_size_px == (160, 90) and scenario.pose_feedback.image_size_px == (640, 360)
+    # Zooms up to where the 160 px view reads the 1024 px recording at its own resolution: 6.
+    assert scenario.actions.zoom == (1.0, 2.0, 3.0, 4.0, 5.0, 6.0)
     assert (recording.frame_step, scenario.frame_rate_hz, scenario.frames) == (2, 6.25, 15)
     world = build_world(scenario, np.random.default_rng(0))
     # The virtual camera's whole-frame view at zoom 1 has the recording's field of view at 160 px.

@@ -35,6 +35,7 @@ _HOME = {
     "pets_scenario": ".builders.recording",
     "pets_follow_scenario": ".builders.recording",
     "dataset_scenario": ".builders.recording",
+    "render_dataset": ".builders.render",
     # the roles and their data
     "CameraBackend": ".roles",
     "Detector": ".roles",
@@ -78,6 +79,7 @@ if TYPE_CHECKING:
     from .builders.episode import episode_world, run_episode
     from .builders.network import run_network_episode
     from .builders.recording import dataset_scenario, pets_follow_scenario, pets_scenario
+    from .builders.render import render_dataset
     from .builders.world import BuiltScene, build_world
     from .camera.actions import ActionGrid
     from .config import Scenario, ScenarioError, load_dataset, load_scenario, scenario_from_dict

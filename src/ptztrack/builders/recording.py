@@ -11,6 +11,8 @@ the detector. From both follow
   step, so that the tracker predicts over the time that really passes, and a rate that differs from
   the protocol's is warned of in one line;
 * the steps, the annotated frames (up to the last one annotated) at that step;
+* the zooms, up to where the virtual view reads the recording at its own resolution
+  (:func:`recorded_zooms`, unless the protocol gives them);
 * the virtual camera's image, and the image registration reads (``pose_feedback.image_size_px``), each the
   protocol's width at the recording's aspect ratio.
 
@@ -48,7 +50,6 @@ TABLES_PROTOCOL: dict = {
     "actions": {
         "pan_deg": {"start": -14.0, "stop": 14.0, "count": 7},
         "tilt_deg": {"start": -10.0, "stop": 10.0, "count": 5},
-        "zoom": (1.0, 2.0, 3.0, 4.0),
     },
     # A person's box as the policies see it: the Caltech benchmark's standardised pedestrian aspect
     # ratio, width = 0.41 x height (Dollar et al., "Pedestrian detection: an evaluation of the state
@@ -60,8 +61,8 @@ TABLES_PROTOCOL: dict = {
     "detector": {"kind": "ideal"},
 }
 """The PTZ paper's realistic experiment (section 5.2), the same on every recording: steps at 5 Hz, the
-paper's 160-pixel-wide "zoom 1" view of the whole recorded frame, its 7 x 5 x 4 action grid (pan and tilt
-offsets from the whole-frame view, degrees)."""
+paper's 160-pixel-wide "zoom 1" view of the whole recorded frame, its 7 x 5 pan and tilt grid (offsets
+from the whole-frame view, degrees) and the zooms the recording can show (:func:`recorded_zooms`)."""
 
 FOLLOW_PROTOCOL: dict = {
     "frame_rate_hz": None,
@@ -113,6 +114,14 @@ def frames_size_px(stated_px, calibration: str, video: str | None) -> tuple[int,
 def recorded_size_px(recording: Recording) -> tuple[int, int]:
     """A scenario's recorded frames' (width, height) px (:func:`frames_size_px` of its recording)."""
     return frames_size_px(recording.recorded_size_px, recording.calibration, recording.video)
+
+
+def recorded_zooms(recorded_width_px: int, view_width_px: int) -> tuple[float, ...]:
+    """The zooms 1, 2, ... up to the largest at which the virtual view still reads the recording at its own
+    resolution or coarser, ``recorded_width_px // view_width_px`` (at least 1): the paper's 4 steps on
+    PETS (768 // 160), more where the recording has the pixels, so that a zoomed view never shows more
+    detail than was recorded."""
+    return tuple(float(zoom) for zoom in range(1, max(1, recorded_width_px // view_width_px) + 1))
 
 
 def frame_step(frame_rate_hz: float, step_rate_hz: float | None) -> int:
@@ -188,8 +197,12 @@ def dataset_scenario(
         "tracking_area_m": dataset.tracking_area_m,
         "name": f"{dataset.name} {chosen.name}",
     }
+    actions = protocol.get("actions", {})
+    if "zoom" not in actions:
+        actions = {**actions, "zoom": recorded_zooms(recorded_width_px, view_width_px)}
     data = {
         **protocol,
+        "actions": actions,
         "frames": protocol.get("frames") or math.ceil((int(annotations.frame.max()) + 1) / step),
         "frame_rate_hz": rate_hz,
         "camera": {
