@@ -96,18 +96,31 @@ def dataset_view(dataset: MultiViewDataset, name: str | None, label: str) -> tup
     raise ScenarioError(f"{label}: {wanted} (views: {names})")
 
 
-def frames_size_px(stated_px, calibration: str, video: str | None) -> tuple[int, int]:
-    """A recording's frames' (width, height) px: ``stated_px`` (a scenario's ``recorded_size_px``, a
-    dataset view's ``image_size_px``), else a Tsai calibration's, else the ``video``'s first frame's."""
+def stated_size_px(stated_px, calibration: str) -> tuple[int, int] | None:
+    """A recording's frames' (width, height) px as its files state them: ``stated_px`` (a scenario's
+    ``recorded_size_px``, a dataset view's ``image_size_px``), else a Tsai calibration's; None where only
+    the frames tell."""
     if stated_px is not None:
         return (int(stated_px[0]), int(stated_px[1]))
     if Path(calibration).suffix.lower() == ".xml":
         return load_tsai(calibration).image_size_px
+    return None
+
+
+def frames_size_px(stated_px, calibration: str, video: str | None) -> tuple[int, int]:
+    """A recording's frames' (width, height) px: :func:`stated_size_px`, else the ``video``'s first frame's."""
+    size_px = stated_size_px(stated_px, calibration)
+    if size_px is not None:
+        return size_px
     if video is None:
         raise ScenarioError(
             f"{calibration}: a pinhole calibration states no image size: give the recording's image size or a video"
         )
-    first = RecordedVideo(video).frame(0)
+    return _frame_size_px(RecordedVideo(video))
+
+
+def _frame_size_px(video: RecordedVideo) -> tuple[int, int]:
+    first = video.frame(0)
     return (int(first.shape[1]), int(first.shape[0]))
 
 
@@ -160,8 +173,9 @@ def dataset_scenario(
     ground_truth = chosen.ground_truth or dataset.ground_truth
     if ground_truth is None:
         raise ScenarioError(f"{label}: {field} has no ground truth (ground_truth, of the dataset or the view)")
-    size_px = frames_size_px(chosen.image_size_px, chosen.calibration, chosen.video)
-    video = RecordedVideo(chosen.video, size_px)
+    # The video is opened once: it checks a stated size against its frames, or gives the size.
+    video = RecordedVideo(chosen.video, stated_size_px(chosen.image_size_px, chosen.calibration))
+    size_px = _frame_size_px(video)
     annotations = load_mot_ground_truth(ground_truth)
     refuse_rows_beyond(
         ground_truth,
