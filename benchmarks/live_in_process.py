@@ -1,8 +1,8 @@
 """The live loop against a camera in its own process: no stream, no ONVIF, every picture dated exactly.
 
-``ptztrack live``'s loop (:func:`ptztrack.live.run_live`, with the policy,
+``ptztrack live``'s loop (:func:`ptztrack.loop.live.run_live`, with the policy,
 tracker and planning :func:`ptztrack.builders.live.run_live_episode` gives
-it) drives the virtual camera's head (:mod:`ptztrack.camera.onvif_head`, 90
+it) drives the virtual camera's head (:mod:`ptztrack.virtual_onvif.head`, 90
 deg/s and 3 zoom per second, times ``--speedup``), whose pictures are the
 PETS S2.L1 view at its pose, the recording playing in real time: 25 a
 second, each handed to the loop ``--delay-s`` after its capture with its
@@ -38,15 +38,15 @@ from ptztrack.builders.live import (
 )
 from ptztrack.builders.recording import pets_scenario
 from ptztrack.camera.live_camera import POLL_S
-from ptztrack.camera.onvif_head import Head, head_axes
 from ptztrack.camera.stream import LatestFrame
 from ptztrack.evaluate.metrics import episode_metrics
 from ptztrack.files import write_json
-from ptztrack.live import run_live, warm_up
+from ptztrack.loop.live import run_live, warm_up
+from ptztrack.virtual_onvif.head import Head, head_axes
 
 
 class InProcessCamera:
-    """A :class:`ptztrack.live.LiveCamera` in this process: ``feed``'s picture at the head's pose, every
+    """A :class:`ptztrack.loop.live.LiveCamera` in this process: ``feed``'s picture at the head's pose, every
     frame interval, handed over ``delay_s`` after its capture."""
 
     def __init__(self, feed: RecordingFeed, head: Head, timeline, delay_s: float):

@@ -53,7 +53,7 @@ from ptztrack.camera.onvif_spaces import MoveTimes
 from ptztrack.camera.stream import FrameStream, rtsp_pictures, thumbnail
 from ptztrack.evaluate.metrics import clear_metrics, episode_metrics
 from ptztrack.files import write_json
-from ptztrack.loop import track
+from ptztrack.loop.steps import track
 
 # A picture is matched among the renders of the second before its estimated capture time and after it.
 MATCH_WINDOW_S = (1.0, 0.5)
@@ -139,7 +139,7 @@ def main() -> None:
     scenario = pets_scenario("hog")
     decisions: list[tuple[float, int, int]] = []
 
-    def observe(world, policy):
+    def observe(worlds, policy):
         return lambda step, context, record: decisions.append(
             (record["decision_s"], len(context.tracks), len(context.reachable))
         )
@@ -152,8 +152,8 @@ def main() -> None:
         address = CameraAddress("127.0.0.1", ready.get(timeout=120), "bench", "bench-pass")
         calibration = calibrated(address)
         started = time.perf_counter()
-        world, live = run_live_episode(
-            scenario, calibration, address, args.policy, args.steps, args.time_scale, 0,
+        (world,), (live,) = run_live_episode(
+            scenario, [calibration], [address], args.policy, args.steps, args.time_scale, 0,
             observe=observe, transport=args.transport, keep_images=True,
         )  # fmt: skip
         wall_s = time.perf_counter() - started

@@ -9,9 +9,9 @@ from the area's centre, facing both (the one-camera scene's mount, repeated;
 one camera is the one-camera scene itself). Every camera is a PTZ camera
 with the scenario's grid, lens and realistic detector, and learns its own
 detector model; the PTZ cameras decide jointly with 'intg'
-(:class:`ptztrack.control.network_policy.NetworkInformationPolicy`) and the
+(:class:`ptztrack.network.policy.NetworkInformationPolicy`) and the
 one belief is updated by every camera in turn
-(:class:`ptztrack.track.shared_belief.SharedBelief`).
+(:class:`ptztrack.network.shared_belief.SharedBelief`).
 
 The figures, over the ``--steps`` steps after ``--warmup`` (whose first step
 starts the actors and compiles Numba's kernels in them; this process's are
@@ -32,7 +32,7 @@ compiled by a small episode before the table):
 
 Where the cameras run. With Ray (``--ray``, the default when Ray is
 installed), each camera's capture and detection run in Ray actors
-(:class:`ptztrack.evaluate.camera_actors.RayCameras`) on the cluster at
+(:class:`ptztrack.loop.camera_actors.RayCameras`) on the cluster at
 ``RAY_ADDRESS``, else on a local one started here (loopback only, no
 dashboard); ``--cameras-per-actor`` cameras share an actor's process (default:
 as many as make one actor per CPU of the cluster, since each actor is a
@@ -66,16 +66,16 @@ import numpy as np  # noqa: E402
 
 from ptztrack.builders.network import network_policy, network_tracker, network_world  # noqa: E402
 from ptztrack.config import Scenario, scenario_from_dict  # noqa: E402
-from ptztrack.control import network_policy as conditioning  # noqa: E402
 from ptztrack.control.information_gain import action_geometry, detection_weight_integral  # noqa: E402
 from ptztrack.files import write_json  # noqa: E402
-from ptztrack.network_loop import (  # noqa: E402
+from ptztrack.loop.simulated import (  # noqa: E402
     CameraFleet,
     CameraWorker,
     InProcessCameras,
     run_network_loop,
 )
-from ptztrack.track.tracker import observation_matrix  # noqa: E402
+from ptztrack.network import policy as conditioning  # noqa: E402
+from ptztrack.track.observation import observation_matrix  # noqa: E402
 from ptztrack.types import Tracks  # noqa: E402
 
 CELL_M = 15.0
@@ -103,7 +103,7 @@ def grid_scenario(cameras: int, people: int, frames: int) -> Scenario:
 
 
 def recomputed_posterior(tracks: Tracks, policy, action: int) -> Tracks:
-    """The conditioning before issue 33 part 4: as :func:`ptztrack.control.network_policy.expected_posterior`,
+    """The conditioning before issue 33 part 4: as :func:`ptztrack.network.policy.expected_posterior`,
     but with the view's homographies and Jacobian computed anew for its pose."""
     if len(tracks) == 0:
         return tracks
@@ -185,8 +185,8 @@ def main() -> None:
     load_before = os.getloadavg()[0]
     cpus = None
     if args.ray:
-        from ptztrack.evaluate.camera_actors import RayCameras
-        from ptztrack.evaluate.executors import connect_ray
+        from ptztrack.loop.camera_actors import RayCameras
+        from ptztrack.loop.executors import connect_ray
 
         cpus = int(connect_ray().cluster_resources().get("CPU", 1))
         where = os.environ.get("RAY_ADDRESS") or "a local cluster (127.0.0.1)"

@@ -26,7 +26,7 @@ from pathlib import Path  # noqa: E402
 import cv2  # noqa: E402
 import numpy as np  # noqa: E402
 
-from ptztrack.builders.occupancy import ROOM, room_recording  # noqa: E402
+from ptztrack.builders.occupancy_synthetic import ROOM, room_recording  # noqa: E402
 from ptztrack.files import write_atomically  # noqa: E402
 from ptztrack.occupancy.detectors import LpomDetector, lpom_parameters  # noqa: E402
 from ptztrack.occupancy.lpom import map_modes, occupancy_map, table_map  # noqa: E402

@@ -26,11 +26,11 @@ import numpy as np
 
 from ptztrack.builders.episode import run_episode
 from ptztrack.config import scenario_from_dict
-from ptztrack.evaluate.executors import run_cells
 from ptztrack.evaluate.metrics import clear_metrics
 from ptztrack.files import write_json
 from ptztrack.geometry.ptz import inside_image, person_in_view, project_people
-from ptztrack.track.tracker import predicted_feet_px
+from ptztrack.loop.executors import execute_cells
+from ptztrack.track.observation import predicted_feet_px
 
 SCENES = {
     "default": {},
@@ -88,7 +88,7 @@ def main() -> None:
         for strategy in POLICIES
         for seed in range(args.sequences)
     ]
-    rows = run_cells(cells, cell, "local")
+    rows = execute_cells(cells, cell, "local")
     print(f"MOTA, {args.detector} detector, {args.sequences} sequences: every person / only the people in view")
     print(f"{'scene':<20}" + "".join(f"{strategy:>16}" for strategy in POLICIES))
     table = []

@@ -34,17 +34,17 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from ptztrack.builders.occupancy import plaza_layout
+from ptztrack.builders.occupancy_synthetic import plaza_layout
 from ptztrack.builders.pets_network import published_camera_world, published_network_parts, published_views
 from ptztrack.builders.recording import pets_scenario
 from ptztrack.builders.world import BuiltScene, build_scene, camera_world, detector_model
-from ptztrack.evaluate.executors import run_cells
 from ptztrack.evaluate.metrics import tracking_metrics, tracks_within
 from ptztrack.files import write_json
 from ptztrack.geometry.calibration import PinholeCalibration, camera_centre_m, project_pinhole
 from ptztrack.geometry.occlusion import occluded_fraction
-from ptztrack.loop import episode_seeds
-from ptztrack.network_loop import NetworkWorld, run_network_loop
+from ptztrack.loop.executors import execute_cells
+from ptztrack.loop.simulated import NetworkWorld, run_network_loop
+from ptztrack.loop.streams import episode_streams
 from ptztrack.occupancy.multiview import CameraView
 from ptztrack.occupancy.plaza import plaza_truth
 from ptztrack.types import GroundTruth
@@ -134,20 +134,20 @@ def twin_episode(cell: TwinCell) -> dict:
             )
         }
     )
-    streams = episode_seeds(cell.seed)
-    recorded = build_scene(pets, np.random.default_rng(streams[0]))
+    streams = episode_streams(cell.seed)
+    recorded = build_scene(pets, np.random.default_rng(streams.scene))
     at_step_rate = replace(plaza_layout(), frame_rate_hz=scenario.frame_rate_hz)
     truth = plaza_truth(at_step_rate, cell.people, scenario.frames, cell.seed)
     scene = BuiltScene(recorded.camera, recorded.grid, truth, recorded.area_polygon_m)
     ptz = cell.config != "6fixed"
     worlds = []
     if ptz:
-        world = camera_world(simulated, scene, "simulated", "realistic", streams[4], streams[5])
-        worlds.append(replace(world, detector_model=detector_model(scenario, scene.camera, streams[5])))
+        world = camera_world(simulated, scene, "simulated", "realistic", streams.tracker, streams.detector_model)
+        worlds.append(replace(world, detector_model=detector_model(scenario, scene.camera, streams.detector_model)))
     if cell.config != "ptz":
         rng = np.random.default_rng([cell.seed, 1])
         views = published_views(pets)
-        for view, model_seed in zip(views, streams[5].spawn(len(views)), strict=True):
+        for view, model_seed in zip(views, streams.detector_model.spawn(len(views)), strict=True):
             boxes = walker_boxes(truth, view.calibration, view.image_size_px, rng)
             turned = turned_calibration(view.calibration, cell.sigma_deg, rng)
             believed = CameraView(view.name, turned, view.image_size_px, None, boxes)
@@ -177,7 +177,7 @@ def main() -> None:
         for config in args.configs
         for index in range(args.seeds)
     ]
-    metrics = run_cells(cells, twin_episode, "local", args.workers)
+    metrics = execute_cells(cells, twin_episode, "local", args.workers)
     rows = []
     for sigma_deg in args.sigmas_deg:
         for config in args.configs:

@@ -1,7 +1,7 @@
 """Cost of one closed-loop step on PETS 2009 with the HOG detector, split by role, and today's
 detector beside it.
 
-Runs the loop of :func:`ptztrack.loop.run_loop` on the built-in PETS
+Runs the loop of :func:`ptztrack.loop.simulated.run_loop` on the built-in PETS
 scenario with OpenCV's HOG detector (``pets_scenario("hog")``, beta 1, seed
 0) for the strategies of Table 4 (``fix``, ``patrol``, ``random``, ``intg``,
 ``smpl``), and times each role of a step with ``time.perf_counter``:
@@ -78,7 +78,7 @@ from ptztrack.detect.hog import HogPeopleDetector, feet_and_height_px  # noqa: E
 from ptztrack.detect.recall_fit import MATCH_FRACTION_OF_HEIGHT  # noqa: E402
 from ptztrack.files import write_json  # noqa: E402
 from ptztrack.geometry.ptz import PTZCamera, inside_image  # noqa: E402
-from ptztrack.loop import episode_seeds  # noqa: E402
+from ptztrack.loop.streams import episode_streams  # noqa: E402
 from ptztrack.types import DecisionContext, Detections, PeopleInView  # noqa: E402
 
 cv2.setNumThreads(1)
@@ -114,11 +114,11 @@ def step_costs(scenario, reference: HogPeopleDetector, policy_name: str, steps: 
     """Seconds spent in each part over ``steps`` steps after ``warmup`` untimed ones, the wall and CPU
     times, today's detector's (``reference``) on the same views, and both detectors' counts.
 
-    The loop is run_loop's (a perfect camera, the commanded pose) with the backend's image split
+    The loop is the simulated loop's (a perfect camera, the commanded pose) with the backend's image split
     into reading and warping.
     """
-    scene_seed, _detector_seed, policy_seed, _landing_seed, _tracker_seed, model_seed = episode_seeds(seed)
-    world = build_world(scenario, np.random.default_rng(scene_seed), model_seed=model_seed)
+    streams = episode_streams(seed)
+    world = build_world(scenario, np.random.default_rng(streams.scene), model_seed=streams.detector_model)
     backend, detector = world.backend, world.detector
     if not isinstance(detector, HogPeopleDetector) or detector.search is None:
         raise ValueError("the scenario must use the HOG detector with a ground search")
@@ -127,7 +127,7 @@ def step_costs(scenario, reference: HogPeopleDetector, policy_name: str, steps: 
         raise ValueError(f"{warmup} + {steps} steps asked, the recording has {available}")
     policy = make_policy(policy_name, scenario, world)
     tracker = make_tracker(None, scenario, world)
-    policy_rng = np.random.default_rng(policy_seed)
+    policy_rng = np.random.default_rng(streams.policy)
     grid = world.grid
     max_hidden = scenario.required_recording("the detectors' scores").occluded_above
 

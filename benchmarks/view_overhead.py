@@ -20,9 +20,9 @@ import time
 
 from ptztrack.builders.episode import episode_world, make_policy, run_episode
 from ptztrack.config import scenario_from_dict
-from ptztrack.evaluate.video import view_renderer
-from ptztrack.evaluate.view_state import ViewState
-from ptztrack.evaluate.web_view import ViewHub, ViewServer
+from ptztrack.view.video import view_renderer
+from ptztrack.view.view_state import ViewState
+from ptztrack.view.web_view import ViewHub, ViewServer
 
 # The page, in another process as a browser is: a WebSocket client that parses every state, or Debian's
 # Chromium through Playwright drawing them (its driver in that process too, away from the run's GIL).

@@ -48,7 +48,7 @@ def main() -> None:
 
     strategies = ["fix", "smpl", follow_the_most_uncertain]
     cells = ptztrack.synthetic_cells(scenario, sequences=3, strategies=strategies)
-    rows = ptztrack.run_cells(cells, ptztrack.run_cell, executor="serial")
+    rows = ptztrack.execute_cells(cells, ptztrack.cell_metrics, executor="serial")
     print(ptztrack.format_table(ptztrack.summarise(rows), "3 synthetic sequences, realistic detector"))
 
 

@@ -60,3 +60,19 @@ def excerpt_scenario():
     """``excerpt_scenario(directory, **overrides)``: the small PETS scenario file of the excerpt, written
     into ``directory`` (a test's tmp_path) and loaded."""
     return _excerpt_scenario
+
+
+def pytest_collection_modifyitems(config, items):
+    """Tests that share a module-scoped fixture run in one worker (one xdist group per module), so the
+    fixture is built once for the whole run rather than once per worker."""
+    for item in items:
+        if item.get_closest_marker("xdist_group") is not None:
+            continue
+        definitions = getattr(item, "_fixtureinfo", None)
+        scopes = {
+            definition.scope
+            for defs in (definitions.name2fixturedefs.values() if definitions else ())
+            for definition in defs
+        }
+        if "module" in scopes:
+            item.add_marker(pytest.mark.xdist_group(item.module.__name__))

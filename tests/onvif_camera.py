@@ -11,8 +11,8 @@ import pytest
 pytest.importorskip("ipycam", reason="the virtual ONVIF camera needs ipycam (pip install --no-deps ipycam==1.3.0)")
 onvif = pytest.importorskip("onvif", reason="the ONVIF client is onvif-zeep-async (pip install onvif-zeep-async)")
 
-from ptztrack.camera.onvif_server import VirtualONVIFCamera  # noqa: E402
 from ptztrack.camera.onvif_spaces import AxisSpeeds, CameraSpaces  # noqa: E402
+from ptztrack.virtual_onvif.server import VirtualONVIFCamera  # noqa: E402
 
 HOST = "127.0.0.1"
 USER, PASSWORD = "operator", "s3cret-pass"

@@ -29,7 +29,8 @@ from pathlib import Path
 import PIL.Image
 import pytest
 
-from bad_inputs import Case, cases, run_case, write_case
+from bad_input_files import Case
+from bad_inputs import cases, run_case, write_case
 from ptztrack.cli import main
 from ptztrack.cli.interrupt import INTERRUPTED
 from ptztrack.config import load_camera_calibration, write_camera_calibration

@@ -6,7 +6,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from ptztrack.builders.follow import follow_parameters, initial_box, target_scenario
+from ptztrack.builders.follow import framing_parameters, initial_box, target_scenario
 from ptztrack.builders.recording import pets_follow_scenario
 from ptztrack.cli import main
 from ptztrack.config import ScenarioError, scenario_from_dict
@@ -34,7 +34,7 @@ def test_a_person_narrows_the_steps_and_the_camera_starts_framing_them():
     cell = FollowCell(excerpt_scenario("csrt", frames=1), "csrt", 9)
     narrowed, world, _ = follow_run(cell)
     box_px, start_pose = initial_box(narrowed, world)
-    parameters = follow_parameters(narrowed, world.camera)
+    parameters = framing_parameters(narrowed, world.camera)
     # The start pose frames person 9 as the controller wants: middle at (x*, y*), 160 px tall.
     np.testing.assert_allclose(box_px[:2] + box_px[2:] / 2, parameters.target_point_px, atol=8.0)
     first_m = world.truth.positions_m[0, np.searchsorted(world.backend.scene.person_id, 9)]

@@ -1,7 +1,7 @@
 import numpy as np
 
 from ptztrack.builders.episode import run_episode
-from ptztrack.builders.network import camera_scenario, network_world, run_network_episode
+from ptztrack.builders.network import camera_scenario, network_world
 from ptztrack.config import scenario_from_dict
 from ptztrack.control.baselines import area_coverage
 from ptztrack.evaluate.metrics import episode_metrics, network_metrics
@@ -13,7 +13,7 @@ def test_a_network_of_the_one_default_camera_is_the_one_camera_run():
     """Same people, same detector luck, same decisions: the network loop reuses the one-camera steps."""
     one = scenario_from_dict({"frames": 15})
     network = scenario_from_dict({"frames": 15, "cameras": [{"position_m": SOUTH}]})
-    alone, together = run_episode(one, "intg", 4), run_network_episode(network, 4)
+    alone, together = run_episode(one, "intg", 4), run_episode(network, "intg", 4)
     np.testing.assert_array_equal(alone.actions, together.cameras[0].actions)
     for a, b in zip(alone.tracks, together.tracks, strict=True):
         np.testing.assert_array_equal(a.ids, b.ids)
@@ -39,14 +39,14 @@ def test_each_camera_faces_the_area_with_its_own_lens_and_detector_and_a_fixed_o
     for camera in world.cameras:
         assert camera.truth is world.truth
         assert area_coverage(camera.camera, camera.grid.poses[camera.start_action], world.area_polygon_m) > 0.8
-    episode = run_network_episode(scenario, 1)
+    episode = run_episode(scenario, "intg", 1)
     assert np.all(episode.cameras[1].actions == world.cameras[1].start_action)
     assert len(set(episode.cameras[0].actions.tolist())) > 1
 
 
 def test_the_same_seed_gives_the_same_network_episode():
     scenario = scenario_from_dict({"frames": 10, "cameras": [{"position_m": SOUTH}, {"position_m": NORTH}]})
-    first, again = (run_network_episode(scenario, 2, "joint", "smpl") for _ in range(2))
+    first, again = (run_episode(scenario, "smpl", 2, coordination="joint") for _ in range(2))
     for a, b in zip(first.cameras, again.cameras, strict=True):
         np.testing.assert_array_equal(a.actions, b.actions)
     for a, b in zip(first.tracks, again.tracks, strict=True):

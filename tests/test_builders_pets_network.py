@@ -14,7 +14,7 @@ from ptztrack.detect.published import PublishedDetections
 from ptztrack.detect.simulated import RecallModel
 from ptztrack.evaluate.metrics import episode_metrics
 from ptztrack.geometry.calibration import project_pinhole
-from ptztrack.track.tracker import ground_points
+from ptztrack.track.observation import ground_points
 from ptztrack.types import Detections
 
 

@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from bad_inputs import video_bytes
+from bad_input_files import video_bytes
 from ptztrack.builders.episode import run_episode
 from ptztrack.builders.recording import (
     FOLLOW_PROTOCOL,

@@ -55,6 +55,7 @@ def test_the_index_is_built_once_and_then_read_from_its_file(small_registration)
     np.testing.assert_array_equal(again.descriptors, index.descriptors)
 
 
+@pytest.mark.slow
 def test_pets_views_register_to_a_fraction_of_a_percent_and_centimetres(small_registration):
     scenario, index = small_registration
     rows = registration_views(scenario, index, views=8, seed=3)
@@ -64,6 +65,7 @@ def test_pets_views_register_to_a_fraction_of_a_percent_and_centimetres(small_re
     assert summary["ground_err_median_m"] < 0.1
 
 
+@pytest.mark.slow
 def test_realistic_pets_views_register_within_a_percent_and_fifteen_centimetres(small_registration):
     scenario, index = small_registration
     realistic = scenario.model_copy(update={"camera": scenario.camera.model_copy(update={"live_view": LiveView()})})

@@ -9,13 +9,13 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from ptztrack.camera import live_view
-from ptztrack.camera.parameters import LiveViewModel
+from ptztrack.camera.parameters import LiveViewParameters
 from ptztrack.camera.virtual import virtual_ptz
 from ptztrack.geometry.calibration import load_pinhole
 
 EXCERPT = Path(__file__).parent / "data" / "pets_s2l1_excerpt"
 VIRTUAL, CENTRE_POSE = virtual_ptz(load_pinhole(EXCERPT / "pinhole.json"), image_size_px=(320, 240))
-MODEL = LiveViewModel(
+MODEL = LiveViewParameters(
     roll_max_deg=2.0,
     principal_offset_max_px=10.0,
     offset_image_width_px=640,

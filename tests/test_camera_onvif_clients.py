@@ -38,9 +38,9 @@ onveef = pytest.importorskip("onveef", reason="the outside ONVIF client is onvee
 
 import zeep.exceptions  # noqa: E402  (onvif-zeep-async's SOAP library)
 
-from ptztrack.camera.onvif_ptz import PAN_TILT_FOV  # noqa: E402
-from ptztrack.camera.onvif_server import VirtualONVIFCamera  # noqa: E402
 from ptztrack.geometry.ptz import rotation_world_to_camera  # noqa: E402
+from ptztrack.virtual_onvif.ptz import PAN_TILT_FOV  # noqa: E402
+from ptztrack.virtual_onvif.server import VirtualONVIFCamera  # noqa: E402
 
 pytestmark = pytest.mark.onvif
 

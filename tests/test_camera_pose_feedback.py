@@ -4,17 +4,19 @@ import numpy as np
 import pytest
 
 from ptztrack.camera import pose_feedback
-from ptztrack.camera.parameters import LandingError
+from ptztrack.camera.parameters import LandingErrorParameters
 
 
 def test_a_perfect_camera_lands_exactly_where_it_is_sent():
     commanded = np.array([12.5, 20.0, 3.0])
-    landed = pose_feedback.landed_pose(commanded, LandingError(), np.random.default_rng(0))
+    landed = pose_feedback.landed_pose(commanded, LandingErrorParameters(), np.random.default_rng(0))
     np.testing.assert_array_equal(landed, commanded)
 
 
 def test_bias_and_noise_of_the_landing_pose_have_the_configured_size():
-    error = LandingError(pan_tilt_sigma_deg=2.0, pan_tilt_bias_deg=(1.0, -0.5), zoom_sigma=0.03, zoom_bias=1.1)
+    error = LandingErrorParameters(
+        pan_tilt_sigma_deg=2.0, pan_tilt_bias_deg=(1.0, -0.5), zoom_sigma=0.03, zoom_bias=1.1
+    )
     rng = np.random.default_rng(1)
     commanded = np.array([10.0, 20.0, 2.0])
     landed = np.array([pose_feedback.landed_pose(commanded, error, rng) for _ in range(20000)])

@@ -101,5 +101,5 @@ def test_a_camera_network_needs_the_synthetic_scene_and_runs_as_a_network(excerp
     with pytest.raises(ScenarioError, match="cameras: a network of cameras runs on the synthetic scene"):
         excerpt_scenario(tmp_path, cameras=[{"position_m": (0.0, 0.0, 3.0)}])
     network = scenario_from_dict({"cameras": [{"position_m": (0.0, 0.0, 3.0)}]})
-    with pytest.raises(ScenarioError, match="a camera network runs as one"):
+    with pytest.raises(ScenarioError, match="a camera network decides by intg or smpl, not 'fix'"):
         run_episode(network, "fix", 0)

@@ -17,7 +17,7 @@ from ptztrack.control.information_gain import (
 )
 from ptztrack.control.information_policy import InformationGainPolicy
 from ptztrack.control.parameters import ControlParameters
-from ptztrack.detect.parameters import DetectorPrior
+from ptztrack.detect.parameters import DetectorPriorParameters
 from ptztrack.detect.simulated import RecallModel
 from ptztrack.geometry.area import rectangle_m
 from ptztrack.geometry.occlusion import occluded_fraction, occlusion_in_centred_views
@@ -41,8 +41,8 @@ WIDTH_M = 0.5
 STEP_S = 0.2
 # The paper's recall curve of HOG (the realistic detector's), and the ideal detector's recall of 1.
 CURVES = {
-    "realistic": RecallModel(DetectorPrior.recall_kd, DetectorPrior.recall_r0_px),
-    "ideal": RecallModel(DetectorPrior.recall_kd, DetectorPrior.recall_r0_px, perfect=True),
+    "realistic": RecallModel(DetectorPriorParameters.recall_kd, DetectorPriorParameters.recall_r0_px),
+    "ideal": RecallModel(DetectorPriorParameters.recall_kd, DetectorPriorParameters.recall_r0_px, perfect=True),
 }
 
 

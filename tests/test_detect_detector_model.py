@@ -204,6 +204,7 @@ def test_the_prior_weighs_as_many_trials_per_bin_as_it_says():
     assert len(learned.prior_trials) == len(HEIGHT_BIN_EDGES_PX) - 1
 
 
+@pytest.mark.slow
 def test_a_run_writes_what_it_learned_and_the_next_run_starts_from_it(tmp_path, capsys):
     from ptztrack.cli import main
 

@@ -134,6 +134,7 @@ def test_the_ground_search_scans_the_full_searchs_windows_in_its_bands_and_no_ot
         assert dict(zip(map(tuple, searched.tolist()), scores, strict=True)) == expected
 
 
+@pytest.mark.slow
 def test_the_ground_search_finds_as_many_people_at_their_size_as_the_full_search(hog_world):
     backend, full = hog_world.backend, HogPeopleDetector()
     found_full = found_ground = 0

@@ -9,7 +9,10 @@ from ptztrack.builders.episode import episode_world, run_episode
 from ptztrack.cli import main
 from ptztrack.cli.run import DETECTOR_MODEL_FILE
 from ptztrack.config import scenario_from_dict
-from ptztrack.evaluate.video import (
+from ptztrack.geometry.area import bounds_m
+from ptztrack.geometry.ptz import PTZCamera
+from ptztrack.names import RUN_FILES, VIEW_STATES_FILE
+from ptztrack.view.video import (
     FRAME_SIZE_PX,
     PANEL_SIZE_PX,
     ellipse_axes,
@@ -19,9 +22,6 @@ from ptztrack.evaluate.video import (
     view_renderer,
     write_episode_video,
 )
-from ptztrack.geometry.area import bounds_m
-from ptztrack.geometry.ptz import PTZCamera
-from ptztrack.names import RUN_FILES, VIEW_STATES_FILE
 
 EXCERPT = Path(__file__).parent / "data" / "pets_s2l1_excerpt"
 

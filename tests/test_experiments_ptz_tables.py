@@ -10,8 +10,7 @@ import pytest
 from ptztrack.builders.world import build_scene
 from ptztrack.cli import main
 from ptztrack.config import scenario_from_dict
-from ptztrack.evaluate.executors import run_cells
-from ptztrack.experiments.cells import run_cell
+from ptztrack.experiments.cells import cell_metrics
 from ptztrack.experiments.ptz_tables import (
     fit_detector,
     format_table,
@@ -25,6 +24,7 @@ from ptztrack.experiments.ptz_tables import (
     synthetic_cells,
 )
 from ptztrack.geometry.area import inside
+from ptztrack.loop.executors import execute_cells
 from ptztrack.names import STRATEGIES
 
 SMALL = scenario_from_dict({"frames": 8})
@@ -86,7 +86,7 @@ def test_unknown_strategies_and_executors_are_refused():
     with pytest.raises(ValueError, match="unknown strategies"):
         synthetic_cells(SMALL, 1, ("fix", "greedy"))
     with pytest.raises(ValueError, match="unknown executor"):
-        run_cells(synthetic_cells(SMALL, 1, ("fix",)), run_cell, "cluster")
+        execute_cells(synthetic_cells(SMALL, 1, ("fix",)), cell_metrics, "cluster")
 
 
 def test_experiment_command_prints_the_table_and_writes_one_row_per_strategy(tmp_path, capsys):
@@ -106,7 +106,7 @@ def test_experiment_command_prints_the_table_and_writes_one_row_per_strategy(tmp
 def table(detector):
     # The paper's protocol: the policies know the simulated detector's curve.
     scenario = scenario_from_dict({"detector": {"kind": detector, "model": "true"}})
-    return {row["label"]: row for row in summarise(run_cells(synthetic_cells(scenario, 12), run_cell, "local"))}
+    return {row["label"]: row for row in summarise(execute_cells(synthetic_cells(scenario, 12), cell_metrics, "local"))}
 
 
 @pytest.mark.slow

@@ -6,10 +6,8 @@ import networkx as nx
 import numpy as np
 import pytest
 
-from ptztrack.evaluate.executors import run_cells
 from ptztrack.facecapture import msg
 from ptztrack.facecapture.experiment import (
-    EXPERIMENT_SCENE,
     labelled_fraction,
     msg_cells,
     paired_difference_m,
@@ -17,12 +15,13 @@ from ptztrack.facecapture.experiment import (
     run_msg_cell,
     summarise_by_ambiguity,
 )
+from ptztrack.facecapture.parameters import MsgExperimentParameters, TrackletTrackerParameters
 from ptztrack.facecapture.road_camera import Blob
 from ptztrack.facecapture.roads import RoadScene, walk_roads
 from ptztrack.facecapture.scheduler import SCHEDULERS
-from ptztrack.facecapture.tracklets import TrackletTrackerConfig
+from ptztrack.loop.executors import execute_cells
 
-BUSY = replace(EXPERIMENT_SCENE, people=15, join_probability=0.7)
+BUSY = replace(MsgExperimentParameters.scene, people=15, join_probability=0.7)
 
 
 class TruthUpTo(np.ndarray):
@@ -74,7 +73,7 @@ def test_no_decision_reads_the_future_cutting_the_truth_after_a_step_changes_not
     full = run_msg(scene, scheduler, seed=3)
     # Cut where a zoom is decided, where its face is captured, and anywhere.
     decided = next(step for step, _ in full.zooms if step >= 150)
-    for step in (decided, decided + TrackletTrackerConfig().zoom_steps, 300):
+    for step in (decided, decided + TrackletTrackerParameters().zoom_steps, 300):
         original = run_msg(scene, scheduler, seed=3, steps=step + 1)
         assert original.zooms == [zoom for zoom in full.zooms if zoom[0] <= step]
         for continuation in ("nothing", "another walk"):
@@ -124,7 +123,9 @@ def test_differences_pair_up_run_by_run():
 
 
 def test_a_run_is_reproducible_and_every_scheduler_captures_faces():
-    scene = walk_roads(replace(EXPERIMENT_SCENE, people=12, join_probability=0.7), np.random.default_rng(3))
+    scene = walk_roads(
+        replace(MsgExperimentParameters.scene, people=12, join_probability=0.7), np.random.default_rng(3)
+    )
     for scheduler in SCHEDULERS:
         first, second = run_msg(scene, scheduler, seed=1), run_msg(scene, scheduler, seed=1)
         assert first.m == second.m and first.captures == second.captures
@@ -135,7 +136,7 @@ def test_a_run_is_reproducible_and_every_scheduler_captures_faces():
 
 @pytest.mark.slow
 def test_the_paper_scheduler_labels_more_than_the_naive_one_and_untangling_helps():
-    rows = [row for rows in run_cells(msg_cells(16), run_msg_cell, "serial") for row in rows]
+    rows = [row for rows in execute_cells(msg_cells(16), run_msg_cell, "serial") for row in rows]
     mean_m = {
         scheduler: np.mean([row["m"] for row in rows if row["scheduler"] == scheduler])
         for scheduler in ("msg", "msg-no-untangling", "naive")
@@ -149,4 +150,4 @@ def test_the_paper_scheduler_labels_more_than_the_naive_one_and_untangling_helps
 @pytest.mark.slow
 def test_local_processes_and_serial_give_the_same_rows():
     cells = msg_cells(4)
-    assert run_cells(cells, run_msg_cell, "local", workers=2) == run_cells(cells, run_msg_cell, "serial")
+    assert execute_cells(cells, run_msg_cell, "local", workers=2) == execute_cells(cells, run_msg_cell, "serial")

@@ -1,6 +1,7 @@
 """The MSG's auxiliary data against the traversal reference, under random growth, labelling and untangling."""
 
 import networkx as nx
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -99,6 +100,7 @@ class Scene:
             assert stored == {field: expected[field] for field in msg.AUX_FIELDS}, (v, stored, expected)
 
 
+@pytest.mark.slow
 @settings(max_examples=1000, deadline=None)
 @given(st.data())
 def test_auxiliary_data_equals_traversal_through_growth_labelling_and_untangling(data):

@@ -3,7 +3,8 @@
 import numpy as np
 import pytest
 
-from ptztrack.facecapture.road_camera import ZOOMED_HALF_WIDTH_M, RoadCamera, Zoom
+from ptztrack.facecapture.parameters import RoadCameraParameters
+from ptztrack.facecapture.road_camera import RoadCamera, Zoom
 from ptztrack.facecapture.roads import RoadScene
 
 CENTRE_M = (20.0, 20.0)
@@ -76,12 +77,14 @@ def test_a_face_is_captured_when_aimed_right_and_never_from_behind_or_in_a_group
     group_id[5:] = 0
     grouped = straight_scene([[5, 20], [5, 20]], [[1, 0], [1, 0]], 20, group_id)
     assert capture_at(grouped, 10, grouped.positions_m[10, 0]) is None
-    assert capture_at(towards, 10, towards.positions_m[10, 0] + [0, 6 * ZOOMED_HALF_WIDTH_M]) is None
+    assert (
+        capture_at(towards, 10, towards.positions_m[10, 0] + [0, 6 * RoadCameraParameters.zoomed_half_width_m]) is None
+    )
 
 
 def test_the_capture_succeeds_with_probability_exp_of_minus_half_the_squared_error_in_half_widths():
     scene = straight_scene([[5, 20]], [[1, 0]], 5)
-    aim_m = scene.positions_m[3, 0] + [0, ZOOMED_HALF_WIDTH_M]  # off by one half-width
+    aim_m = scene.positions_m[3, 0] + [0, RoadCameraParameters.zoomed_half_width_m]  # off by one half-width
     captured = np.mean([capture_at(scene, 3, aim_m, seed) is not None for seed in range(600)])
     assert captured == pytest.approx(np.exp(-0.5), abs=4 * np.sqrt(0.61 * 0.39 / 600))
 

@@ -3,11 +3,12 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from ptztrack.facecapture.roads import RoadScene, RoadSceneConfig, joins_and_splits, walk_roads
+from ptztrack.facecapture.parameters import RoadSceneParameters
+from ptztrack.facecapture.roads import RoadScene, joins_and_splits, walk_roads
 
 
 def walk(seed=0, **fields):
-    return walk_roads(RoadSceneConfig(**fields), np.random.default_rng(seed))
+    return walk_roads(RoadSceneParameters(**fields), np.random.default_rng(seed))
 
 
 def lattice(scene):
@@ -189,5 +190,5 @@ def test_the_seed_fixes_the_scene():
 )
 def test_invalid_configurations_are_refused_naming_the_field(fields, name):
     with pytest.raises((TypeError, ValueError)) as error:
-        RoadSceneConfig(**fields)
+        RoadSceneParameters(**fields)
     assert name in str(error.value)

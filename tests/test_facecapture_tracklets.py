@@ -3,19 +3,14 @@
 import numpy as np
 import pytest
 
-from ptztrack.facecapture.tracklets import (
-    FaceCapture,
-    Observation,
-    TrackletTracker,
-    TrackletTrackerConfig,
-    UnitSighting,
-)
+from ptztrack.facecapture.parameters import TrackletTrackerParameters
+from ptztrack.facecapture.tracklets import FaceCapture, Observation, TrackletTracker, UnitSighting
 
 RATE_HZ = 5.0
 
 
 def tracker(**config):
-    return TrackletTracker(40.0, RATE_HZ, (20.0, 20.0), TrackletTrackerConfig(**config))
+    return TrackletTracker(40.0, RATE_HZ, (20.0, 20.0), TrackletTrackerParameters(**config))
 
 
 def walker(blob, start_m, heading, speed_m_s, step, came_from=(), count=1):

@@ -3,21 +3,24 @@
 import numpy as np
 import pytest
 
-from ptztrack.follow.controller import FollowParameters, FollowPolicy, framing_pose
+from ptztrack.follow.controller import FollowPolicy, FramingParameters, framing_pose
+from ptztrack.follow.parameters import FollowParameters
 from ptztrack.geometry.ptz import PTZCamera, look_at, project_people, projection_matrix
 from ptztrack.types import DecisionContext, Tracks
 
 CAMERA = PTZCamera((0.0, 0.0, 7.0), 640, 480, 400.0)
-PARAMETERS = FollowParameters(
+PARAMETERS = FramingParameters(
+    follow=FollowParameters(
+        target_height_px=150.0,
+        max_speed_deg_s=30.0,
+        max_acceleration_deg_s2=30.0,
+        max_zoom_speed=0.7,
+        max_zoom_acceleration=0.7,
+        zoom_range=(1.0, 8.0),
+    ),
     target_point_px=np.array([200.0, 300.0]),
-    target_height_px=150.0,
     person_height_m=1.75,
     person_width_m=0.5,
-    max_speed_deg_s=30.0,
-    max_acceleration_deg_s2=30.0,
-    max_zoom_speed=0.7,
-    max_zoom_acceleration=0.7,
-    zoom_range=(1.0, 8.0),
     step_s=0.1,
 )
 

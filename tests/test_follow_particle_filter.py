@@ -6,7 +6,7 @@ import cv2
 import numpy as np
 import pytest
 
-from ptztrack.follow.parameters import FollowSettings
+from ptztrack.follow.parameters import FollowParameters
 from ptztrack.follow.particle_filter import (
     MAX_HEIGHT_Z,
     carry_states,
@@ -18,9 +18,9 @@ from ptztrack.follow.particle_filter import (
     systematic_resample,
 )
 
-PARAMETERS = particle_filter_parameters(FollowSettings(), 10.0)
+PARAMETERS = particle_filter_parameters(FollowParameters(), 10.0)
 # The particles move by the estimate's velocity (the prediction before the particles had their own).
-SHARED_VELOCITY = particle_filter_parameters(FollowSettings(prediction="constant_velocity"), 10.0)
+SHARED_VELOCITY = particle_filter_parameters(FollowParameters(prediction="constant_velocity"), 10.0)
 RANDOM_WALK = replace(SHARED_VELOCITY, velocity_gain=0.0)  # the paper's prediction
 HEIGHT_PX = 120
 WIDTH_PX = 48
@@ -174,6 +174,7 @@ def _cross_a_twin(parameters, seed: int, paths=HEAD_ON, shirts=((RED, RED), (RED
     return float(np.hypot(*(state.estimate[:2] - mine[-1]))), state.lost
 
 
+@pytest.mark.slow
 def test_the_velocity_carries_the_filter_past_a_twin_that_the_random_walk_follows():
     """Two figures of the same colours cross: the particles' own velocities keep the first in every
     run; the paper's random walk ends on the twin, or lost, in some (7 of 8 here)."""
@@ -183,6 +184,7 @@ def test_the_velocity_carries_the_filter_past_a_twin_that_the_random_walk_follow
     assert sum(error_px > 50.0 or lost for error_px, lost in random_walk) >= 2
 
 
+@pytest.mark.slow
 def test_the_particles_own_velocities_keep_a_figure_that_a_twin_overtakes_where_a_shared_one_turns():
     """A twin overtakes the figure in front of it: the particles that moved with the twin cannot make the
     figure's velocity the twin's, and the filter keeps the figure in every run; with one velocity shared
@@ -194,6 +196,7 @@ def test_the_particles_own_velocities_keep_a_figure_that_a_twin_overtakes_where_
     assert sum(error_px > 50.0 or lost for error_px, lost in shared) >= 4
 
 
+@pytest.mark.slow
 def test_the_split_patches_tell_the_figure_from_a_mirrored_twin_that_the_papers_patches_follow():
     """The twin's shirt is the figure's mirrored (green and red halves against red and green), so that
     a whole-torso histogram cannot tell them apart. With the paper's random walk, so that only the

@@ -17,7 +17,9 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from bad_inputs import _dataset, video_bytes, write_case
+from bad_dataset_inputs import _dataset
+from bad_input_files import video_bytes
+from bad_inputs import write_case
 from ptztrack.builders.budget import refuse_if_too_large
 from ptztrack.builders.episode import run_episode
 from ptztrack.builders.live import camera_spaces, pose_timeline
@@ -194,7 +196,7 @@ SMALL_DATASET = _dataset(
     top="frames: 2\noccupancy: {cell_m: 0.05, kernel_sigma_m: 0.1, separation_m: 0.5, window_m: 0.25, block_px: 4}\n",
     extra=("--quiet", "--methods"),
 )
-"""One PETS view's calibration, two frames of its detections and ground truth (tests/bad_inputs.py), and the
+"""One PETS view's calibration, two frames of its detections and ground truth (tests/bad_dataset_inputs.py), and the
 parameters whose cost grows with them."""
 
 

@@ -11,7 +11,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from bad_inputs import _pinhole_with_k_scaled, calibration_fit_case, write_case
+from bad_dataset_inputs import calibration_fit_case
+from bad_input_files import _pinhole_with_k_scaled
+from bad_inputs import write_case
 from ptztrack.builders.occupancy import recording_from_dataset
 from ptztrack.cli import main
 from ptztrack.config import load_dataset
@@ -95,7 +97,7 @@ def test_an_area_seen_whole_gets_no_warning(tmp_path, caplog):
 
 def test_a_calibration_that_projects_the_ground_truth_onto_the_views_detections_gets_no_warning(tmp_path, caplog):
     """View_001's detections are the ground truth's own boxes, and PETS's pinhole calibration projects the
-    people onto them (the same with K halved is warned of: tests/bad_inputs.py)."""
+    people onto them (the same with K halved is warned of: tests/bad_dataset_inputs.py)."""
     case = calibration_fit_case("fit", 1.0, ("--quiet", "--methods"))
     with caplog.at_level(logging.WARNING):
         assert main(write_case(case, tmp_path)) == 0

@@ -5,7 +5,8 @@ from ptztrack.occupancy.feet import fitted_feet_variances, localized_by_feet, ne
 from ptztrack.occupancy.lpom import Modes
 from ptztrack.occupancy.multiview import CameraView, MultiViewRecording
 from ptztrack.occupancy.parameters import PomParameters
-from ptztrack.occupancy.pom import PomDetector, person_box_px
+from ptztrack.occupancy.pom import PomDetector
+from ptztrack.occupancy.pom_rectangles import person_box_px
 from ptztrack.occupancy.room import RoomLayout, room_cameras
 
 LAYOUT = RoomLayout(image_size_px=(320, 240), focal_px=156.0)

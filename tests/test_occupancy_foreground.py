@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 from scipy.spatial.distance import pdist
 
-from ptztrack.builders.occupancy import ROOM_AREA_M, rendered_recording, room_recording
+from ptztrack.builders.occupancy_synthetic import ROOM_AREA_M, rendered_recording, room_recording
 from ptztrack.occupancy.detectors import ClusteringDetector, LpomForegroundDetector, lpom_parameters
 from ptztrack.occupancy.foreground import ViewForeground, clean_silhouettes, silhouette_edges, view_foregrounds
 from ptztrack.occupancy.parameters import ForegroundParameters, OccupancyParameters
@@ -38,6 +38,7 @@ def boundary(mask) -> np.ndarray:
     return mask & ~inside
 
 
+@pytest.mark.slow
 def test_the_silhouettes_cover_the_rendered_people_and_little_else_once_warmed_up(room):
     hits = people = false = 0
     for view in range(4):
@@ -66,6 +67,7 @@ def test_the_edges_are_the_silhouettes_boundary():
     assert not silhouette_edges(np.ones((4, 4), bool)).any()
 
 
+@pytest.mark.slow
 def test_the_edges_of_the_rooms_silhouettes_are_their_boundary(room):
     model = ViewForeground(lambda frame: room.image(1, frame), ForegroundParameters())
     for frame in range(CHECKED.start):
@@ -104,6 +106,7 @@ def test_clean_silhouettes_drop_shadows_and_specks_and_close_small_gaps():
     assert not silhouettes[:, 22:].any()
 
 
+@pytest.mark.slow
 def test_the_same_frames_give_the_same_masks_whatever_the_order_and_the_thread_count():
     layout = RoomLayout(image_size_px=(256, 192), focal_px=125.0)
     renderer = RoomRenderer(layout, room_truth(layout, 3, 30, 1), 1)
@@ -125,6 +128,7 @@ def test_the_same_frames_give_the_same_masks_whatever_the_order_and_the_thread_c
         cv2.setNumThreads(threads)
 
 
+@pytest.mark.slow
 def test_a_lead_in_is_learned_before_the_first_frame_and_frame_0_has_silhouettes():
     """Frames -L..-1 of a recording with a lead-in are what frames 0..L-1 are to a recording without one."""
     layout = RoomLayout(image_size_px=(256, 192), focal_px=125.0)
@@ -142,6 +146,7 @@ def test_a_lead_in_is_learned_before_the_first_frame_and_frame_0_has_silhouettes
     assert not ViewForeground(from_the_lead_in, ForegroundParameters()).silhouettes(0).any()
 
 
+@pytest.mark.slow
 def test_the_baselines_blob_boxes_learn_the_lead_in_as_well():
     """The baseline's frame 0 after a lead-in of L frames is what its frame L is without one."""
     layout = RoomLayout(image_size_px=(256, 192), focal_px=125.0)
@@ -161,6 +166,7 @@ def test_the_baselines_blob_boxes_learn_the_lead_in_as_well():
     assert len(expected.position_m) >= 1
 
 
+@pytest.mark.slow
 def test_lpom_from_the_silhouettes_finds_the_rooms_people_within_a_quarter_metre():
     recording = room_recording(people=3, frames=FRAMES, seed=SEED)
     detector = LpomForegroundDetector(

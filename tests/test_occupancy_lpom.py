@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 from scipy.stats import multivariate_normal
 
-from ptztrack.builders.occupancy import room_recording
+from ptztrack.builders.occupancy_synthetic import room_recording
 from ptztrack.occupancy.detectors import LpomDetector, lpom_parameters
 from ptztrack.occupancy.locus import PERSON
 from ptztrack.occupancy.lpom import (
@@ -22,6 +22,7 @@ from ptztrack.occupancy.parameters import OccupancyParameters
 from ptztrack.occupancy.room import RoomLayout, room_cameras
 
 
+@pytest.mark.slow
 def test_a_single_person_in_the_synthetic_room_gives_one_mode_near_the_truth():
     recording = room_recording(people=1, frames=6, seed=3)
     detector = LpomDetector(recording, lpom_parameters(OccupancyParameters()))

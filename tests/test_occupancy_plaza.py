@@ -9,7 +9,7 @@ import cv2
 import numpy as np
 import pytest
 
-from ptztrack.builders.occupancy import plaza_layout, plaza_recording, plaza_renderer
+from ptztrack.builders.occupancy_synthetic import plaza_layout, plaza_recording, plaza_renderer
 from ptztrack.cli import main
 from ptztrack.config import pets_dataset
 from ptztrack.geometry.calibration import camera_centre_m, in_image, load_tsai, pinhole_from_tsai, project_pinhole
@@ -62,6 +62,7 @@ CONVERSION_PX = {
 }
 
 
+@pytest.mark.slow
 def test_the_plaza_sees_through_petss_calibrations():
     recording = plaza_recording(people=2, frames=2, seed=0)
     assert [view.name for view in recording.views] == list(CONVERSION_PX)
@@ -92,6 +93,7 @@ def test_every_camera_stands_inside_the_stage(renderer):
         assert x0 < x < x1 and y0 < y < y1 and 0 < z < renderer.stage.height_m
 
 
+@pytest.mark.slow
 def test_people_are_drawn_where_the_truth_puts_them(renderer):
     """Each person drawn alone on black: the pixel of their feet lies in their silhouette's convex hull
     (the point between the feet, which stride apart, within a pixel), at its bottom (within 5 % of its

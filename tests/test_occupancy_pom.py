@@ -12,17 +12,13 @@ from ptztrack.geometry.calibration import aimed_pinhole, project_pinhole
 from ptztrack.occupancy.lpom import GroundGrid
 from ptztrack.occupancy.multiview import CameraView, MultiViewRecording
 from ptztrack.occupancy.parameters import PomParameters
-from ptztrack.occupancy.pom import (
+from ptztrack.occupancy.pom import PomDetector, box_sums, integral_image, pom_modes, pom_posterior
+from ptztrack.occupancy.pom_rectangles import (
     PersonBoxes,
-    PomDetector,
-    box_sums,
     boxes_mask,
     fitted_box_scales,
-    integral_image,
     person_box_px,
     person_boxes,
-    pom_modes,
-    pom_posterior,
     scaled_about_feet,
     working_mask,
 )
@@ -277,6 +273,7 @@ def room_detector(layout: RoomLayout, truth, boxes=None) -> PomDetector:
     return PomDetector(recording, PARAMETERS)
 
 
+@pytest.mark.slow
 def test_pom_finds_the_people_of_the_rendered_room_from_foreground_masks():
     layout = RoomLayout()
     truth = room_truth(layout, people=2, frames=21, seed=2)

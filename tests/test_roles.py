@@ -16,11 +16,11 @@ from ptztrack import registry
 from ptztrack.builders.episode import run_episode
 from ptztrack.cli import main
 from ptztrack.config import ScenarioError, scenario_from_dict
-from ptztrack.evaluate.executors import run_cells
 from ptztrack.evaluate.metrics import episode_metrics
-from ptztrack.experiments.cells import run_cell
+from ptztrack.experiments.cells import cell_metrics
 from ptztrack.experiments.ptz_tables import summarise, synthetic_cells
 from ptztrack.geometry.ptz import look_at, project_people
+from ptztrack.loop.executors import execute_cells
 from ptztrack.types import DecisionContext, Detections
 
 # The drawn-blob detector is about roles, not the scene: the overhead camera of the hand-worked tests.
@@ -108,7 +108,7 @@ class Stay:
 def test_they_run_in_the_synthetic_experiment_beside_the_papers_strategies():
     strategies = ["fix", centre_of_tracks, Stay()]
     cells = synthetic_cells(SCENARIO, 2, strategies, camera=drawn_camera, detector=DarkBlobDetector())
-    rows = run_cells(cells, run_cell, "serial")
+    rows = execute_cells(cells, cell_metrics, "serial")
     table = {row["label"]: row for row in summarise(rows)}
     assert list(table) == ["fix", "centre_of_tracks", "Stay"]
     assert all(row["zoom"] == 1.0 for row in table.values())
@@ -129,6 +129,7 @@ def test_a_registered_policy_is_a_name_for_the_command_line(capsys):
     assert "stay-here" not in registry.names("policies")
 
 
+@pytest.mark.slow
 def test_another_package_adds_a_policy_and_a_detector_through_entry_points(tmp_path):
     (tmp_path / "other_package.py").write_text(
         textwrap.dedent(
@@ -189,6 +190,7 @@ def test_experiment_subcommands_take_only_their_own_flags(capfd):
     assert stderr.count("\n") == 1 and "unrecognized arguments: --views 3" in stderr
 
 
+@pytest.mark.slow
 def test_a_run_can_be_rescored_from_its_files_with_motmetrics_alone(tmp_path):
     """tracks_mot.txt and truth_mot.txt, read back and scored by motmetrics with the 1 m ground gate,
     give the run's metrics.json; steps.csv and detections.csv give its zoom and detections."""

@@ -2,7 +2,7 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from ptztrack.scene.parameters import Crowd
+from ptztrack.scene.parameters import CrowdParameters
 from ptztrack.scene.synthetic import walk_people
 
 AREA = (15.0, 15.0)
@@ -10,7 +10,7 @@ AREA = (15.0, 15.0)
 
 def walk(seed, frames=200, **people):
     """Walkers alone unless ``pairs`` is given."""
-    crowd = Crowd(**{"paired_fraction": 0.0, **people})
+    crowd = CrowdParameters(**{"paired_fraction": 0.0, **people})
     return walk_people(crowd, AREA, frames, 5.0, np.random.default_rng(seed))
 
 
@@ -76,5 +76,5 @@ def test_a_pair_walks_side_by_side_the_second_on_the_left_of_the_first(seed, ent
 
 
 def test_the_paired_fraction_makes_whole_pairs():
-    assert [Crowd(count=count, paired_fraction=0.85).pairs for count in (0, 1, 3, 7, 20)] == [0, 0, 1, 3, 8]
-    assert Crowd(count=7, paired_fraction=1.0).pairs == 3
+    assert [CrowdParameters(count=count, paired_fraction=0.85).pairs for count in (0, 1, 3, 7, 20)] == [0, 0, 1, 3, 8]
+    assert CrowdParameters(count=7, paired_fraction=1.0).pairs == 3

@@ -9,17 +9,18 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from bad_inputs import Case, write_case
+from bad_input_files import Case
+from bad_inputs import write_case
 from ptztrack.builders.episode import run_episode
 from ptztrack.builders.network import network_world
 from ptztrack.builders.world import build_scene
 from ptztrack.cli import main
 from ptztrack.config import ScenarioError, load_scenario, scenario_from_dict
-from ptztrack.evaluate.executors import run_cells
 from ptztrack.evaluate.metrics import episode_metrics
-from ptztrack.experiments.cells import run_cell
+from ptztrack.experiments.cells import cell_metrics
 from ptztrack.experiments.ptz_tables import synthetic_cells
 from ptztrack.files import InputError
+from ptztrack.loop.executors import execute_cells
 from ptztrack.scene.pets import DatasetError, load_mot_ground_truth
 from ptztrack.scene.trajectories import (
     MAX_GAP_S,
@@ -128,7 +129,7 @@ def test_the_synthetic_experiment_runs_on_a_file_of_frame_id_x_y(tmp_path):
     scenario = scenario_from_dict(
         {"frames": 8, "people": {"trajectories": str(path), "trajectories_frame_rate_hz": 25}}
     )
-    rows = run_cells(synthetic_cells(scenario, sequences=2, strategies=("fix", "smpl")), run_cell, "serial")
+    rows = execute_cells(synthetic_cells(scenario, sequences=2, strategies=("fix", "smpl")), cell_metrics, "serial")
     assert [row["strategy"] for row in rows] == ["fix", "fix", "smpl", "smpl"]
     assert all(row["objects"] == 4 * 8 for row in rows)
     first, second = (build_scene(scenario, np.random.default_rng(seed)).truth for seed in (0, 1))

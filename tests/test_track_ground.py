@@ -4,8 +4,9 @@ import numpy as np
 import pytest
 
 from ptztrack.track.kalman import constant_velocity_model
+from ptztrack.track.lifecycle import start_ground_tracks
 from ptztrack.track.parameters import TrackerParameters
-from ptztrack.track.tracker import predict_tracks, start_ground_tracks, update_tracks_on_ground
+from ptztrack.track.tracker import predict_tracks, update_tracks_on_ground
 from ptztrack.types import Tracks
 
 PARAMETERS = TrackerParameters(report_position_sigma_m=2.0)

@@ -7,15 +7,11 @@ from hypothesis import strategies as st
 from scipy.stats import chi2, multivariate_normal
 
 from ptztrack.track import jpdaf, kalman
+from ptztrack.track.association import gated_innovations
 from ptztrack.track.kalman import constant_velocity_model
-from ptztrack.track.tracker import (
-    gated_innovations,
-    observation_matrix,
-    predict_tracks,
-    predicted_feet_px,
-    start_tracks,
-    update_tracks,
-)
+from ptztrack.track.lifecycle import start_tracks
+from ptztrack.track.observation import observation_matrix, predicted_feet_px
+from ptztrack.track.tracker import predict_tracks, update_tracks
 from ptztrack.types import Tracks
 from test_track_tracker import (
     ACCELERATION_SIGMA_M_S2,

@@ -17,6 +17,7 @@ from ptztrack.geometry.ptz import (
 from ptztrack.scene.pets import RecordedVideo, load_mot_ground_truth
 from ptztrack.track.appearance import pixel_span, similarity, spatiogram
 from ptztrack.track.kalman import constant_velocity_model
+from ptztrack.track.lifecycle import start_tracks
 from ptztrack.track.templates import (
     MIN_SIMILARITY,
     refresh_templates,
@@ -24,7 +25,7 @@ from ptztrack.track.templates import (
     template_box_px,
     template_measurements,
 )
-from ptztrack.track.tracker import predict_tracks, start_tracks, update_tracks
+from ptztrack.track.tracker import predict_tracks, update_tracks
 from ptztrack.types import Tracks
 from test_track_tracker import ACCELERATION_SIGMA_M_S2, parameters
 

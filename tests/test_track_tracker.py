@@ -10,24 +10,14 @@ from scipy.stats import chi2
 from ptztrack.geometry.ptz import PTZCamera, apply_homography, feet_jacobian, ground_to_image, look_at
 from ptztrack.track import kalman
 from ptztrack.track.association import student_t_gate
+from ptztrack.track.evidence import birth_exposure
 from ptztrack.track.kalman import constant_velocity_model
+from ptztrack.track.lifecycle import existence_after_detection, existence_after_miss, start_ground_tracks, start_tracks
+from ptztrack.track.observation import gate_in_front, observation_matrix
 from ptztrack.track.parameters import TrackerParameters
+from ptztrack.track.pixel_noise import innovation_likelihood, student_t_noise
 from ptztrack.track.sensor_bias import PixelBias
-from ptztrack.track.tracker import (
-    EkfTracker,
-    birth_exposure,
-    existence_after_detection,
-    existence_after_miss,
-    gate_in_front,
-    innovation_likelihood,
-    observation_matrix,
-    predict_tracks,
-    start_ground_tracks,
-    start_tracks,
-    student_t_noise,
-    update_own_tracks,
-    update_tracks,
-)
+from ptztrack.track.tracker import EkfTracker, predict_tracks, update_own_tracks, update_tracks
 from ptztrack.types import Detections, Tracks
 
 CAMERA = PTZCamera((7.5, -4.0, 7.0), 640, 480, 400.0)

@@ -1,6 +1,7 @@
 """ptztrack: multi-person tracking with cameras that move.
 
-The public API is flat: ``from ptztrack import run_episode, scenario_from_dict``.
+The public API is flat: ``from ptztrack import run_episode, scenario_from_dict``. One runner per mode,
+each with one camera or many: ``run_episode`` (simulated) and ``run_live_episode`` (live cameras).
 Names are imported on first use (from the modules named relative to this package), so
 ``import ptztrack`` stays cheap.
 
@@ -51,21 +52,22 @@ _HOME = {
     "PTZCamera": ".geometry.ptz",
     "ActionGrid": ".camera.actions",
     # running
-    "World": ".loop",
-    "Episode": ".loop",
-    "run_loop": ".loop",
+    "World": ".loop.steps",
+    "Episode": ".loop.steps",
+    "NetworkWorld": ".loop.simulated",
+    "NetworkEpisode": ".loop.simulated",
     "BuiltScene": ".builders.world",
     "build_world": ".builders.world",
     "episode_world": ".builders.episode",
+    "network_world": ".builders.network",
     "run_episode": ".builders.episode",
-    "NetworkEpisode": ".network_loop",
-    "run_network_episode": ".builders.network",
+    "run_live_episode": ".builders.live",
     "network_metrics": ".evaluate.metrics",
     "Cell": ".experiments.cells",
     "synthetic_cells": ".experiments.ptz_tables",
     "recording_cells": ".experiments.ptz_tables",
-    "run_cell": ".experiments.cells",
-    "run_cells": ".evaluate.executors",
+    "cell_metrics": ".experiments.cells",
+    "execute_cells": ".loop.executors",
     "summarise": ".experiments.ptz_tables",
     "format_table": ".experiments.ptz_tables",
     "episode_metrics": ".evaluate.metrics",
@@ -77,20 +79,21 @@ __all__ = ["__version__", *_HOME, *_RENAMED]
 
 if TYPE_CHECKING:
     from .builders.episode import episode_world, run_episode
-    from .builders.network import run_network_episode
+    from .builders.live import run_live_episode
+    from .builders.network import network_world
     from .builders.recording import dataset_scenario, pets_follow_scenario, pets_scenario
     from .builders.render import render_dataset
     from .builders.world import BuiltScene, build_world
     from .camera.actions import ActionGrid
     from .config import Scenario, ScenarioError, load_dataset, load_scenario, scenario_from_dict
-    from .evaluate.executors import run_cells
     from .evaluate.metrics import episode_metrics, network_metrics
     from .evaluate.report import write_outputs
-    from .experiments.cells import Cell, run_cell
+    from .experiments.cells import Cell, cell_metrics
     from .experiments.ptz_tables import format_table, recording_cells, summarise, synthetic_cells
     from .geometry.ptz import PTZCamera
-    from .loop import Episode, World, run_loop
-    from .network_loop import NetworkEpisode
+    from .loop.executors import execute_cells
+    from .loop.simulated import NetworkEpisode, NetworkWorld
+    from .loop.steps import Episode, World
     from .registry import names as registered_names
     from .registry import register
     from .roles import CameraBackend, Detector, Policy, Tracker

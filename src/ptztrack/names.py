@@ -1,7 +1,10 @@
 """Names and defaults that the command line shows before any subsystem loads, and the subsystems use.
 
-Plain Python values only: importing this module imports nothing else.
+Plain Python values, and frozen dataclasses of them whose fields carry their one-line help
+(``metadata["help"]``): importing this module imports nothing else of ptztrack.
 """
+
+from dataclasses import dataclass, field
 
 RUN_FILES = (
     "metrics.json",
@@ -15,13 +18,70 @@ RUN_FILES = (
 )
 """The files a run writes into its ``--out`` folder (:mod:`ptztrack.evaluate.report`)."""
 VIEW_STATES_FILE = "view_states.jsonl"
-"""The web view's states of a run, beside its files (:mod:`ptztrack.evaluate.view_state`)."""
+"""The web view's states of a run, beside its files (:mod:`ptztrack.view.view_state`)."""
 STRATEGIES = ("fix", "patrol", "rnd", "intg", "smpl")
 """The PTZ paper's strategies, as its tables name them ('rnd' is the 'random' policy)."""
 POSE_SOURCES = ("oracle", "commanded", "registered")
 """Where the tracker takes the camera's pose from (:mod:`ptztrack.camera.pose_feedback`)."""
+DETECTOR_MODELS = ("a-priori", "online", "true")
+"""What the policies and the tracker may know of the detector (``detector.model``, besides a
+``detector_model.json``): its prior curve kept, learned online from the prior, or a simulation's own curve."""
+KEPT_DETECTOR_MODELS = ("a-priori", "true")
+"""The ``DETECTOR_MODELS`` whose curve is kept, not learned."""
 PROTOCOLS = ("a-priori", "two-fold")
 """How the PETS tables fix their detector's parameters (:func:`ptztrack.experiments.ptz_tables.protocol_folds`)."""
+
+
+@dataclass(frozen=True)
+class Tunable:
+    """A parameter's one-line doc, unit and bounds, as ``typing.Annotated`` metadata on a field of a
+    parameters dataclass; the configuration validates the field with them
+    (:func:`ptztrack.config.fields.tunable`).
+
+    gt, ge, lt, le : open and closed bounds; at_most : (limit, reason) a bound on a size, count or rate
+    whose error message gives the reason (memory, time, physics).
+    """
+
+    doc: str
+    unit: str = ""
+    gt: float | None = None
+    ge: float | None = None
+    lt: float | None = None
+    le: float | None = None
+    at_most: tuple[float, str] | None = None
+
+
+@dataclass(frozen=True)
+class SyntheticProtocol:
+    """The PTZ paper's synthetic tables (Tables 1-2, section 5.1), ``ptztrack experiment synthetic``."""
+
+    sequences: int = field(default=12, metadata={"help": "sequences every strategy runs on (seeds 0 .. n-1)"})
+    detector: str = field(default="realistic", metadata={"help": "the simulated or registered detector"})
+    strategies: tuple[str, ...] = field(default=STRATEGIES, metadata={"help": "the table's columns"})
+
+
+@dataclass(frozen=True)
+class PetsProtocol:
+    """The PTZ paper's realistic tables (Tables 3-4, section 5.2) on a recording, ``ptztrack experiment pets``."""
+
+    detector: str = field(
+        default="ideal",
+        metadata={
+            "help": "ideal (the annotations), hog, detections (the dataset view's own boxes) or a registered one"
+        },
+    )
+    betas: tuple[float, ...] = field(default=(9.0, 1.0), metadata={"help": "a weight of the patrolling term"})
+    strategies: tuple[str, ...] = field(default=STRATEGIES, metadata={"help": "the table's columns"})
+    protocol: str = field(
+        default="a-priori",
+        metadata={
+            "help": "a-priori: every parameter fixed before looking at the recording; two-fold: the detector's model "
+            "fitted on one half of the frames, the table scored on the other, both ways"
+        },
+    )
+    seeds: int = field(default=5, metadata={"help": "runs of a strategy whose run depends on its seed"})
+
+
 FOLLOW_TRACKERS = ("particle", "csrt", "mil")
 """The follow camera's trackers: the paper's particle filter and OpenCV's two."""
 OTB_TRACKS = 5
@@ -36,7 +96,7 @@ PLAZA_FRAMES = 200
 OCCUPANCY_MAP_METHODS = ("lpom-foreground", "pom")
 """Frames of each synthetic-plaza sequence of the occupancy experiment (20 s at PETS's 10 Hz)."""
 EXECUTORS = ("local", "ray", "serial")
-"""Where an experiment's cells run (:mod:`ptztrack.evaluate.executors`)."""
+"""Where an experiment's cells run (:mod:`ptztrack.loop.executors`)."""
 PASSWORD_VARIABLE = "PTZTRACK_CAMERA_PASSWORD"
 """The environment variable a camera's password is read from."""
 LOOPBACK = "127.0.0.1"

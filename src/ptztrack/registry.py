@@ -5,7 +5,7 @@ Four kinds: ``policies``, ``detectors``, ``cameras`` (camera backends) and
 (:mod:`ptztrack.builders`) with the validated scenario and what is built so far:
 
 * ``policies`` and ``trackers``: ``factory(scenario, world) -> Policy | Tracker``,
-  ``world`` a :class:`ptztrack.loop.World`;
+  ``world`` a :class:`ptztrack.loop.steps.World`;
 * ``detectors`` and ``cameras``: ``factory(scenario, scene) -> Detector | CameraBackend``,
   ``scene`` a :class:`ptztrack.builders.world.BuiltScene`.
 

@@ -1,6 +1,6 @@
 """The roles of the closed loop, as protocols over :mod:`ptztrack.types`.
 
-Every run is the same loop (:func:`ptztrack.loop.run_loop`): a camera backend
+Every run is the same loop (:func:`ptztrack.loop.simulated.run_loop`): a camera backend
 shows the scene at a pose, a detector finds people in it, a tracker keeps
 beliefs about them on the ground plane, and a policy chooses the next pose.
 A new backend, detector, tracker or policy implements one of these protocols
@@ -91,7 +91,7 @@ class Policy(Protocol):
 
 
 class NetworkTracker(Protocol):
-    """One ground belief that several cameras update in turn (:func:`ptztrack.network_loop.run_network_loop`)."""
+    """One ground belief that several cameras update in turn (:func:`ptztrack.loop.simulated.run_network_loop`)."""
 
     def predict(self, dt_s: float | None = None) -> Tracks:
         """Advance every track by one step, once for the whole network; returns the predicted tracks."""

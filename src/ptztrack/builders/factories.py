@@ -1,12 +1,11 @@
 """ptztrack's own implementations of the roles, by name (:mod:`ptztrack.registry` points here).
 
-Policies and trackers are made from a scenario and its :class:`~ptztrack.loop.World`;
+Policies and trackers are made from a scenario and its :class:`~ptztrack.loop.steps.World`;
 camera backends and detectors from a scenario and its :class:`~ptztrack.builders.world.BuiltScene`.
 """
 
 import math
 from functools import partial
-from typing import Literal
 
 from ptztrack.builders.parameters import parameters_from
 from ptztrack.builders.registration import live_view_model
@@ -17,15 +16,16 @@ from ptztrack.config import MAX_DATASET_FRAMES, Scenario, ScenarioError
 from ptztrack.control.baselines import FixPolicy, PatrolPolicy, RandomPolicy, patrol_route, widest_view_action
 from ptztrack.control.exploration import exploration_map
 from ptztrack.control.information_gain import expected_detection_probability
-from ptztrack.control.information_policy import InformationGainPolicy
+from ptztrack.control.information_policy import InformationGainPolicy, InformationMethod
 from ptztrack.detect.hog import GroundSearch, HogPeopleDetector
 from ptztrack.detect.published import PublishedDetections
 from ptztrack.detect.simulated import AnnotationDetector, RecallCurve, RecallDetector, RecallModel
-from ptztrack.loop import World
+from ptztrack.loop.steps import World
 from ptztrack.occupancy.multiview import load_mot_detections
 from ptztrack.track.parameters import TrackerParameters
+from ptztrack.track.pixel_noise import pixel_noise_covariance
 from ptztrack.track.templates import TemplateTracker
-from ptztrack.track.tracker import DetectionModel, EkfTracker, pixel_noise_covariance
+from ptztrack.track.tracker import DetectionModel, EkfTracker
 
 
 def expected_model(scenario: Scenario, world: World) -> RecallCurve:
@@ -81,7 +81,7 @@ def random_policy(scenario: Scenario, world: World) -> RandomPolicy:
     return RandomPolicy()
 
 
-def information_policy(scenario: Scenario, world: World, method: Literal["intg", "smpl"]) -> InformationGainPolicy:
+def information_policy(scenario: Scenario, world: World, method: InformationMethod) -> InformationGainPolicy:
     """The information-gain policy ``method`` ('intg' or 'smpl') of the camera of ``world``."""
     control, recall = scenario.control, planning_model(scenario, world)
     exploration = None

@@ -14,23 +14,23 @@ from ptztrack.builders.recording import recorded_size_px
 from ptztrack.camera.recorded import RecordedPTZ
 from ptztrack.camera.virtual import virtual_ptz
 from ptztrack.config import Actions, Scenario, ScenarioError
-from ptztrack.follow.controller import FollowParameters, FollowPolicy, framing_pose
-from ptztrack.follow.parameters import FollowSettings
+from ptztrack.follow.controller import FollowPolicy, FramingParameters, framing_pose
+from ptztrack.follow.parameters import FollowParameters
 from ptztrack.follow.particle_filter import particle_filter_parameters, smoothing_pole
 from ptztrack.follow.target import OpenCVSource, ParticleSource, TargetSource, TargetTracker, opencv_tracker_factory
 from ptztrack.geometry.calibration import load_calibration
 from ptztrack.geometry.ptz import PTZCamera, aim_at
-from ptztrack.loop import World
+from ptztrack.loop.steps import World
 from ptztrack.names import FOLLOW_TRACKERS
 from ptztrack.scene.pets import load_mot_ground_truth
 
 
-def follow_settings(scenario: Scenario) -> FollowSettings:
+def follow_parameters(scenario: Scenario) -> FollowParameters:
     """The scenario's follow section as the follow camera's parameters."""
-    return parameters_from(scenario.follow, FollowSettings)
+    return parameters_from(scenario.follow, FollowParameters)
 
 
-def follow_parameters(scenario: Scenario, camera: PTZCamera) -> FollowParameters:
+def framing_parameters(scenario: Scenario, camera: PTZCamera) -> FramingParameters:
     follow = scenario.follow
     target_point_px = follow.target_point_px or (camera.image_width_px / 2, camera.image_height_px / 2)
     if not (0 <= target_point_px[0] <= camera.image_width_px and 0 <= target_point_px[1] <= camera.image_height_px):
@@ -38,22 +38,17 @@ def follow_parameters(scenario: Scenario, camera: PTZCamera) -> FollowParameters
             f"follow.target_point_px: {list(target_point_px)} lies outside the "
             f"{camera.image_width_px} x {camera.image_height_px} image"
         )
-    return FollowParameters(
+    return FramingParameters(
+        follow=follow_parameters(scenario),
         target_point_px=np.asarray(target_point_px, dtype=float),
-        target_height_px=follow.target_height_px,
         person_height_m=scenario.control.person_height_m,
         person_width_m=scenario.people.width_m,
-        max_speed_deg_s=follow.max_speed_deg_s,
-        max_acceleration_deg_s2=follow.max_acceleration_deg_s2,
-        max_zoom_speed=follow.max_zoom_speed,
-        max_zoom_acceleration=follow.max_zoom_acceleration,
-        zoom_range=follow.zoom_range,
         step_s=1.0 / scenario.frame_rate_hz,
     )
 
 
 def follow_policy(scenario: Scenario, world: World) -> FollowPolicy:
-    return FollowPolicy(world.camera, follow_parameters(scenario, world.camera))
+    return FollowPolicy(world.camera, framing_parameters(scenario, world.camera))
 
 
 def initial_box(scenario: Scenario, world: World) -> tuple[np.ndarray, np.ndarray]:
@@ -86,7 +81,7 @@ def initial_box(scenario: Scenario, world: World) -> tuple[np.ndarray, np.ndarra
 def target_source(scenario: Scenario, tracker: str, rng: np.random.Generator) -> TargetSource:
     """The source of a follow tracker by name: 'particle' (drawing from ``rng``), 'csrt' or 'mil'."""
     if tracker == "particle":
-        return ParticleSource(particle_filter_parameters(follow_settings(scenario), scenario.frame_rate_hz), rng)
+        return ParticleSource(particle_filter_parameters(follow_parameters(scenario), scenario.frame_rate_hz), rng)
     if tracker in ("csrt", "mil"):
         return OpenCVSource(opencv_tracker_factory(tracker))
     raise ScenarioError(f"no follow tracker {tracker!r}; expected one of {', '.join(FOLLOW_TRACKERS)}")
@@ -155,7 +150,7 @@ def target_scenario(scenario: Scenario, target_id: int) -> Scenario:
         scenario.camera.image_size_px,
     )
     position_m = annotations.ground_m[rows[0]]
-    parameters = follow_parameters(scenario, virtual.camera)
+    parameters = framing_parameters(scenario, virtual.camera)
     middle_m = np.r_[position_m, parameters.person_height_m / 2]
     centred = aim_at(virtual.camera, middle_m, virtual.camera.principal_point_px, 1.0)
     start = framing_pose(virtual.camera, position_m, centred, parameters) - [*whole_frame_pose[:2], 0.0]

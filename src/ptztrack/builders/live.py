@@ -13,7 +13,7 @@ import threading
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
-from typing import TYPE_CHECKING, Literal
+from typing import TYPE_CHECKING, cast, get_args
 
 import cv2
 import numpy as np
@@ -28,16 +28,19 @@ from ptztrack.camera.pose_timeline import PoseTimeline
 from ptztrack.camera.recorded import RecordedPTZ
 from ptztrack.camera.stream import thumbnail
 from ptztrack.config import VIRTUAL_CAMERA_CALIBRATION, CameraCalibrationFile, Scenario
-from ptztrack.control.network_policy import NetworkInformationPolicy
-from ptztrack.evaluate.video import RenderView
-from ptztrack.live import LiveEpisode, PlanAhead, run_live, run_live_network, warm_up
-from ptztrack.loop import Episode, StepObserver, World, episode_seeds
-from ptztrack.roles import Policy
+from ptztrack.control.information_policy import InformationMethod
+from ptztrack.loop.alone import AlonePolicy, AloneTracker
+from ptztrack.loop.live import LiveEpisode, PlanAhead, run_live_network, warm_up
+from ptztrack.loop.steps import Episode, StepObserver, World
+from ptztrack.loop.streams import episode_streams
+from ptztrack.network.policy import NetworkInformationPolicy
+from ptztrack.roles import NetworkPolicy, NetworkTracker, Policy
 from ptztrack.track.tracker import tracks_ahead
 from ptztrack.types import GroundTruth
+from ptztrack.view.video import RenderView
 
 if TYPE_CHECKING:
-    from ptztrack.camera.onvif_server import VirtualONVIFCamera
+    from ptztrack.virtual_onvif.server import VirtualONVIFCamera
 
 
 def camera_spaces(calibration: CameraCalibrationFile) -> CameraSpaces:
@@ -138,7 +141,7 @@ def live_as_episode(world: World, live: LiveEpisode, truth_log=None) -> Episode:
 
 
 def live_pictures(live: LiveEpisode) -> RenderView:
-    """``render_view`` for a live run's video (:mod:`ptztrack.evaluate.video`): the picture each step
+    """``render_view`` for a live run's video (:mod:`ptztrack.view.video`): the picture each step
     used, as the run kept it (``keep_images``)."""
 
     def render(step: int, pose) -> np.ndarray:
@@ -189,7 +192,7 @@ def virtual_onvif_camera(
     """The virtual ONVIF camera over ``scenario``'s recording (not started) and the feed that logs its
     truth (``feed``, to go on with one)."""
     try:  # the server is ipycam's, installed apart (it must not bring opencv-python): only here is it needed
-        from ptztrack.camera.onvif_server import VirtualONVIFCamera
+        from ptztrack.virtual_onvif.server import VirtualONVIFCamera
     except ImportError:
         raise RuntimeError(
             "the virtual ONVIF camera needs ipycam: pip install --no-deps ipycam==1.3.0 (docs: Real cameras)"
@@ -246,7 +249,7 @@ def live_world(
         camera = replace(camera, position_m=calibration.position_m)
     if calibration.f_min_px is not None:
         camera = replace(camera, f_min_px=calibration.f_min_px)
-    model_seed = episode_seeds(seed)[5] if model_seed is None else model_seed
+    model_seed = episode_streams(seed).detector_model if model_seed is None else model_seed
     return replace(world, camera=camera, detector_model=detector_model(scenario, camera, model_seed))
 
 
@@ -288,46 +291,9 @@ def _live_camera(
 
 def run_live_episode(
     scenario: Scenario,
-    calibration: CameraCalibrationFile,
-    address: CameraAddress,
-    policy: str,
-    steps: int,
-    time_scale: float,
-    seed: int,
-    timeout_s: float = 5.0,
-    observe: Callable[[World, Policy], StepObserver | None] | None = None,
-    transport: str = "tcp",
-    keep_images: bool = False,
-) -> tuple[World, LiveEpisode]:
-    """Connect to the camera at ``address`` (a :class:`CameraError` if it cannot be used) and run
-    ``policy`` on ``steps`` of its pictures, the recording's time passing ``time_scale`` times as fast
-    as the wall clock's; the camera is released at the end (Ctrl-C included).
-
-    observe : ``observe(world, policy)`` gives the run's step observer (a live view, say).
-    transport : the RTSP stream over 'tcp' or 'udp'; keep_images : keep the pictures used (for a video).
-    """
-    world = live_world(scenario, calibration, seed)
-    live_policy = make_policy(policy, scenario, world)
-    tracker = make_tracker(None, scenario, world)
-    warm_up(world, live_policy, tracker)
-    camera = _live_camera(address, calibration, timeout_s, transport)
-    try:
-        camera.start()
-        observer = None if observe is None else observe(world, live_policy)
-        live = run_live(
-            world, live_policy, tracker, camera, steps, time_scale, seed, observer, keep_images,
-            plan_ahead_of(scenario),
-        )  # fmt: skip
-    finally:
-        camera.close()
-    return world, live
-
-
-def run_live_network_episode(
-    scenario: Scenario,
     calibrations: Sequence[CameraCalibrationFile],
     addresses: Sequence[CameraAddress],
-    method: Literal["intg", "smpl"],
+    policy: str,
     steps: int,
     time_scale: float,
     seed: int,
@@ -335,41 +301,59 @@ def run_live_network_episode(
     timeout_s: float = 5.0,
     transport: str = "tcp",
     keep_images: bool = False,
-    observe: Callable[[list[World], NetworkInformationPolicy], StepObserver | None] | None = None,
+    observe: Callable[[list[World], Policy | NetworkInformationPolicy], StepObserver | None] | None = None,
 ) -> tuple[list[World], tuple[LiveEpisode, ...]]:
-    """Connect to the cameras at ``addresses`` (each with its calibration of ``calibrations``, in the same
-    order; a :class:`CameraError` if one cannot be used) and run them on ``steps`` of their pictures in
-    all with one ground belief (:func:`ptztrack.live.run_live_network`): each camera's information-gain
-    policy ``method`` with its calibrated move times, deciding ``coordination`` (the network's policy,
-    :func:`ptztrack.builders.network.policy_of_cameras`), and each camera's EKF tracker updating the one
-    belief in turn (:func:`ptztrack.builders.network.belief_of_cameras`). The cameras are released at the
-    end (Ctrl-C included).
+    """Connect to the cameras at ``addresses``, one or many (each with its calibration of ``calibrations``,
+    in the same order; a :class:`CameraError` if one cannot be used), and run them on ``steps`` of their
+    pictures in all with one ground belief (:func:`ptztrack.loop.live.run_live_network`), the recording's
+    time passing ``time_scale`` times as fast as the wall clock's. The cameras are released at the end
+    (Ctrl-C included).
 
-    observe : ``observe(worlds, policy)`` gives the run's step observer (a live view, say).
+    One camera runs ``policy`` (any registered name) with the scenario's tracker, as the network of it
+    alone. Several run each camera's information-gain policy ``policy`` ('intg' or 'smpl') with its
+    calibrated move times, deciding ``coordination`` (the network's policy,
+    :func:`ptztrack.builders.network.policy_of_cameras`), each camera's EKF tracker updating the one belief
+    in turn (:func:`ptztrack.builders.network.belief_of_cameras`).
+
+    observe : ``observe(worlds, policy)`` gives the run's step observer (a live view, say); ``policy`` is
+    the camera's own for one camera, the network's for several.
+    transport : the RTSP stream over 'tcp' or 'udp'; keep_images : keep the pictures used (for a video).
     Returns every camera's world and its :class:`LiveEpisode` (each step's tracks are the belief's).
     """
     if len(calibrations) != len(addresses) or not addresses:
         raise ValueError(f"{len(addresses)} camera addresses with {len(calibrations)} calibrations")
     # The first camera's detector model draws from the one-camera run's stream, every other from its own.
-    model_seed = episode_seeds(seed)[5]
+    model_seed = episode_streams(seed).detector_model
     model_seeds = [model_seed, *model_seed.spawn(len(addresses) - 1)]
     worlds = [
         live_world(scenario, calibration, seed, camera_seed)
         for calibration, camera_seed in zip(calibrations, model_seeds, strict=True)
     ]
-    policy = policy_of_cameras([(scenario, world, False) for world in worlds], coordination, method)
-    tracker = belief_of_cameras([(scenario, world) for world in worlds])
-    for world, member, updater in zip(worlds, policy.cameras, tracker.cameras, strict=True):
-        warm_up(world, member.policy, updater)
+    shown: Policy | NetworkInformationPolicy
+    if len(worlds) == 1:
+        shown = make_policy(policy, scenario, worlds[0])
+        alone = make_tracker(None, scenario, worlds[0])
+        warm_up(worlds[0], shown, alone)
+        network_policy: NetworkPolicy = AlonePolicy(shown)
+        tracker: NetworkTracker = AloneTracker(alone)
+    elif isinstance(policy, str) and policy in get_args(InformationMethod):
+        method = cast(InformationMethod, policy)
+        shown = policy_of_cameras([(scenario, world, False) for world in worlds], coordination, method)
+        belief = belief_of_cameras([(scenario, world) for world in worlds])
+        for world, member, updater in zip(worlds, shown.cameras, belief.cameras, strict=True):
+            warm_up(world, member.policy, updater)
+        network_policy, tracker = shown, belief
+    else:
+        raise ValueError(f"a network of cameras decides by intg or smpl, not {policy}")
     cameras: list[LiveONVIFCamera] = []
     try:
         # Each camera starts as soon as it is connected, so that one that cannot be is closed with the others.
         for address, calibration in zip(addresses, calibrations, strict=True):
             cameras.append(_live_camera(address, calibration, timeout_s, transport))
             cameras[-1].start()
-        observer = None if observe is None else observe(worlds, policy)
+        observer = None if observe is None else observe(worlds, shown)
         live = run_live_network(
-            worlds, policy, tracker, cameras, steps, time_scale, seed, observer, keep_images,
+            worlds, network_policy, tracker, cameras, steps, time_scale, seed, observer, keep_images,
             plan_ahead_of(scenario),
         )  # fmt: skip
     finally:

@@ -1,5 +1,5 @@
-"""A camera network's episode: the scenario's ``cameras`` built into worlds, a joint or independent
-network policy and one shared belief, run by :func:`ptztrack.network_loop.run_network_loop`.
+"""A camera network's parts: the scenario's ``cameras`` built into worlds, a joint or independent network
+policy and one shared belief, which :func:`ptztrack.builders.episode.run_episode` runs.
 
 Each camera is built as the one camera of a scenario of its own (:func:`camera_scenario`): its
 mount, lens and detector, and the action grid turned to face the area. The people are drawn once,
@@ -10,7 +10,6 @@ camera's from a stream spawned after it.
 
 from collections.abc import Sequence
 from dataclasses import replace
-from functools import partial
 from typing import Literal
 
 import numpy as np
@@ -18,12 +17,13 @@ import numpy as np
 from ptztrack.builders.factories import ekf_tracker, information_policy
 from ptztrack.builders.world import BuiltScene, action_grid, build_scene, camera_world, ptz_camera
 from ptztrack.config import AxisRange, MountedCamera, Scenario, ScenarioError
-from ptztrack.control.network_policy import NetworkCamera, NetworkInformationPolicy
-from ptztrack.evaluate.camera_actors import RayCameras
+from ptztrack.control.information_policy import InformationMethod
 from ptztrack.geometry.ptz import look_at
-from ptztrack.loop import World, episode_seeds
-from ptztrack.network_loop import NetworkEpisode, NetworkWorld, run_network_loop
-from ptztrack.track.shared_belief import SharedBelief
+from ptztrack.loop.simulated import NetworkWorld
+from ptztrack.loop.steps import World
+from ptztrack.loop.streams import episode_streams
+from ptztrack.network.policy import NetworkCamera, NetworkInformationPolicy
+from ptztrack.network.shared_belief import SharedBelief
 from ptztrack.track.tracker import EkfTracker
 
 Coordination = Literal["joint", "independent"]
@@ -54,10 +54,10 @@ def network_world(scenario: Scenario, seed: int) -> NetworkWorld:
     """Every camera's world for the episode of ``seed``: the same people, seen by each camera."""
     if not scenario.cameras:
         raise ScenarioError("a camera network needs the scenario's cameras (cameras: a list of at least one)")
-    streams = episode_seeds(seed)
+    streams = episode_streams(seed)
     views = [camera_scenario(scenario, mounted) for mounted in scenario.cameras]
-    first = build_scene(views[0], np.random.default_rng(streams[0]))
-    model_seeds = [streams[5], *streams[5].spawn(len(views) - 1)]
+    first = build_scene(views[0], np.random.default_rng(streams.scene))
+    model_seeds = [streams.detector_model, *streams.detector_model.spawn(len(views) - 1)]
     worlds = []
     for view, model_seed in zip(views, model_seeds, strict=True):
         scene: BuiltScene = replace(first, camera=ptz_camera(view), grid=action_grid(view))
@@ -66,7 +66,7 @@ def network_world(scenario: Scenario, seed: int) -> NetworkWorld:
 
 
 def network_policy(
-    scenario: Scenario, world: NetworkWorld, coordination: Coordination, method: Literal["intg", "smpl"]
+    scenario: Scenario, world: NetworkWorld, coordination: Coordination, method: InformationMethod
 ) -> NetworkInformationPolicy:
     """The network's policy: each PTZ camera's own information-gain policy ``method``, deciding
     ``coordination`` ('joint' or 'independent'); each fixed camera at its widest view of the area."""
@@ -78,7 +78,7 @@ def network_policy(
 
 
 def policy_of_cameras(
-    members: Sequence[tuple[Scenario, World, bool]], coordination: Coordination, method: Literal["intg", "smpl"]
+    members: Sequence[tuple[Scenario, World, bool]], coordination: Coordination, method: InformationMethod
 ) -> NetworkInformationPolicy:
     """The network policy of cameras given as (the scenario the camera alone runs, its world, whether it
     is fixed): each camera's information-gain policy ``method`` (a fixed camera's scores its one view,
@@ -109,26 +109,3 @@ def belief_of_cameras(members: Sequence[tuple[Scenario, World]]) -> SharedBelief
         assert isinstance(tracker, EkfTracker)
         trackers.append(tracker)
     return SharedBelief(tuple(trackers))
-
-
-def run_network_episode(
-    scenario: Scenario,
-    seed: int,
-    coordination: Coordination = "joint",
-    method: Literal["intg", "smpl"] = "intg",
-    cameras_on: Literal["serial", "ray"] = "serial",
-    cameras_per_actor: int = 1,
-) -> NetworkEpisode:
-    """One closed-loop episode of the scenario's camera network (see the module's docstring).
-
-    cameras_on : where the cameras capture and detect: 'serial' in this process, 'ray' as actors on a Ray
-    cluster (:class:`~ptztrack.evaluate.camera_actors.RayCameras`, ``cameras_per_actor`` cameras to an
-    actor); the episode is the same.
-    """
-    world = network_world(scenario, seed)
-    policy = network_policy(scenario, world, coordination, method)
-    tracker = network_tracker(scenario, world)
-    if cameras_on == "ray":
-        fleet = partial(RayCameras, cameras_per_actor=cameras_per_actor)
-        return run_network_loop(world, policy, tracker, seed, fleet)
-    return run_network_loop(world, policy, tracker, seed)

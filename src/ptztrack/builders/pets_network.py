@@ -26,12 +26,11 @@ freedom, which gates a far detection and lets it move its track less; a detectio
 track starts no track (``TrackerParameters.birth`` 'outside_gates'); what part of the error is
 common to a view's detections, its bias, is estimated as the run goes and taken off them
 (:mod:`ptztrack.track.sensor_bias`); and a track that only one fixed camera has detected is not reported
-until another camera detects it too (:attr:`~ptztrack.track.shared_belief.SharedBelief.needs_a_second_camera`).
+until another camera detects it too (:attr:`~ptztrack.network.shared_belief.SharedBelief.needs_a_second_camera`).
 """
 
 from collections.abc import Sequence
 from dataclasses import replace
-from typing import Literal
 
 import numpy as np
 
@@ -39,19 +38,21 @@ from ptztrack.builders.network import Coordination, belief_of_cameras, policy_of
 from ptztrack.builders.occupancy import recording_from_dataset
 from ptztrack.builders.world import BuiltScene, build_scene, camera_world, detector_model
 from ptztrack.camera.actions import ActionGrid
-from ptztrack.camera.parameters import LandingError
+from ptztrack.camera.parameters import LandingErrorParameters
 from ptztrack.camera.pose_feedback import commanded_pose
 from ptztrack.camera.virtual import virtual_ptz
 from ptztrack.config import Scenario, ScenarioError, dataset_from_dict, load_dataset
-from ptztrack.control.network_policy import NetworkInformationPolicy
+from ptztrack.control.information_policy import InformationMethod
 from ptztrack.detect.published import PublishedDetections
 from ptztrack.detect.simulated import RecallModel
-from ptztrack.loop import World, episode_seeds
-from ptztrack.network_loop import NetworkEpisode, NetworkWorld, run_network_loop
+from ptztrack.loop.simulated import NetworkWorld
+from ptztrack.loop.steps import World
+from ptztrack.loop.streams import episode_streams
+from ptztrack.network.policy import NetworkInformationPolicy
+from ptztrack.network.shared_belief import SharedBelief
 from ptztrack.occupancy.multiview import CameraView
 from ptztrack.occupancy.parameters import OccupancyParameters
 from ptztrack.track.sensor_bias import PixelBias
-from ptztrack.track.shared_belief import SharedBelief
 
 PUBLISHED_RECALL = 0.9
 """The fixed cameras' detector model: the probability that the published detector finds a person wholly
@@ -115,7 +116,7 @@ def published_camera_world(
         area_polygon_m=scene.area_polygon_m,
         start_action=0,
         pose_source=commanded_pose,
-        landing_error=LandingError(),
+        landing_error=LandingErrorParameters(),
         detector_model=detector_model(scenario, virtual.camera, model_seed, own=RecallModel.constant(PUBLISHED_RECALL)),
     )
 
@@ -126,12 +127,12 @@ def pets_network_world(scenario: Scenario, seed: int, ptz: bool, views: Sequence
     from the PTZ camera's model's (which spawning leaves as it was)."""
     if not ptz and not views:
         raise ScenarioError("a PETS camera network needs the PTZ camera or a published view")
-    streams = episode_seeds(seed)
-    scene = build_scene(scenario, np.random.default_rng(streams[0]))
+    streams = episode_streams(seed)
+    scene = build_scene(scenario, np.random.default_rng(streams.scene))
     worlds = []
     if ptz:
-        worlds.append(camera_world(scenario, scene, tracker_seed=streams[4], model_seed=streams[5]))
-    model_seeds = streams[5].spawn(len(views))
+        worlds.append(camera_world(scenario, scene, tracker_seed=streams.tracker, model_seed=streams.detector_model))
+    model_seeds = streams.detector_model.spawn(len(views))
     assert scene.recording is not None  # published_views asked for the recording
     worlds += [
         published_camera_world(scenario, scene, view, scene.recording.video_frame, seed)
@@ -140,29 +141,12 @@ def pets_network_world(scenario: Scenario, seed: int, ptz: bool, views: Sequence
     return NetworkWorld(tuple(worlds))
 
 
-def run_pets_network_episode(
-    scenario: Scenario,
-    seed: int,
-    ptz: bool,
-    views: Sequence[CameraView],
-    coordination: Coordination = "joint",
-    method: Literal["intg", "smpl"] = "intg",
-) -> NetworkEpisode:
-    """One closed-loop episode of the PETS network (:func:`pets_network_world`): the PTZ camera's
-    information-gain policy ``method`` deciding ``coordination`` with the fixed views' expected
-    information, one belief updated by every camera in turn (the fixed cameras' trackers as the module's
-    docstring says; the PTZ camera's the one-camera run's)."""
-    world = pets_network_world(scenario, seed, ptz, views)
-    policy, tracker = published_network_parts(scenario, world, ptz, coordination, method)
-    return run_network_loop(world, policy, tracker, seed)
-
-
 def published_network_parts(
     scenario: Scenario,
     world: NetworkWorld,
     ptz: bool,
     coordination: Coordination = "joint",
-    method: Literal["intg", "smpl"] = "intg",
+    method: InformationMethod = "intg",
 ) -> tuple[NetworkInformationPolicy, SharedBelief]:
     """The policy and the one belief of a network whose first camera is the PTZ camera (with ``ptz``)
     and whose other cameras are fixed cameras of published boxes: every camera's information-gain

@@ -37,6 +37,7 @@ from ptztrack.config import (
 )
 from ptztrack.control.parameters import ControlParameters
 from ptztrack.geometry.calibration import load_tsai
+from ptztrack.names import PetsProtocol
 from ptztrack.scene.pets import RecordedVideo, load_mot_ground_truth, refuse_rows_beyond
 
 log = logging.getLogger(__name__)
@@ -58,7 +59,7 @@ TABLES_PROTOCOL: dict = {
     # People come and go in a recording (section 5.2): the patrolling term looks for them.
     "control": {"beta": 1.0},
     # The annotated people the camera sees whole (Table 3); hog and detections read the pictures or boxes.
-    "detector": {"kind": "ideal"},
+    "detector": {"kind": PetsProtocol.detector},
 }
 """The PTZ paper's realistic experiment (section 5.2), the same on every recording: steps at 5 Hz, the
 paper's 160-pixel-wide "zoom 1" view of the whole recorded frame, its 7 x 5 pan and tilt grid (offsets

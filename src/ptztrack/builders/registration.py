@@ -7,7 +7,7 @@ import numpy as np
 from ptztrack.builders.parameters import parameters_from
 from ptztrack.builders.recording import recorded_size_px
 from ptztrack.camera.live_view import k1_at_zoom
-from ptztrack.camera.parameters import LiveViewModel
+from ptztrack.camera.parameters import LiveViewParameters
 from ptztrack.camera.pose_feedback import RegisteredPose, build_reference_index, cached_reference_index, reference_poses
 from ptztrack.camera.virtual import VirtualPTZ, virtual_ptz
 from ptztrack.config import Scenario, ScenarioError
@@ -45,14 +45,16 @@ def registration_camera(
     )
 
 
-def live_view_model(scenario: Scenario, calibration: PinholeCalibration | None = None) -> LiveViewModel | None:
+def live_view_model(scenario: Scenario, calibration: PinholeCalibration | None = None) -> LiveViewParameters | None:
     """The scenario's ``camera.live_view`` as the camera layer's model; None for exact pinhole views.
     Its principal point offset is in pixels of the registered image. calibration : the recording's,
     when the caller has read it already."""
     live_view = scenario.camera.live_view
     if live_view is None:
         return None
-    model = parameters_from(live_view, LiveViewModel, offset_image_width_px=scenario.pose_feedback.image_size_px[0])
+    model = parameters_from(
+        live_view, LiveViewParameters, offset_image_width_px=scenario.pose_feedback.image_size_px[0]
+    )
     camera = registration_camera(scenario, calibration)[0].camera
     for zoom in np.linspace(1.0, max(max(scenario.actions.zoom), model.tele_zoom), 50):
         if not distortion_invertible(k1_at_zoom(model, zoom), corner_radius2(camera, zoom)):

@@ -29,15 +29,15 @@ import yaml
 
 from ptztrack.builders.world import build_scene
 from ptztrack.config import Scenario, ScenarioError, pets_dataset
-from ptztrack.evaluate.video import write_video
 from ptztrack.files import run_folder, write_atomically, write_json
 from ptztrack.geometry.calibration import PinholeCalibration, aimed_pinhole, pinhole_document
-from ptztrack.loop import episode_seeds
+from ptztrack.loop.streams import episode_streams
 from ptztrack.names import PEOPLE_LOOKS
 from ptztrack.scene.cutouts import CutoutTrack, cut_people
 from ptztrack.scene.pets import RecordedVideo, load_mot_ground_truth
 from ptztrack.scene.render import SceneRenderer, person_boxes, stage_around
 from ptztrack.types import GroundTruth
+from ptztrack.view.video import write_video
 
 DATASET_FILE = "dataset.yaml"
 CALIBRATION_FILE = "calibration.json"
@@ -81,7 +81,7 @@ def rendered_truth(scenario: Scenario, seed: int) -> GroundTruth:
     leaves unknown (NaN) is the middle of ``people.height_m``, or ``people.width_m``."""
     if scenario.recording is not None:
         raise ScenarioError("render: the scenario has a recording; render takes a scenario without one (recording)")
-    truth = build_scene(scenario, np.random.default_rng(episode_seeds(seed)[0])).truth
+    truth = build_scene(scenario, np.random.default_rng(episode_streams(seed).scene)).truth
     heights_m = np.where(np.isnan(truth.heights_m), np.mean(scenario.people.height_m), truth.heights_m)
     widths_m = np.where(np.isnan(truth.widths_m), scenario.people.width_m, truth.widths_m)
     return replace(truth, heights_m=heights_m, widths_m=widths_m)

@@ -1,4 +1,5 @@
-"""The scene, the camera backend, the detector and the pose source of a scenario: its :class:`~ptztrack.loop.World`."""
+"""The scene, the camera backend, the detector and the pose source of a scenario: its
+:class:`~ptztrack.loop.steps.World`."""
 
 import logging
 from collections.abc import Callable
@@ -12,7 +13,7 @@ from ptztrack.builders.parameters import parameters_from
 from ptztrack.builders.recording import recorded_size_px
 from ptztrack.builders.registration import registered_pose_source
 from ptztrack.camera.actions import ActionGrid
-from ptztrack.camera.parameters import LandingError
+from ptztrack.camera.parameters import LandingErrorParameters
 from ptztrack.camera.pose_feedback import commanded_pose, true_pose
 from ptztrack.camera.virtual import VirtualPTZ, virtual_ptz
 from ptztrack.config import Scenario, ScenarioError
@@ -22,9 +23,10 @@ from ptztrack.detect.simulated import RecallModel
 from ptztrack.geometry.area import rectangle_m
 from ptztrack.geometry.calibration import PinholeCalibration, load_calibration
 from ptztrack.geometry.ptz import PTZCamera, ground_footprint
-from ptztrack.loop import World
+from ptztrack.loop.steps import World
+from ptztrack.names import DETECTOR_MODELS, KEPT_DETECTOR_MODELS
 from ptztrack.roles import CameraBackend, Detector, PoseSource
-from ptztrack.scene.parameters import Crowd
+from ptztrack.scene.parameters import CrowdParameters
 from ptztrack.scene.pets import (
     RecordedScene,
     RecordedVideo,
@@ -89,8 +91,8 @@ def action_grid(scenario: Scenario) -> ActionGrid:
     )
 
 
-def crowd(scenario: Scenario) -> Crowd:
-    return parameters_from(scenario.people, Crowd)
+def crowd(scenario: Scenario) -> CrowdParameters:
+    return parameters_from(scenario.people, CrowdParameters)
 
 
 def build_scene(scenario: Scenario, scene_rng: np.random.Generator) -> BuiltScene:
@@ -203,8 +205,8 @@ def pose_source(scenario: Scenario, scene: BuiltScene) -> PoseSource:
     return {"commanded": commanded_pose, "oracle": true_pose}[source]
 
 
-def landing_error(scenario: Scenario) -> LandingError:
-    return parameters_from(scenario.camera.pose_error, LandingError)
+def landing_error(scenario: Scenario) -> LandingErrorParameters:
+    return parameters_from(scenario.camera.pose_error, LandingErrorParameters)
 
 
 def recall_model(scenario: Scenario) -> RecallModel:
@@ -226,8 +228,8 @@ def detector_model(
     people = (camera, scenario.control.person_height_m, scenario.people.width_m)
     rng = np.random.default_rng(seed if seed is not None else 0)
     if own is not None:
-        prior, learning = own, detector.model not in ("a-priori", "true")
-    elif detector.model not in ("online", "a-priori", "true"):
+        prior, learning = own, detector.model not in KEPT_DETECTOR_MODELS
+    elif detector.model not in DETECTOR_MODELS:
         return OnlineDetectorModel(*people, **read_detector_model_file(detector.model), rng=rng)
     else:
         prior, learning = recall_model(scenario), False

@@ -28,7 +28,7 @@ from ptztrack.camera.onvif_spaces import CameraSpaces
 from ptztrack.camera.pose_timeline import PoseTimeline
 from ptztrack.camera.stream import FrameStream, rtsp_pictures
 
-log = logging.getLogger("ptztrack.live")
+log = logging.getLogger("ptztrack.loop.live")
 
 FIRST_RETRY_S = 0.5
 LONGEST_RETRY_S = 8.0

@@ -6,7 +6,7 @@ must survive (the scale-invariant tracking paper registers such views):
 each view is rolled about its optical axis, its principal point is off the
 image centre, its lens distorts radially by an amount that changes with
 zoom, the light and the exposure differ from those of the reference views,
-and the camera compresses its images. :class:`LiveViewModel` holds the
+and the camera compresses its images. :class:`LiveViewParameters` holds the
 ranges; :func:`view_conditions` draws one view's values and
 :func:`render_live` renders the view with them.
 
@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from ptztrack.camera.parameters import LiveViewModel
+from ptztrack.camera.parameters import LiveViewParameters
 from ptztrack.camera.virtual import VirtualPTZ, resample
 from ptztrack.geometry.lens import Lens, pixel_directions, project_directions
 
@@ -37,13 +37,13 @@ class ViewConditions:
     brightness: float
 
 
-def k1_at_zoom(model: LiveViewModel, zoom: float) -> float:
+def k1_at_zoom(model: LiveViewParameters, zoom: float) -> float:
     """The radial distortion of a view at ``zoom``: k1_wide at zoom 1, linear to k1_tele at tele_zoom."""
     fraction = np.clip((zoom - 1.0) / (model.tele_zoom - 1.0), 0.0, 1.0)
     return float(model.k1_wide + fraction * (model.k1_tele - model.k1_wide))
 
 
-def view_conditions(model: LiveViewModel, pose) -> ViewConditions:
+def view_conditions(model: LiveViewParameters, pose) -> ViewConditions:
     """The values of the view at ``pose`` (pan_deg, tilt_deg, zoom): drawn from a generator seeded
     by the model's seed and the pose's bits, so that the same pose always gets the same values."""
     pose = np.asarray(pose, dtype=float)
@@ -58,19 +58,19 @@ def view_conditions(model: LiveViewModel, pose) -> ViewConditions:
     return ViewConditions(Lens(float(roll_deg), offset_px, k1_at_zoom(model, pose[2])), float(gain), float(brightness))
 
 
-def view_lens(model: LiveViewModel, virtual: VirtualPTZ, pose) -> Lens:
+def view_lens(model: LiveViewParameters, virtual: VirtualPTZ, pose) -> Lens:
     """The lens of the view at ``pose`` in ``virtual``'s pixels (its principal point offset scaled
     to the virtual camera's image width)."""
     return _in_pixels_of(virtual, model, view_conditions(model, pose).lens)
 
 
-def _in_pixels_of(virtual: VirtualPTZ, model: LiveViewModel, lens: Lens) -> Lens:
+def _in_pixels_of(virtual: VirtualPTZ, model: LiveViewParameters, lens: Lens) -> Lens:
     scale = virtual.camera.image_width_px / model.offset_image_width_px
     offset_px = (lens.principal_offset_px[0] * scale, lens.principal_offset_px[1] * scale)
     return Lens(lens.roll_deg, offset_px, lens.k1)
 
 
-def render_live(virtual: VirtualPTZ, frame, pose, model: LiveViewModel) -> np.ndarray:
+def render_live(virtual: VirtualPTZ, frame, pose, model: LiveViewParameters) -> np.ndarray:
     """The live view (h, w, 3) uint8 BGR of a recorded frame at ``pose``: each pixel reads the
     recording along its ray through the view's lens; then the view's gain and brightness, then JPEG
     compression (``cv2.imencode`` and ``cv2.imdecode``)."""
@@ -84,13 +84,13 @@ def render_live(virtual: VirtualPTZ, frame, pose, model: LiveViewModel) -> np.nd
     return np.asarray(cv2.imdecode(encoded, cv2.IMREAD_COLOR))
 
 
-def render_view(virtual: VirtualPTZ, frame, pose, model: LiveViewModel | None) -> np.ndarray:
+def render_view(virtual: VirtualPTZ, frame, pose, model: LiveViewParameters | None) -> np.ndarray:
     """The camera's view of a recorded frame at ``pose``: live (:func:`render_live`) with a model,
     the exact pinhole view (``virtual.render``) without."""
     return virtual.render(frame, pose) if model is None else render_live(virtual, frame, pose, model)
 
 
-def recorded_to_live(virtual: VirtualPTZ, recorded_px, pose, model: LiveViewModel) -> np.ndarray:
+def recorded_to_live(virtual: VirtualPTZ, recorded_px, pose, model: LiveViewParameters) -> np.ndarray:
     """Recorded (distorted) pixels (N, 2) to pixels (N, 2) of the live view at ``pose``; NaN behind it."""
     pose = np.asarray(pose, dtype=float)
     directions = virtual.recorded_directions(recorded_px)

@@ -5,7 +5,7 @@ from dataclasses import dataclass
 
 
 @dataclass(frozen=True)
-class LandingError:
+class LandingErrorParameters:
     """How far a camera lands from the pose it is sent to: pan and tilt off by ``pan_tilt_bias_deg``
     plus Gaussian errors of ``pan_tilt_sigma_deg``, zoom times ``zoom_bias`` times (1 + a Gaussian
     error of ``zoom_sigma``). The defaults are a perfect camera."""
@@ -17,7 +17,7 @@ class LandingError:
 
 
 @dataclass(frozen=True)
-class LiveViewModel:
+class LiveViewParameters:
     """The departures of a real PTZ camera's views from the pinhole model, and their ranges.
 
     roll_max_deg : roll about the optical axis, uniform in [-roll_max_deg, roll_max_deg].

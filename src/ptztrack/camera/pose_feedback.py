@@ -1,7 +1,7 @@
 """Where the camera looks: the pose it lands at, and the pose the tracker believes.
 
 A real PTZ camera lands near, not at, the pose it is sent to
-(:class:`LandingError`). The tracker maps detections to the ground with one
+(:class:`LandingErrorParameters`). The tracker maps detections to the ground with one
 of three poses (``pose_feedback.source`` of a scenario):
 the commanded one, the true one (an oracle, for experiments), or the one
 registered from the camera's own image against bundle-adjusted reference
@@ -19,13 +19,13 @@ from pathlib import Path
 import numpy as np
 
 from ptztrack.camera.live_view import render_view
-from ptztrack.camera.parameters import LandingError, LiveViewModel
+from ptztrack.camera.parameters import LandingErrorParameters, LiveViewParameters
 from ptztrack.camera.virtual import VirtualPTZ
 from ptztrack.geometry.registration import ReferenceIndex, build_index, load_index, register, save_index
 from ptztrack.scene.pets import RecordedVideo
 
 
-def landed_pose(commanded, error: LandingError, rng: np.random.Generator) -> np.ndarray:
+def landed_pose(commanded, error: LandingErrorParameters, rng: np.random.Generator) -> np.ndarray:
     """Where a camera sent to ``commanded`` (3,) lands: (pan_deg, tilt_deg, zoom) with the error model's
     bias and one draw of its noise. The zoom is not clipped to the lens's range: the error is symmetric."""
     commanded = np.asarray(commanded, dtype=float)
@@ -106,7 +106,7 @@ class RegisteredPose:
     index: ReferenceIndex
     video: RecordedVideo
     video_frame: np.ndarray
-    live: LiveViewModel | None = None
+    live: LiveViewParameters | None = None
 
     def __post_init__(self):
         size = (self.virtual.camera.image_width_px, self.virtual.camera.image_height_px)

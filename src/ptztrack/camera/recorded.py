@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ptztrack.camera.live_view import recorded_to_live, render_view
-from ptztrack.camera.parameters import LiveViewModel
+from ptztrack.camera.parameters import LiveViewParameters
 from ptztrack.camera.virtual import VirtualPTZ
 from ptztrack.geometry.occlusion import occluded_fraction
 from ptztrack.scene.pets import RecordedScene, RecordedVideo
@@ -33,7 +33,7 @@ class RecordedPTZ:
     virtual: VirtualPTZ
     scene: RecordedScene
     video: RecordedVideo | None = None
-    live: LiveViewModel | None = None
+    live: LiveViewParameters | None = None
     _last_view: tuple = field(default=(None, None, None), init=False, repr=False)
 
     def image(self, step: int, pose) -> np.ndarray | None:

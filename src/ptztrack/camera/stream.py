@@ -23,7 +23,7 @@ from urllib.parse import urlsplit
 import cv2
 import numpy as np
 
-log = logging.getLogger("ptztrack.live")
+log = logging.getLogger("ptztrack.loop.live")
 
 OPEN_TIMEOUT_S = 10.0
 # OpenCV's FFmpeg reads its options from this variable when a capture opens; the lock keeps two opens

@@ -16,14 +16,13 @@ from ptztrack.builders.live import (
     live_as_episode,
     live_pictures,
     run_live_episode,
-    run_live_network_episode,
     virtual_calibration,
     virtual_onvif_cameras,
 )
 from ptztrack.camera.move_timing import measure_image_delay, measure_move_times, timed_move
 from ptztrack.camera.onvif_client import ONVIFClient, camera_address
 from ptztrack.camera.stream import FrameStream, rtsp_pictures
-from ptztrack.cli.arguments import RUN_FOLDER_FILES
+from ptztrack.cli.options import RUN_FOLDER_FILES
 from ptztrack.cli.run import format_metrics
 from ptztrack.cli.scenario import build_scenario
 from ptztrack.cli.watch import Watch
@@ -37,10 +36,10 @@ from ptztrack.config import (
 )
 from ptztrack.evaluate.metrics import episode_metrics
 from ptztrack.evaluate.report import write_outputs
-from ptztrack.evaluate.view_state import NetworkViewState, ViewState
 from ptztrack.files import check_output_file, read_text, run_folder
-from ptztrack.live import LiveEpisode
+from ptztrack.loop.live import LiveEpisode
 from ptztrack.names import PASSWORD_VARIABLE, VIEW_STATES_FILE
+from ptztrack.view.view_state import NetworkViewState, ViewState
 
 
 def _credentials(args: argparse.Namespace) -> dict | None:
@@ -65,10 +64,11 @@ def live_command(args: argparse.Namespace) -> int:
         return _live_network(args, scenario, calibrations, addresses, truth_log, steps)
     print(f"live: {args.policy} on {addresses[0]}, up to {steps} pictures, RTSP over {args.transport}")
     label = f"live {args.policy}"
-    with Watch(args.view, args.out is not None, lambda w, p: ViewState(w, p, steps, label, truth=False)) as watch:
-        world, live = run_live_episode(
-            scenario, calibrations[0], addresses[0], args.policy, steps, args.time_scale, args.seed, args.timeout_s,
-            watch.observe, args.transport, keep_images=args.out is not None,
+    with Watch(args.view, args.out is not None, lambda w, p: ViewState(w[0], p, steps, label, truth=False)) as watch:
+        (world,), (live,) = run_live_episode(
+            scenario, calibrations, addresses, args.policy, steps, args.time_scale, args.seed,
+            timeout_s=args.timeout_s, transport=args.transport, keep_images=args.out is not None,
+            observe=watch.observe,
         )  # fmt: skip
     episode = live_as_episode(world, live, truth_log)
     _print_rates(live)
@@ -116,7 +116,7 @@ def _live_network(args, scenario, calibrations, addresses, truth_log, steps: int
         )
 
     with Watch(args.view, args.out is not None, view) as watch:
-        worlds, lives = run_live_network_episode(
+        worlds, lives = run_live_episode(
             scenario, calibrations, addresses, args.policy, steps, args.time_scale, args.seed, args.coordination,
             args.timeout_s, args.transport, keep_images=args.out is not None, observe=watch.observe,
         )  # fmt: skip

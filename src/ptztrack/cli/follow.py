@@ -5,14 +5,11 @@ import sys
 from pathlib import Path
 
 from ptztrack.builders.recording import FOLLOW_PROTOCOL, pets_follow_scenario
-from ptztrack.cli.arguments import RUN_FOLDER_FILES
+from ptztrack.cli.options import RUN_FOLDER_FILES
 from ptztrack.cli.scenario import build_scenario, recording_overrides, recording_paths
 from ptztrack.cli.watch import Watch
 from ptztrack.config import Scenario, load_scenario
-from ptztrack.evaluate.executors import Progress
 from ptztrack.evaluate.report import write_outputs
-from ptztrack.evaluate.video import view_renderer
-from ptztrack.evaluate.view_state import ViewState
 from ptztrack.experiments.cells import Execution, run_experiment_cells
 from ptztrack.experiments.follow import (
     FOLLOW_FIGURES,
@@ -28,6 +25,9 @@ from ptztrack.experiments.follow import (
     summarise_follow_experiment,
 )
 from ptztrack.files import check_output_folder, run_folder, write_json
+from ptztrack.loop.executors import Progress
+from ptztrack.view.video import view_renderer
+from ptztrack.view.view_state import ViewState
 
 
 def _follow_scenario(args: argparse.Namespace, tracker: str = "particle") -> Scenario:

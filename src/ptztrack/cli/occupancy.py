@@ -3,11 +3,11 @@ against clustering."""
 
 import argparse
 
-from ptztrack.builders.occupancy import PLAZA_LEAD_IN_FRAMES
+from ptztrack.builders.occupancy_synthetic import PLAZA_LEAD_IN_FRAMES
 from ptztrack.config import load_dataset, pets_dataset
-from ptztrack.evaluate.executors import Progress
 from ptztrack.experiments.occupancy import dataset_runs, format_occupancy_table, plaza_runs, room_runs
 from ptztrack.files import InputError, run_folder, write_json
+from ptztrack.loop.executors import Progress
 from ptztrack.names import PLAZA_FRAMES, ROOM_FRAMES
 from ptztrack.occupancy.output import write_occupancy_outputs
 

@@ -16,6 +16,7 @@ from ptztrack.experiments.ptz_tables import (
     synthetic_title,
 )
 from ptztrack.files import write_json
+from ptztrack.names import PetsProtocol
 
 
 def synthetic_experiment_command(args: argparse.Namespace) -> int:
@@ -41,7 +42,7 @@ def pets_experiment_command(args: argparse.Namespace) -> int:
         if fold.fitted:
             fitted = ", ".join(f"{name} {value:.4g}" for name, value in fold.fitted.items())
             print(f"fold {fold.index}: fitted on the other half's frames: {fitted}", file=sys.stderr)
-    betas = args.beta or [9.0, 1.0]
+    betas = args.beta or list(PetsProtocol.betas)
     cells = [
         cell
         for fold in folds

@@ -9,7 +9,6 @@ from pathlib import Path
 from ptztrack.builders.registration import reference_index
 from ptztrack.cli.scenario import command_scenario
 from ptztrack.config import LiveView, PoseError, ScenarioError
-from ptztrack.evaluate.executors import Progress
 from ptztrack.experiments.cells import Execution, run_experiment_cells
 from ptztrack.experiments.registration import (
     closed_loop_cells,
@@ -21,6 +20,7 @@ from ptztrack.experiments.registration import (
     summarise_registration,
 )
 from ptztrack.files import write_json
+from ptztrack.loop.executors import Progress
 
 
 def registration_experiment_command(args: argparse.Namespace) -> int:

@@ -4,7 +4,7 @@ import argparse
 
 from ptztrack.builders.render import render_dataset
 from ptztrack.cli.scenario import build_scenario
-from ptztrack.evaluate.executors import Progress
+from ptztrack.loop.executors import Progress
 
 
 def render_command(args: argparse.Namespace) -> int:

@@ -5,16 +5,16 @@ from functools import partial
 
 from ptztrack.builders.budget import refuse_if_too_large
 from ptztrack.builders.episode import episode_world, make_policy, run_episode
-from ptztrack.cli.arguments import RUN_FOLDER_FILES
+from ptztrack.cli.options import RUN_FOLDER_FILES
 from ptztrack.cli.scenario import command_scenario
 from ptztrack.cli.watch import Watch
-from ptztrack.evaluate.executors import Progress
 from ptztrack.evaluate.metrics import DISPLAY, episode_metrics
 from ptztrack.evaluate.report import write_outputs
-from ptztrack.evaluate.video import view_renderer
-from ptztrack.evaluate.view_state import ViewState, read_view_states
-from ptztrack.evaluate.web_view import ViewHub, ViewServer, replay
 from ptztrack.files import run_folder
+from ptztrack.loop.executors import Progress
+from ptztrack.view.video import view_renderer
+from ptztrack.view.view_state import ViewState, read_view_states
+from ptztrack.view.web_view import ViewHub, ViewServer, replay
 
 DETECTOR_MODEL_FILE = "detector_model.json"  # what run adds to RUN_FOLDER_FILES: the detector model as the run ended
 RUN_FIGURES = ("mota", "motp_m", "idf1", "height_px", "detections", "zoom", "switches")

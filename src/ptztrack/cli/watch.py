@@ -3,11 +3,11 @@
 from pathlib import Path
 
 from ptztrack.cli.interrupt import raise_if_interrupted
-from ptztrack.evaluate.executors import Progress
-from ptztrack.evaluate.view_state import StepView, ViewState
-from ptztrack.evaluate.web_view import ViewHub, ViewServer
-from ptztrack.loop import StepObserver
+from ptztrack.loop.executors import Progress
+from ptztrack.loop.steps import StepObserver
 from ptztrack.names import VIEW_STATES_FILE
+from ptztrack.view.view_state import StepView, ViewState
+from ptztrack.view.web_view import ViewHub, ViewServer
 
 
 class Watch:

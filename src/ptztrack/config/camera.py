@@ -6,7 +6,7 @@ from typing import Annotated, Literal
 import numpy as np
 from pydantic import Field, model_validator
 
-from ptztrack.camera.parameters import LandingError, LiveViewModel
+from ptztrack.camera.parameters import LandingErrorParameters, LiveViewParameters
 from ptztrack.config.fields import (
     Degrees,
     NonNegativeFloat,
@@ -29,13 +29,13 @@ class PoseError(_Strict):
     ``pan_tilt_bias_deg`` plus independent Gaussian errors of ``pan_tilt_sigma_deg``, and at the
     commanded zoom times ``zoom_bias`` times (1 + a Gaussian error of ``zoom_sigma``); it stays there
     while the command does not change. The defaults are
-    :class:`~ptztrack.camera.parameters.LandingError`'s: a perfect camera.
+    :class:`~ptztrack.camera.parameters.LandingErrorParameters`'s: a perfect camera.
     """
 
-    pan_tilt_sigma_deg: Annotated[NonNegativeFloat, at_most(90, "degrees")] = LandingError.pan_tilt_sigma_deg
-    pan_tilt_bias_deg: tuple[Degrees, Degrees] = LandingError.pan_tilt_bias_deg
-    zoom_sigma: Annotated[float, Field(ge=0, lt=0.5)] = LandingError.zoom_sigma
-    zoom_bias: Annotated[PositiveFloat, at_most(10, "a factor on the zoom")] = LandingError.zoom_bias
+    pan_tilt_sigma_deg: Annotated[NonNegativeFloat, at_most(90, "degrees")] = LandingErrorParameters.pan_tilt_sigma_deg
+    pan_tilt_bias_deg: tuple[Degrees, Degrees] = LandingErrorParameters.pan_tilt_bias_deg
+    zoom_sigma: Annotated[float, Field(ge=0, lt=0.5)] = LandingErrorParameters.zoom_sigma
+    zoom_bias: Annotated[PositiveFloat, at_most(10, "a factor on the zoom")] = LandingErrorParameters.zoom_bias
 
 
 _Gain = Annotated[PositiveFloat, at_most(100, "a factor on the contrast")]
@@ -43,7 +43,7 @@ _Gain = Annotated[PositiveFloat, at_most(100, "a factor on the contrast")]
 
 class LiveView(_Strict):
     """How a real PTZ camera's views depart from the pinhole model (:mod:`ptztrack.camera.live_view`);
-    the defaults (:class:`~ptztrack.camera.parameters.LiveViewModel`'s) are the realistic model of the
+    the defaults (:class:`~ptztrack.camera.parameters.LiveViewParameters`'s) are the realistic model of the
     registration experiment.
 
     Each view is rolled by up to ``roll_max_deg`` (uniform), its principal point is off the centre
@@ -56,18 +56,18 @@ class LiveView(_Strict):
     """
 
     roll_max_deg: Annotated[NonNegativeFloat, at_most(45, "degrees: a mount rolled further is not level")] = (
-        LiveViewModel.roll_max_deg
+        LiveViewParameters.roll_max_deg
     )
     principal_offset_max_px: Annotated[NonNegativeFloat, at_most(1000, "pixels")] = (
-        LiveViewModel.principal_offset_max_px
+        LiveViewParameters.principal_offset_max_px
     )
-    k1_wide: Annotated[float, Field(gt=-1, lt=1)] = LiveViewModel.k1_wide
-    k1_tele: Annotated[float, Field(gt=-1, lt=1)] = LiveViewModel.k1_tele
-    tele_zoom: Annotated[float, Field(gt=1), at_most(100, "a PTZ camera's optical zoom")] = LiveViewModel.tele_zoom
-    gain: tuple[_Gain, _Gain] = LiveViewModel.gain
-    brightness_max: Annotated[NonNegativeFloat, at_most(255, "grey levels")] = LiveViewModel.brightness_max
-    jpeg_quality: int = Field(LiveViewModel.jpeg_quality, ge=1, le=100)
-    seed: int = Field(LiveViewModel.seed, ge=0, lt=2**63)
+    k1_wide: Annotated[float, Field(gt=-1, lt=1)] = LiveViewParameters.k1_wide
+    k1_tele: Annotated[float, Field(gt=-1, lt=1)] = LiveViewParameters.k1_tele
+    tele_zoom: Annotated[float, Field(gt=1), at_most(100, "a PTZ camera's optical zoom")] = LiveViewParameters.tele_zoom
+    gain: tuple[_Gain, _Gain] = LiveViewParameters.gain
+    brightness_max: Annotated[NonNegativeFloat, at_most(255, "grey levels")] = LiveViewParameters.brightness_max
+    jpeg_quality: int = Field(LiveViewParameters.jpeg_quality, ge=1, le=100)
+    seed: int = Field(LiveViewParameters.seed, ge=0, lt=2**63)
 
     @model_validator(mode="after")
     def _gain_ordered(self):

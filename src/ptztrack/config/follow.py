@@ -5,7 +5,7 @@ from typing import Annotated, Literal
 from pydantic import Field, model_validator
 
 from ptztrack.config.fields import NonNegativeFloat, PositiveFloat, _Strict, _Zoom, at_most, at_most_items
-from ptztrack.follow.parameters import FollowSettings
+from ptztrack.follow.parameters import FollowParameters
 
 _FollowPixels = Annotated[NonNegativeFloat, at_most(8192, "pixels")]
 _PARTICLE_TIME = "time: every particle is scored on every patch each step"
@@ -19,60 +19,60 @@ Patch = tuple[
 
 
 class Follow(_Strict):
-    """The follow camera's section: :class:`~ptztrack.follow.parameters.FollowSettings`, whose fields
+    """The follow camera's section: :class:`~ptztrack.follow.parameters.FollowParameters`, whose fields
     it validates and whose defaults it takes (their meaning is given there).
 
     The ``tracker.kind`` 'particle' (the paper's particle filter), 'csrt' or 'mil' (OpenCV's) follows
     the person and the policy 'follow' moves the camera.
     """
 
-    target_id: int | None = FollowSettings.target_id
-    target_point_px: tuple[_FollowPixels, _FollowPixels] | None = FollowSettings.target_point_px
-    target_height_px: Annotated[PositiveFloat, at_most(8192, "pixels")] = FollowSettings.target_height_px
-    max_speed_deg_s: Annotated[PositiveFloat, at_most(1000, "degrees per second")] = FollowSettings.max_speed_deg_s
+    target_id: int | None = FollowParameters.target_id
+    target_point_px: tuple[_FollowPixels, _FollowPixels] | None = FollowParameters.target_point_px
+    target_height_px: Annotated[PositiveFloat, at_most(8192, "pixels")] = FollowParameters.target_height_px
+    max_speed_deg_s: Annotated[PositiveFloat, at_most(1000, "degrees per second")] = FollowParameters.max_speed_deg_s
     max_acceleration_deg_s2: Annotated[PositiveFloat, at_most(10_000, "degrees per second squared")] = (
-        FollowSettings.max_acceleration_deg_s2
+        FollowParameters.max_acceleration_deg_s2
     )
-    max_zoom_speed: Annotated[PositiveFloat, at_most(100, "per second")] = FollowSettings.max_zoom_speed
+    max_zoom_speed: Annotated[PositiveFloat, at_most(100, "per second")] = FollowParameters.max_zoom_speed
     max_zoom_acceleration: Annotated[PositiveFloat, at_most(1000, "per second squared")] = (
-        FollowSettings.max_zoom_acceleration
+        FollowParameters.max_zoom_acceleration
     )
-    zoom_range: tuple[_Zoom, _Zoom] = FollowSettings.zoom_range
-    smoothing_cutoff_hz: Annotated[PositiveFloat, at_most(1000, "hertz")] = FollowSettings.smoothing_cutoff_hz
-    particles: Annotated[int, Field(ge=1), at_most(100_000, _PARTICLE_TIME)] = FollowSettings.particles
-    search_particles: Annotated[int, Field(ge=2), at_most(100_000, _PARTICLE_TIME)] = FollowSettings.search_particles
-    patches: Annotated[tuple[Patch, ...], at_most_items(100, _PARTICLE_TIME)] = FollowSettings.patches
-    histogram_bins: int = Field(FollowSettings.histogram_bins, ge=1, le=64)
-    achromatic_bins: bool = FollowSettings.achromatic_bins
+    zoom_range: tuple[_Zoom, _Zoom] = FollowParameters.zoom_range
+    smoothing_cutoff_hz: Annotated[PositiveFloat, at_most(1000, "hertz")] = FollowParameters.smoothing_cutoff_hz
+    particles: Annotated[int, Field(ge=1), at_most(100_000, _PARTICLE_TIME)] = FollowParameters.particles
+    search_particles: Annotated[int, Field(ge=2), at_most(100_000, _PARTICLE_TIME)] = FollowParameters.search_particles
+    patches: Annotated[tuple[Patch, ...], at_most_items(100, _PARTICLE_TIME)] = FollowParameters.patches
+    histogram_bins: int = Field(FollowParameters.histogram_bins, ge=1, le=64)
+    achromatic_bins: bool = FollowParameters.achromatic_bins
     background_area_ratio: Annotated[float, Field(gt=1), at_most(10_000, "box areas")] | None = (
-        FollowSettings.background_area_ratio
+        FollowParameters.background_area_ratio
     )
-    height_log_sigma: PositiveFloat | None = FollowSettings.height_log_sigma
-    samples_per_patch: Annotated[int, Field(ge=1), at_most(1000, _PARTICLE_TIME)] = FollowSettings.samples_per_patch
-    lambda_colour: Annotated[PositiveFloat, at_most(1e6, "a likelihood scale")] = FollowSettings.lambda_colour
-    lambda_loss: Annotated[PositiveFloat, at_most(1e6, "a likelihood scale")] = FollowSettings.lambda_loss
-    lambda_motion: Annotated[PositiveFloat, at_most(1e6, "a likelihood scale")] = FollowSettings.lambda_motion
+    height_log_sigma: PositiveFloat | None = FollowParameters.height_log_sigma
+    samples_per_patch: Annotated[int, Field(ge=1), at_most(1000, _PARTICLE_TIME)] = FollowParameters.samples_per_patch
+    lambda_colour: Annotated[PositiveFloat, at_most(1e6, "a likelihood scale")] = FollowParameters.lambda_colour
+    lambda_loss: Annotated[PositiveFloat, at_most(1e6, "a likelihood scale")] = FollowParameters.lambda_loss
+    lambda_motion: Annotated[PositiveFloat, at_most(1e6, "a likelihood scale")] = FollowParameters.lambda_motion
     walk_heights_per_s: Annotated[PositiveFloat, at_most(1000, "box heights per second")] = (
-        FollowSettings.walk_heights_per_s
+        FollowParameters.walk_heights_per_s
     )
-    scale_change_per_s: Annotated[PositiveFloat, at_most(100, "per second")] = FollowSettings.scale_change_per_s
-    prediction: Literal["constant_velocity", "particle_velocity", "random_walk"] = FollowSettings.prediction
+    scale_change_per_s: Annotated[PositiveFloat, at_most(100, "per second")] = FollowParameters.scale_change_per_s
+    prediction: Literal["constant_velocity", "particle_velocity", "random_walk"] = FollowParameters.prediction
     acceleration_heights_per_s2: Annotated[PositiveFloat, at_most(1000, "box heights per second squared")] = (
-        FollowSettings.acceleration_heights_per_s2
+        FollowParameters.acceleration_heights_per_s2
     )
     initial_speed_heights_per_s: Annotated[PositiveFloat, at_most(1000, "box heights per second")] = (
-        FollowSettings.initial_speed_heights_per_s
+        FollowParameters.initial_speed_heights_per_s
     )
-    loss_fraction: Fraction = FollowSettings.loss_fraction
-    adapt_fraction: Fraction = FollowSettings.adapt_fraction
+    loss_fraction: Fraction = FollowParameters.loss_fraction
+    adapt_fraction: Fraction = FollowParameters.adapt_fraction
     reference_time_constant_s: Annotated[PositiveFloat, at_most(86_400, "seconds")] = (
-        FollowSettings.reference_time_constant_s
+        FollowParameters.reference_time_constant_s
     )
-    search_heights: Annotated[PositiveFloat, at_most(1000, "box heights")] = FollowSettings.search_heights
-    search_scale: Annotated[PositiveFloat, at_most(100, "a relative spread")] = FollowSettings.search_scale
-    motion_threshold: Annotated[NonNegativeFloat, at_most(255, "grey levels")] = FollowSettings.motion_threshold
-    motion_memory_s: Annotated[PositiveFloat, at_most(86_400, "seconds")] = FollowSettings.motion_memory_s
-    motion_scale: Annotated[float, Field(gt=0, le=1)] = FollowSettings.motion_scale
+    search_heights: Annotated[PositiveFloat, at_most(1000, "box heights")] = FollowParameters.search_heights
+    search_scale: Annotated[PositiveFloat, at_most(100, "a relative spread")] = FollowParameters.search_scale
+    motion_threshold: Annotated[NonNegativeFloat, at_most(255, "grey levels")] = FollowParameters.motion_threshold
+    motion_memory_s: Annotated[PositiveFloat, at_most(86_400, "seconds")] = FollowParameters.motion_memory_s
+    motion_scale: Annotated[float, Field(gt=0, le=1)] = FollowParameters.motion_scale
 
     @model_validator(mode="after")
     def _consistent(self):

@@ -23,13 +23,15 @@ from ptztrack.config.fields import (
     _Strict,
     at_most,
     at_most_items,
+    tunable,
 )
 from ptztrack.config.follow import Follow
 from ptztrack.config.reading import ScenarioError, _first_error_line, read_yaml
 from ptztrack.control.parameters import ControlParameters
-from ptztrack.detect.parameters import BoxDetectorParameters, DetectorPrior, HogParameters
-from ptztrack.scene.parameters import Crowd
-from ptztrack.track.parameters import TrackerParameters
+from ptztrack.detect.parameters import BoxDetectorParameters, DetectorPriorParameters, HogParameters
+from ptztrack.names import DETECTOR_MODELS
+from ptztrack.scene.parameters import CrowdParameters
+from ptztrack.track.parameters import Association, ExistenceUpdate, TrackerParameters
 
 _Speed = Annotated[PositiveFloat, at_most(15, "metres per second: faster than anyone runs")]
 _Height = Annotated[PositiveFloat, at_most(3, "metres: taller than anyone")]
@@ -37,7 +39,7 @@ _Stay = Annotated[PositiveFloat, at_most(86_400, "seconds: a day")]
 
 
 class People(_Strict):
-    """The synthetic crowd (:class:`~ptztrack.scene.parameters.Crowd`, whose defaults it takes).
+    """The synthetic crowd (:class:`~ptztrack.scene.parameters.CrowdParameters`, whose defaults it takes).
     paired_fraction : the share of the ``count`` people who walk in pairs, side by side
     ``pair_spacing_m`` apart (pairs: the fraction of count / 2, rounded).
 
@@ -54,19 +56,19 @@ class People(_Strict):
     """
 
     count: Annotated[int, Field(ge=0), at_most(1000, "time: the policies score every person under every action")] = (
-        Crowd.count
+        CrowdParameters.count
     )
-    speed_m_s: tuple[_Speed, _Speed] = Crowd.speed_m_s
-    height_m: tuple[_Height, _Height] = Crowd.height_m
-    width_m: Annotated[PositiveFloat, at_most(3, "metres: a person's width")] = Crowd.width_m
+    speed_m_s: tuple[_Speed, _Speed] = CrowdParameters.speed_m_s
+    height_m: tuple[_Height, _Height] = CrowdParameters.height_m
+    width_m: Annotated[PositiveFloat, at_most(3, "metres: a person's width")] = CrowdParameters.width_m
     turn_rate_sigma_deg_s: Annotated[NonNegativeFloat, at_most(3600, "degrees per second")] = (
-        Crowd.turn_rate_sigma_deg_s
+        CrowdParameters.turn_rate_sigma_deg_s
     )
-    enter_leave: bool = Crowd.enter_leave
-    stay_s: tuple[_Stay, _Stay] = Crowd.stay_s
-    paired_fraction: float = Field(Crowd.paired_fraction, ge=0, le=1)
+    enter_leave: bool = CrowdParameters.enter_leave
+    stay_s: tuple[_Stay, _Stay] = CrowdParameters.stay_s
+    paired_fraction: float = Field(CrowdParameters.paired_fraction, ge=0, le=1)
     pair_spacing_m: Annotated[PositiveFloat, at_most(10, "metres between two people walking together")] = (
-        Crowd.pair_spacing_m
+        CrowdParameters.pair_spacing_m
     )
     trajectories: str | None = None
     trajectories_frame_rate_hz: Annotated[PositiveFloat, at_most(1000, "frames per second")] | None = None
@@ -94,11 +96,6 @@ class People(_Strict):
         return self
 
 
-# How the policies and the tracker know the detector: its prior curve fixed, learned from the run, or the
-# simulation's own curve (for comparison only); anything else names a detector_model.json to start from.
-DETECTOR_MODELS = ("a-priori", "online", "true")
-
-
 class Detector(_Strict):
     """The detector: simulated (ideal, realistic), OpenCV's HOG on a recording's virtual view, or any
     detector registered by another package (``options`` are its parameters).
@@ -110,7 +107,7 @@ class Detector(_Strict):
     simulation's own curve, and a file path starts from what an earlier run learned.
 
     The recall curve's, the noise's and the HOG fields' defaults are those of
-    :class:`~ptztrack.detect.parameters.DetectorPrior` and :class:`~ptztrack.detect.parameters.HogParameters`.
+    :class:`~ptztrack.detect.parameters.DetectorPriorParameters` and :class:`~ptztrack.detect.parameters.HogParameters`.
 
     hog_search : 'ground' scans only the windows where a standing person ``hog_person_height_m``
     (shortest, tallest) tall could be seen on the walkable area, at their sizes; 'image' scans every
@@ -124,12 +121,12 @@ class Detector(_Strict):
 
     kind: Annotated[str, _registered("detectors")] = "realistic"
     options: Options = Field(default_factory=dict)
-    recall_kd: Annotated[PositiveFloat, at_most(100, "per pixel")] = DetectorPrior.recall_kd
-    recall_r0_px: Annotated[NonNegativeFloat, at_most(10_000, "pixels")] = DetectorPrior.recall_r0_px
-    pixel_noise_px: Annotated[NonNegativeFloat, at_most(10_000, "pixels")] = DetectorPrior.pixel_noise_px
+    recall_kd: Annotated[PositiveFloat, at_most(100, "per pixel")] = DetectorPriorParameters.recall_kd
+    recall_r0_px: Annotated[NonNegativeFloat, at_most(10_000, "pixels")] = DetectorPriorParameters.recall_r0_px
+    pixel_noise_px: Annotated[NonNegativeFloat, at_most(10_000, "pixels")] = DetectorPriorParameters.pixel_noise_px
     false_positives_per_frame: Annotated[
         NonNegativeFloat, at_most(1000, "time and memory: every detection is kept and associated")
-    ] = DetectorPrior.false_positives_per_frame
+    ] = DetectorPriorParameters.false_positives_per_frame
     hog_upsample: Annotated[PositiveFloat, at_most(16, "memory: the view is upsampled this much each way")] = (
         HogParameters.upsample
     )
@@ -200,25 +197,41 @@ class Tracker(_Strict):
 
     kind: Annotated[str, _registered("trackers")] = "ekf"
     options: Options = Field(default_factory=dict)
-    acceleration_sigma_m_s2: Annotated[PositiveFloat, at_most(100, "metres per second squared")] = (
+    acceleration_sigma_m_s2: Annotated[float, *tunable(TrackerParameters, "acceleration_sigma_m_s2")] = (
         TrackerParameters.acceleration_sigma_m_s2
     )
-    initial_speed_sigma_m_s: Annotated[PositiveFloat, at_most(100, "metres per second")] = (
+    initial_speed_sigma_m_s: Annotated[float, *tunable(TrackerParameters, "initial_speed_sigma_m_s")] = (
         TrackerParameters.initial_speed_sigma_m_s
     )
-    gate_probability: float = Field(TrackerParameters.gate_probability, gt=0, lt=1)
-    existence_at_birth: float = Field(TrackerParameters.existence_at_birth, gt=0, lt=1)
-    existence_when_detected: float = Field(TrackerParameters.existence_when_detected, gt=0, lt=1)
-    existence_to_delete: float = Field(TrackerParameters.existence_to_delete, gt=0, lt=1)
-    max_position_sigma_m: Annotated[PositiveFloat, at_most(10_000, "metres")] = TrackerParameters.max_position_sigma_m
-    confirmation_hits: Annotated[int, Field(ge=1), at_most(_MAX_FRAMES, "steps")] = TrackerParameters.confirmation_hits
-    report_position_sigma_m: Annotated[PositiveFloat, at_most(10_000, "metres")] = (
+    gate_probability: Annotated[float, *tunable(TrackerParameters, "gate_probability")] = (
+        TrackerParameters.gate_probability
+    )
+    existence_at_birth: Annotated[float, *tunable(TrackerParameters, "existence_at_birth")] = (
+        TrackerParameters.existence_at_birth
+    )
+    existence_when_detected: Annotated[float, *tunable(TrackerParameters, "existence_when_detected")] = (
+        TrackerParameters.existence_when_detected
+    )
+    existence_to_delete: Annotated[float, *tunable(TrackerParameters, "existence_to_delete")] = (
+        TrackerParameters.existence_to_delete
+    )
+    max_position_sigma_m: Annotated[float, *tunable(TrackerParameters, "max_position_sigma_m")] = (
+        TrackerParameters.max_position_sigma_m
+    )
+    confirmation_hits: Annotated[int, *tunable(TrackerParameters, "confirmation_hits")] = (
+        TrackerParameters.confirmation_hits
+    )
+    report_position_sigma_m: Annotated[float, *tunable(TrackerParameters, "report_position_sigma_m")] = (
         TrackerParameters.report_position_sigma_m
     )
-    existence_update: Literal["bayes", "fixed"] = TrackerParameters.existence_update
-    existence_to_report: float = Field(TrackerParameters.existence_to_report, gt=0, lt=1)
-    association: Literal["hungarian", "cjpdaf"] = TrackerParameters.association
-    clutter_density_per_px2: Annotated[NonNegativeFloat, at_most(1, "detections per pixel")] = (
+    existence_update: Annotated[ExistenceUpdate, *tunable(TrackerParameters, "existence_update")] = (
+        TrackerParameters.existence_update
+    )
+    existence_to_report: Annotated[float, *tunable(TrackerParameters, "existence_to_report")] = (
+        TrackerParameters.existence_to_report
+    )
+    association: Annotated[Association, *tunable(TrackerParameters, "association")] = TrackerParameters.association
+    clutter_density_per_px2: Annotated[float, *tunable(TrackerParameters, "clutter_density_per_px2")] = (
         TrackerParameters.clutter_density_per_px2
     )
     measurement_source: Literal["detector", "spatiogram"] = "detector"

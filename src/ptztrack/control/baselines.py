@@ -7,9 +7,8 @@ import numpy as np
 from ptztrack.camera.actions import ActionGrid
 from ptztrack.geometry.area import bounds_m, grid_inside
 from ptztrack.geometry.ptz import PTZCamera, person_in_view, project_people
+from ptztrack.scene.parameters import PersonParameters
 from ptztrack.types import DecisionContext
-
-REFERENCE_PERSON_HEIGHT_M = 1.75
 
 
 def area_samples_m(area_polygon_m, per_axis: int = 30) -> np.ndarray:
@@ -22,7 +21,7 @@ def area_samples_m(area_polygon_m, per_axis: int = 30) -> np.ndarray:
 
 def area_coverage(camera: PTZCamera, poses, area_polygon_m) -> np.ndarray:
     """Fraction of the area where a standing person has head and feet in the image; (*P,)."""
-    people = project_people(camera, poses, area_samples_m(area_polygon_m), REFERENCE_PERSON_HEIGHT_M, 0.0)
+    people = project_people(camera, poses, area_samples_m(area_polygon_m), PersonParameters.height_m, 0.0)
     return person_in_view(camera, people).mean(axis=-1)
 
 

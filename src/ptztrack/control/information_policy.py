@@ -10,7 +10,7 @@ exploration term), the camera stays.
 
 A camera whose moves take time (a live one) plans the same way: it is
 given a new choice only once a picture taken at rest where its last move
-took it is in the belief (:func:`ptztrack.live.run_live_network`).
+took it is in the belief (:func:`ptztrack.loop.live.run_live_network`).
 """
 
 from dataclasses import dataclass, field
@@ -31,6 +31,10 @@ from ptztrack.control.parameters import ControlParameters
 from ptztrack.detect.simulated import RecallCurve
 from ptztrack.geometry.ptz import PTZCamera, look_at
 from ptztrack.types import DecisionContext, Tracks
+
+InformationMethod = Literal["intg", "smpl"]
+"""The information-gain policy's two ways of computing the expected gain: 'intg' (equation 8, closed form)
+or 'smpl' (equation 19, by sampling)."""
 
 
 @dataclass(frozen=True)
@@ -71,7 +75,7 @@ class InformationGainPolicy:
     V: np.ndarray
     person_height_m: float
     person_width_m: float
-    method: Literal["intg", "smpl"]
+    method: InformationMethod
     samples: int = ControlParameters.samples
     beta: float = ControlParameters.beta
     exploration: ExplorationMap | None = None

@@ -3,6 +3,8 @@ maps onto (:mod:`ptztrack.config` takes its defaults from here)."""
 
 from dataclasses import dataclass
 
+from ptztrack.scene.parameters import PersonParameters
+
 
 @dataclass(frozen=True)
 class ControlParameters:
@@ -17,7 +19,7 @@ class ControlParameters:
 
     samples: int = 100
     beta: float = 0.0
-    person_height_m: float = 1.75
+    person_height_m: float = PersonParameters.height_m
     exploration_cell_m: float = 1.0
     prior_untracked_people: float = 1.0
     arrival_rate_per_s: float = 0.1

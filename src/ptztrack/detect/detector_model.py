@@ -61,7 +61,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ptztrack.detect.parameters import DetectorPrior
+from ptztrack.detect.parameters import DetectorPriorParameters
 from ptztrack.detect.simulated import RecallModel
 from ptztrack.files import InputError, read_json, write_json
 from ptztrack.geometry.occlusion import occluded_fraction
@@ -117,8 +117,8 @@ class OnlineDetectorModel:
     person_width_m: float
     prior: RecallModel
     learning: bool = True
-    false_positives_per_view: float = DetectorPrior.false_positives_per_frame
-    pixel_noise_px: float = DetectorPrior.pixel_noise_px
+    false_positives_per_view: float = DetectorPriorParameters.false_positives_per_frame
+    pixel_noise_px: float = DetectorPriorParameters.pixel_noise_px
     prior_successes: np.ndarray | None = None
     prior_trials: np.ndarray | None = None
     prior_views: float = PRIOR_VIEWS

@@ -5,7 +5,7 @@ from dataclasses import dataclass
 
 
 @dataclass(frozen=True)
-class DetectorPrior:
+class DetectorPriorParameters:
     """What the policies and the tracker are told of a simulated or learned detector before a run.
 
     recall_kd, recall_r0_px : the recall curve ``1 - exp(-kd (r - r0))`` of a person ``r`` px tall

@@ -13,8 +13,8 @@ import motmetrics as mm
 import numpy as np
 
 from ptztrack.geometry.area import inside
-from ptztrack.loop import Episode
-from ptztrack.network_loop import NetworkEpisode
+from ptztrack.loop.simulated import NetworkEpisode
+from ptztrack.loop.steps import Episode
 from ptztrack.types import GroundTruth, Tracks
 
 GATE_M = 1.0

@@ -21,7 +21,7 @@ from collections.abc import Callable
 import numpy as np
 
 from ptztrack.camera.live_view import render_view, view_lens
-from ptztrack.camera.parameters import LiveViewModel
+from ptztrack.camera.parameters import LiveViewParameters
 from ptztrack.camera.virtual import VirtualPTZ
 from ptztrack.geometry.lens import Lens, pixel_directions, project_directions
 from ptztrack.geometry.ptz import PTZCamera, apply_homography, image_to_ground, inside_image
@@ -45,7 +45,7 @@ def registration_errors(
     poses,
     frames,
     ground_points_m,
-    live: LiveViewModel | None = None,
+    live: LiveViewParameters | None = None,
     progress: Callable[[int, int], None] | None = None,
 ) -> list[dict]:
     """Register the live views of ``virtual`` at ``poses`` (V, 3) of the video's ``frames`` (V,)

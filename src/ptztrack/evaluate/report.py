@@ -21,12 +21,12 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Polygon
 
 from ptztrack.evaluate.metrics import with_undefined_noted
-from ptztrack.evaluate.video import RenderView, write_episode_video
 from ptztrack.files import strict_json, write_atomically
 from ptztrack.geometry.area import bounds_m
 from ptztrack.geometry.ptz import ground_footprint
-from ptztrack.loop import Episode
-from ptztrack.track.tracker import ground_points
+from ptztrack.loop.steps import Episode
+from ptztrack.track.observation import ground_points
+from ptztrack.view.video import RenderView, write_episode_video
 
 TRACK_COLUMNS = ("frame", "id", "x_m", "y_m", "vx_m_s", "vy_m_s", "var_x_m2", "cov_xy_m2", "var_y_m2")
 STEP_COLUMNS = (
@@ -200,7 +200,7 @@ def write_outputs(
     directory: Path, episode: Episode, metrics: dict, title: str = "", render_view: RenderView | None = None
 ) -> None:
     """Write the files of ``RUN_FILES`` into ``directory`` (created if needed): episode.mp4 only with
-    ``render_view`` (see :mod:`ptztrack.evaluate.video`); the pictures captioned with ``title``."""
+    ``render_view`` (see :mod:`ptztrack.view.video`); the pictures captioned with ``title``."""
     directory = Path(directory)
     directory.mkdir(parents=True, exist_ok=True)
     write_atomically(directory / "metrics.json", metrics_json(metrics))

@@ -1,7 +1,7 @@
 """What the experiments share: a cell of (scenario, strategy, seed), the run of one, and how cells run.
 
 An experiment is a list of cells, each a function of its inputs; the
-executors of :mod:`ptztrack.evaluate.executors` run them in this process, on
+executors of :mod:`ptztrack.loop.executors` run them in this process, on
 local processes or on a Ray cluster, with the same rows.
 """
 
@@ -11,8 +11,9 @@ from dataclasses import dataclass
 from ptztrack.builders.episode import PolicySpec, run_episode
 from ptztrack.builders.world import CameraSpec, DetectorSpec
 from ptztrack.config import Scenario
-from ptztrack.evaluate.executors import Progress, run_cells
 from ptztrack.evaluate.metrics import episode_metrics
+from ptztrack.loop.executors import Progress, execute_cells
+from ptztrack.loop.steps import Episode
 
 # The paper's column names; 'rnd' is the 'random' policy.
 POLICY_OF_STRATEGY = {"rnd": "random"}
@@ -59,9 +60,10 @@ def cell_policy(cell: Cell) -> PolicySpec:
     return copy.deepcopy(cell.strategy)
 
 
-def run_cell(cell: Cell) -> dict:
+def cell_metrics(cell: Cell) -> dict:
     """Run one cell; returns its metrics with ``strategy``, ``label``, ``beta`` (None for baselines) and ``seed``."""
     episode = run_episode(cell.scenario, cell_policy(cell), cell.seed, camera=cell.camera, detector=cell.detector)
+    assert isinstance(episode, Episode), "a table's cell runs one camera"
     beta = cell.scenario.control.beta if cell.strategy in INFORMATION_STRATEGIES else None
     name = strategy_name(cell.strategy)
     fold = {} if cell.fold is None else {"fold": cell.fold}
@@ -71,7 +73,7 @@ def run_cell(cell: Cell) -> dict:
 @dataclass(frozen=True)
 class Execution:
     """Where an experiment's cells run: ``executor`` ('local', 'ray' or 'serial') with ``workers``
-    processes of the local one (None: all cores), as :func:`ptztrack.evaluate.executors.run_cells`
+    processes of the local one (None: all cores), as :func:`ptztrack.loop.executors.execute_cells`
     takes them; ``quiet``: no progress bar (there is none either where stderr is not a terminal)."""
 
     executor: str
@@ -81,6 +83,6 @@ class Execution:
 
 def run_experiment_cells(cells: list, run, execution: Execution, noun: str = "episode", together=None) -> list:
     """An experiment's cells run with ``run`` on ``execution``, counted by a progress bar of ``noun``s;
-    ``together`` as :func:`ptztrack.evaluate.executors.run_cells`'."""
+    ``together`` as :func:`ptztrack.loop.executors.execute_cells`'."""
     with Progress(noun, execution.quiet) as progress:
-        return run_cells(cells, run, execution.executor, execution.workers, progress, together)
+        return execute_cells(cells, run, execution.executor, execution.workers, progress, together)

@@ -16,13 +16,14 @@ from functools import partial
 import numpy as np
 
 from ptztrack.builders.episode import episode_world, make_policy, run_episode
-from ptztrack.builders.follow import follow_parameters, refuse_unknown_people, target_scenario, target_source
+from ptztrack.builders.follow import framing_parameters, refuse_unknown_people, target_scenario, target_source
 from ptztrack.builders.recording import recorded_size_px
 from ptztrack.camera.recorded import RecordedPTZ
 from ptztrack.config import Scenario, ScenarioError
 from ptztrack.follow.evaluation import follow_metrics, one_pass_scores, target_in_views
 from ptztrack.geometry.calibration import load_calibration, standing_height_px
-from ptztrack.loop import Episode, StepObserver, World, episode_seeds
+from ptztrack.loop.steps import Episode, StepObserver, World
+from ptztrack.loop.streams import episode_streams
 from ptztrack.names import OTB_TRACKS
 from ptztrack.roles import Policy
 from ptztrack.scene.pets import Annotations, RecordedVideo, load_mot_ground_truth
@@ -116,7 +117,7 @@ def follow_row(scenario: Scenario, world: World, episode: Episode) -> dict:
     centres_px, heights_px = target_in_views(backend.virtual, target_boxes(world, target_id), episode.poses)
     lost = np.array([tracks.existence[0] == 0 for tracks in episode.tracks])
     camera = world.camera
-    target_point_px = follow_parameters(scenario, camera).target_point_px
+    target_point_px = framing_parameters(scenario, camera).target_point_px
     metrics = follow_metrics(
         centres_px,
         heights_px,
@@ -180,7 +181,7 @@ def run_otb_cell(cell: OnePassCell) -> dict:
         recorded_size_px(recording),
         int(frames[-1]) + 1,
     )
-    rng = np.random.default_rng(episode_seeds(cell.seed)[4])
+    rng = np.random.default_rng(episode_streams(cell.seed).tracker)
     source = target_source(cell.scenario, cell.tracker, rng)
     still = np.eye(3)
     calibration = load_calibration(recording.calibration, recording.view)

@@ -16,7 +16,7 @@ looks at is exactly what the others would also gain by.
 
 Configurations, for ``N`` = 1 to ``max_ptz``: ``Nptz-joint`` (the PTZ cameras
 choose greedily, each on what the views before it are expected to leave:
-:mod:`ptztrack.control.network_policy`), ``Nptz-independent`` (each as if
+:mod:`ptztrack.network.policy`), ``Nptz-independent`` (each as if
 alone), ``Nfixed`` (the same cameras, each at its widest view); for one
 camera joint and independent are the same run, ``1ptz``. With the wide
 camera, the same with ``+wide``, and ``wide`` alone. On the mast, for
@@ -39,8 +39,10 @@ from typing import Literal
 
 import numpy as np
 
-from ptztrack.builders.network import Coordination, run_network_episode
+from ptztrack.builders.episode import run_episode
+from ptztrack.builders.network import Coordination, network_world
 from ptztrack.config import Scenario
+from ptztrack.control.information_policy import InformationMethod
 from ptztrack.evaluate.metrics import DISPLAY, network_metrics, standard_error
 from ptztrack.experiments.cells import Execution, run_experiment_cells
 
@@ -70,7 +72,7 @@ class NetworkCell:
 
     scenario: Scenario
     coordination: Coordination
-    method: Literal["intg", "smpl"]
+    method: InformationMethod
     seed: int
     configuration: Configuration
 
@@ -125,7 +127,7 @@ def network_cells(
     scenario: Scenario,
     sequences: int,
     max_ptz: int = 4,
-    method: Literal["intg", "smpl"] = "intg",
+    method: InformationMethod = "intg",
     first_sequence: int = 0,
 ) -> list[NetworkCell]:
     """Every configuration (:func:`configurations`) on the sequences ``first_sequence`` .. ``first_sequence
@@ -144,7 +146,8 @@ def network_cells(
 def run_network_cell(cell: NetworkCell) -> dict:
     """One cell's metrics (:func:`~ptztrack.evaluate.metrics.network_metrics`), with ``config``, the
     configuration it pairs with (``joint``) and ``seed``."""
-    episode = run_network_episode(cell.scenario, cell.seed, cell.coordination, cell.method)
+    world = network_world(cell.scenario, cell.seed)
+    episode = run_episode(cell.scenario, cell.method, cell.seed, world, coordination=cell.coordination)
     row = {"config": cell.configuration.label, "joint": cell.configuration.pairs_with, "seed": cell.seed}
     return {**row, **network_metrics(episode)}
 

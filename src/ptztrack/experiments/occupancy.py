@@ -13,13 +13,9 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from ptztrack.builders.occupancy import (
-    PLAZA_LEAD_IN_FRAMES,
-    plaza_recording,
-    recording_from_dataset,
-    refuse_if_map_too_large,
-    room_recording,
-)
+from ptztrack.builders.occupancy import recording_from_dataset
+from ptztrack.builders.occupancy_cost import refuse_if_map_too_large
+from ptztrack.builders.occupancy_synthetic import PLAZA_LEAD_IN_FRAMES, plaza_recording, room_recording
 from ptztrack.builders.parameters import parameters_from
 from ptztrack.config import MultiViewDataset, Occupancy, OccupancyTracker, Tracker, pets_dataset
 from ptztrack.names import OCCUPANCY_MAP_METHODS
@@ -38,7 +34,8 @@ from ptztrack.occupancy.feet import fitted_feet_variances
 from ptztrack.occupancy.foreground import ViewForeground, view_foregrounds
 from ptztrack.occupancy.multiview import MultiViewRecording
 from ptztrack.occupancy.parameters import ForegroundParameters, OccupancyParameters, PomParameters
-from ptztrack.occupancy.pom import PomDetector, fitted_box_scales
+from ptztrack.occupancy.pom import PomDetector
+from ptztrack.occupancy.pom_rectangles import fitted_box_scales
 from ptztrack.scene.pets import DatasetError
 from ptztrack.track.parameters import TrackerParameters
 
@@ -52,8 +49,9 @@ PLAZA_PEOPLE = (4, 8)
 POM_WIDTH_CHOICES_M = (0.5, 0.4, 0.3)
 # Where a view has both video and a detector's boxes, its POM mask is its silhouettes (the paper's
 # foreground, first: it wins ties) or its boxes, fitted on the other half with the width; views whose
-# mask is their boxes have their rectangles scaled to the boxes' (:func:`~ptztrack.occupancy.pom.fitted_box_scales`,
-# on the other half too), so the width matters only to views masked by their silhouettes.
+# mask is their boxes have their rectangles scaled to the boxes'
+# (:func:`~ptztrack.occupancy.pom_rectangles.fitted_box_scales`, on the other half too), so the width
+# matters only to views masked by their silhouettes.
 POM_MASK_SOURCES = ("silhouettes", "boxes")
 # The table's columns (a row's key) and their formats.
 OCCUPANCY_COLUMNS = (
@@ -195,7 +193,7 @@ def plaza_runs(
     lead_in_frames: int = PLAZA_LEAD_IN_FRAMES,
 ) -> list[OccupancyRun]:
     """The synthetic plaza with 4 and with 8 people (seeds ``seed`` and ``seed + 1``), each after
-    ``lead_in_frames`` (:func:`~ptztrack.builders.occupancy.plaza_recording`), with the built-in PETS
+    ``lead_in_frames`` (:func:`~ptztrack.builders.occupancy_synthetic.plaza_recording`), with the built-in PETS
     dataset's parameters (its cells and kernel, its tracker), so that its rows compare with PETS's."""
     pets = pets_dataset()
     return [

@@ -3,7 +3,7 @@ detections of its other views as fixed cameras (:mod:`ptztrack.builders.pets_net
 on the built-in PETS 2009 S2.L1, View_001 and six fixed views.
 
 Configurations (N fixed views): ``ptz+Nfixed`` (the PTZ camera deciding jointly with the fixed views'
-expected information, :mod:`ptztrack.control.network_policy`), ``Nfixed`` (the fixed views alone) and ``ptz``
+expected information, :mod:`ptztrack.network.policy`), ``Nfixed`` (the fixed views alone) and ``ptz``
 (the PTZ camera alone: ``experiment pets --detector hog``'s information-gain run of the same beta and
 seeds, step for step). A run with the PTZ camera depends on its seed (its online detector model's
 draws), so it runs on seeds 0 .. n-1, as the PETS table does; the fixed views alone do not depend on it
@@ -21,12 +21,13 @@ published tracking results; the walkable area for a dataset without one).
 
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Literal
 
 import numpy as np
 
-from ptztrack.builders.pets_network import run_pets_network_episode
+from ptztrack.builders.episode import run_episode
+from ptztrack.builders.pets_network import pets_network_world, published_network_parts
 from ptztrack.config import Scenario
+from ptztrack.control.information_policy import InformationMethod
 from ptztrack.evaluate.metrics import DISPLAY, looking_metrics, tracking_metrics, tracks_within, truth_within
 from ptztrack.experiments.cells import Execution, run_experiment_cells
 from ptztrack.geometry.area import rectangle_m
@@ -68,11 +69,11 @@ class PetsNetworkCell:
     ptz: bool
     views: tuple[CameraView, ...]
     seed: int
-    method: Literal["intg", "smpl"] = "intg"
+    method: InformationMethod = "intg"
 
 
 def pets_network_cells(
-    scenario: Scenario, views: Sequence[CameraView], seeds: int, method: Literal["intg", "smpl"] = "intg"
+    scenario: Scenario, views: Sequence[CameraView], seeds: int, method: InformationMethod = "intg"
 ) -> list[PetsNetworkCell]:
     """Every configuration (:data:`CONFIGURATIONS`): on seeds 0 .. ``seeds`` - 1 with the PTZ camera, once
     (seed 0) without it."""
@@ -87,7 +88,9 @@ def run_pets_network_cell(cell: PetsNetworkCell) -> dict:
     """One cell's figures: the tracks inside the walkable area scored (:func:`tracking_metrics`),
     ``mota_all_tracks`` with every track, the ``*_tracking_area`` figures of the tracks and people inside
     the tracking area, and the cameras' detections and zoom."""
-    episode = run_pets_network_episode(cell.scenario, cell.seed, cell.ptz, cell.views, "joint", cell.method)
+    world = pets_network_world(cell.scenario, cell.seed, cell.ptz, cell.views)
+    policy, belief = published_network_parts(cell.scenario, world, cell.ptz, "joint", cell.method)
+    episode = run_episode(cell.scenario, policy, cell.seed, world, tracker=belief)
     scored = tracking_metrics(episode.truth, tracks_within(episode.tracks, episode.area_polygon_m))
     every = tracking_metrics(episode.truth, episode.tracks)
     tracking_area = episode.area_polygon_m

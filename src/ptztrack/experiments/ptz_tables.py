@@ -35,9 +35,10 @@ from ptztrack.builders.world import CameraSpec, DetectorSpec, build_world
 from ptztrack.config import Scenario, scenario_from_dict
 from ptztrack.detect.recall_fit import detection_trials, fit_recall
 from ptztrack.evaluate.metrics import DISPLAY, standard_error
-from ptztrack.experiments.cells import INFORMATION_STRATEGIES, Cell, Execution, run_cell, run_experiment_cells
-from ptztrack.loop import episode_seeds
-from ptztrack.names import PROTOCOLS, STRATEGIES
+from ptztrack.experiments.cells import INFORMATION_STRATEGIES, Cell, Execution, cell_metrics, run_experiment_cells
+from ptztrack.loop.steps import Episode
+from ptztrack.loop.streams import episode_streams
+from ptztrack.names import KEPT_DETECTOR_MODELS, PROTOCOLS, STRATEGIES, PetsProtocol, SyntheticProtocol
 from ptztrack.scene.pets import load_mot_ground_truth
 
 # The strategies that draw from their random stream (the others are deterministic given the detections).
@@ -57,8 +58,8 @@ def _check_strategies(strategies: Sequence[PolicySpec]) -> None:
 
 def synthetic_cells(
     scenario: Scenario,
-    sequences: int,
-    strategies: Sequence[PolicySpec] = STRATEGIES,
+    sequences: int = SyntheticProtocol.sequences,
+    strategies: Sequence[PolicySpec] = SyntheticProtocol.strategies,
     camera: CameraSpec | None = None,
     detector: DetectorSpec | None = None,
 ) -> list[Cell]:
@@ -75,7 +76,7 @@ def seed_matters(scenario: Scenario, strategy: PolicySpec) -> bool:
     """Whether a run of ``strategy`` depends on its seed: a strategy that draws, a detector that does
     (every one but :data:`DETERMINISTIC_DETECTORS`, which find the same people in the same view), or an information-gain
     strategy planning with draws of a detector model it learns."""
-    learning = scenario.detector.model not in ("a-priori", "true") and scenario.detector.kind != "ideal"
+    learning = scenario.detector.model not in KEPT_DETECTOR_MODELS and scenario.detector.kind != "ideal"
     return (
         strategy in RANDOM_STRATEGIES
         or scenario.detector.kind not in DETERMINISTIC_DETECTORS
@@ -85,8 +86,8 @@ def seed_matters(scenario: Scenario, strategy: PolicySpec) -> bool:
 
 def recording_cells(
     scenario: Scenario,
-    betas: Sequence[float],
-    strategies: Sequence[PolicySpec] = STRATEGIES,
+    betas: Sequence[float] = PetsProtocol.betas,
+    strategies: Sequence[PolicySpec] = PetsProtocol.strategies,
     seeds: int = 1,
     fold: int | None = None,
 ) -> list[Cell]:
@@ -107,7 +108,7 @@ def recording_cells(
 
 def shared_views_key(cell: Cell) -> tuple:
     """A key that the cells of a recording table which look at mostly the same views share (for
-    ``run_cells``' ``together``): the information-gain strategies of one fold and beta, whose runs differ
+    ``execute_cells``' ``together``): the information-gain strategies of one fold and beta, whose runs differ
     only in their seed (smpl's Monte Carlo samples) or in how the same objective is computed (intg), so
     that most of their steps choose the same action as each other. Every other cell has a key of its own.
     """
@@ -202,11 +203,11 @@ def protocol_folds(scenario: Scenario, protocol: str) -> list[Fold]:
 def run_table(cells: list[Cell], strategies: Sequence[str], execution: Execution, together=None) -> list[dict]:
     """The cells run on ``execution`` and summarised (:func:`summarise`); refused before any work when
     the runs it holds at once would not fit in the memory available, estimated for the worst of the
-    ``strategies`` (names). ``together`` as :func:`ptztrack.evaluate.executors.run_cells`' (for a
+    ``strategies`` (names). ``together`` as :func:`ptztrack.loop.executors.execute_cells`' (for a
     PETS table, :func:`shared_views_key`)."""
     runs_at_once = 1 if execution.executor == "serial" else min(len(cells), execution.workers or os.cpu_count() or 1)
     refuse_if_too_large(cells[0].scenario, tuple(strategies), runs_at_once)
-    return summarise(run_experiment_cells(cells, run_cell, execution, together=together))
+    return summarise(run_experiment_cells(cells, cell_metrics, execution, together=together))
 
 
 def summarise(rows: Sequence[dict]) -> list[dict]:
@@ -321,7 +322,8 @@ def scene_statistics(scenario: Scenario, sequences: int) -> dict:
     instances = detections = height_sum_px = out_of_view = hidden = 0.0
     for seed in range(sequences):
         episode = run_episode(ideal, "fix", seed)
-        world = build_world(ideal, np.random.default_rng(episode_seeds(seed)[0]))
+        assert isinstance(episode, Episode), "the table's scenario has one camera"
+        world = build_world(ideal, np.random.default_rng(episode_streams(seed).scene))
         present = world.truth.present
         instances += present.sum()
         detections += sum(len(found) for found in episode.detections)

@@ -29,6 +29,7 @@ from ptztrack.evaluate.metrics import episode_metrics
 from ptztrack.evaluate.registration import GROUND_ERRORS, registration_errors
 from ptztrack.experiments.cells import Cell, cell_policy
 from ptztrack.geometry.registration import ReferenceIndex
+from ptztrack.loop.steps import Episode
 from ptztrack.names import POSE_SOURCES
 from ptztrack.scene.pets import RecordedVideo, load_mot_ground_truth
 
@@ -129,6 +130,7 @@ def run_closed_loop_cell(cell: Cell) -> dict:
     (``tracker_pan_err_deg``, ``tracker_tilt_err_deg``, ``tracker_zoom_err_pct``) and the fraction of
     steps whose pose the source gave (``pose_known``)."""
     episode = run_episode(cell.scenario, cell_policy(cell), cell.seed)
+    assert isinstance(episode, Episode), "registration runs one camera"
     error = np.abs(episode.tracker_poses - episode.poses)
     return {
         "pose_source": cell.scenario.pose_feedback.source,

@@ -28,12 +28,19 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from ptztrack.evaluate.metrics import standard_error
-from ptztrack.facecapture.road_camera import ZOOMED_HALF_WIDTH_M, Blob, RoadCamera, Zoom
-from ptztrack.facecapture.roads import RoadScene, RoadSceneConfig, walk_roads
+from ptztrack.facecapture.parameters import (
+    MsgExperimentParameters,
+    RoadCameraParameters,
+    RoadSceneParameters,
+    TrackletTrackerParameters,
+)
+from ptztrack.facecapture.road_camera import Blob, RoadCamera, Zoom
+from ptztrack.facecapture.roads import RoadScene, walk_roads
 from ptztrack.facecapture.scheduler import SCHEDULERS
-from ptztrack.facecapture.tracklets import TrackletTracker, TrackletTrackerConfig
+from ptztrack.facecapture.tracklets import TrackletTracker
+from ptztrack.loop.capture import run_capture_loop
 
-DEFAULT_ZOOM_OUT_SCORE = 5.0
+_EXPERIMENT = MsgExperimentParameters()
 
 
 @dataclass(frozen=True)
@@ -51,37 +58,31 @@ class MsgRun:
 def run_msg(
     scene: RoadScene,
     scheduler: str,
-    config: TrackletTrackerConfig | None = None,
-    zoom_out_score: float = DEFAULT_ZOOM_OUT_SCORE,
+    config: TrackletTrackerParameters | None = None,
+    zoom_out_score: float = _EXPERIMENT.zoom_out_score,
     seed: int = 0,
-    zoomed_half_width_m: float = ZOOMED_HALF_WIDTH_M,
+    zoomed_half_width_m: float = RoadCameraParameters.zoomed_half_width_m,
     steps: int | None = None,
 ) -> MsgRun:
     """Run one scheduler (a name in :data:`SCHEDULERS`) over a scene: ``config`` the tracker's (by
-    default :class:`TrackletTrackerConfig`'s defaults), ``seed`` fixes the capture draws,
+    default :class:`TrackletTrackerParameters`'s defaults), ``seed`` fixes the capture draws,
     ``steps`` stops the run after that many steps (default: all). Only the camera reads the scene, one
     step at a time."""
-    config = config or TrackletTrackerConfig()
+    config = config or TrackletTrackerParameters()
     if scheduler not in SCHEDULERS:
         raise ValueError(f"unknown scheduler {scheduler!r}; expected one of {', '.join(SCHEDULERS)}")
     chosen = SCHEDULERS[scheduler]
     camera_m = (scene.area_m / 2, scene.area_m / 2)
     camera = RoadCamera(scene, camera_m, np.random.default_rng([seed, 2]), zoomed_half_width_m)
     tracker = TrackletTracker(scene.area_m, scene.frame_rate_hz, camera_m, config, chosen.untangling)
-    zooms, captures = [], []
-    zoom = None
-    for step in range(len(scene.positions_m) if steps is None else steps):
-        zoomed_in = zoom is not None and step <= zoom.capture_step
-        observation = camera.observe(step, zoom if zoomed_in else None)
-        tracker.update(observation)
-        if observation.capture is not None:
-            captures.append((step, observation.capture.face))
-        if zoomed_in:
-            continue
+
+    def decide(step: int) -> tuple[Zoom, int] | None:
         candidate = chosen.choose(tracker, step, zoom_out_score)
-        zoom = None if candidate is None else Zoom(candidate.blob, candidate.aim_m, step + config.zoom_steps)
-        if candidate is not None:
-            zooms.append((step, candidate.vertex))
+        if candidate is None:
+            return None
+        return Zoom(candidate.blob, candidate.aim_m, step + config.zoom_steps), candidate.vertex
+
+    zooms, captures = run_capture_loop(camera, tracker, decide, len(scene.positions_m) if steps is None else steps)
     return MsgRun(tracker.graph, camera.blobs, zooms, captures, labelled_fraction(tracker.graph, camera.blobs))
 
 
@@ -116,34 +117,24 @@ def labelled_reach(graph: nx.DiGraph) -> dict:
     return reach
 
 
-# The experiment's scenes: walkers who stay a while and meet often, so that a
-# few dozen of them reach the paper's range of N_j/s (0-40).
-EXPERIMENT_SCENE = RoadSceneConfig(
-    meet_radius_m=3.0, group_duration_s=(3.0, 10.0), stay_s=(40.0, 90.0), duration_s=150.0, entry_window_s=(0.0, 60.0)
-)
-PEOPLE_RANGE = (8, 26)
-JOIN_PROBABILITY_RANGE = (0.1, 0.95)
-BIN_WIDTH = 5
-
-
 @dataclass(frozen=True)
 class MsgCell:
     """One simulation of the experiment, run by every scheduler: its seed fixes the scene and the capture draws."""
 
     seed: int
-    scene: RoadSceneConfig
-    tracker: TrackletTrackerConfig = TrackletTrackerConfig()
-    zoom_out_score: float = DEFAULT_ZOOM_OUT_SCORE
-    zoomed_half_width_m: float = ZOOMED_HALF_WIDTH_M
+    scene: RoadSceneParameters
+    tracker: TrackletTrackerParameters = TrackletTrackerParameters()
+    zoom_out_score: float = _EXPERIMENT.zoom_out_score
+    zoomed_half_width_m: float = RoadCameraParameters.zoomed_half_width_m
 
 
-def msg_cells(runs: int, base: RoadSceneConfig = EXPERIMENT_SCENE) -> list[MsgCell]:
+def msg_cells(runs: int, base: RoadSceneParameters = _EXPERIMENT.scene) -> list[MsgCell]:
     """``runs`` simulations across ambiguity levels: people and join probability drawn per run from its seed."""
     cells = []
     for seed in range(runs):
         rng = np.random.default_rng([seed, 1])
-        people = int(rng.integers(*PEOPLE_RANGE))
-        join_probability = float(rng.uniform(*JOIN_PROBABILITY_RANGE))
+        people = int(rng.integers(*_EXPERIMENT.people_range))
+        join_probability = float(rng.uniform(*_EXPERIMENT.join_probability_range))
         cells.append(MsgCell(seed, replace(base, people=people, join_probability=join_probability)))
     return cells
 
@@ -170,7 +161,7 @@ def run_msg_cell(cell: MsgCell) -> list[dict]:
     return rows
 
 
-def summarise_by_ambiguity(rows: list[dict], bin_width: int = BIN_WIDTH) -> list[dict]:
+def summarise_by_ambiguity(rows: list[dict], bin_width: int = _EXPERIMENT.bin_width) -> list[dict]:
     """Per scheduler and N_j/s bin centred on a multiple of ``bin_width`` (``nj_s`` the centre, the bin
     [nj_s - bin_width / 2, nj_s + bin_width / 2)): runs, mean M and its standard deviation."""
     summary = []
@@ -192,12 +183,8 @@ def summarise_by_ambiguity(rows: list[dict], bin_width: int = BIN_WIDTH) -> list
     return summary
 
 
-# The paper's key ambiguity level ("for moderate ambiguity of N_j/s = 15"): the bin centred there.
-KEY_NJ_S = 15
-
-
 def paired_difference_m(
-    rows: list[dict], first: str, second: str, nj_s: int | None = None, bin_width: int = BIN_WIDTH
+    rows: list[dict], first: str, second: str, nj_s: int | None = None, bin_width: int = _EXPERIMENT.bin_width
 ) -> tuple[float, float, int]:
     """M of scheduler ``first`` minus M of ``second``, paired by run (seed): mean, its standard error and
     the number of runs; over all runs, or those in the N_j/s bin centred on ``nj_s``."""
@@ -212,7 +199,7 @@ def paired_difference_m(
     return float(difference.mean()), standard_error(difference), int(difference.size)
 
 
-def format_paired_differences(rows: list[dict], first: str = "msg", nj_s: int = KEY_NJ_S) -> str:
+def format_paired_differences(rows: list[dict], first: str = "msg", nj_s: int = _EXPERIMENT.key_nj_s) -> str:
     """``first`` minus every other scheduler, paired by run: mean +- standard error, over all runs and in
     the bin centred on ``nj_s``; then each scheduler's faces captured per capture tried."""
     schedulers = [name for name in dict.fromkeys(row["scheduler"] for row in rows) if name != first]
@@ -246,7 +233,7 @@ def format_ambiguity_table(summary: list[dict]) -> str:
     return "\n".join(lines)
 
 
-def ambiguity_figure(rows: list[dict], bin_width: int = BIN_WIDTH) -> Figure:
+def ambiguity_figure(rows: list[dict], bin_width: int = _EXPERIMENT.bin_width) -> Figure:
     """M against N_j/s per scheduler, mean and standard deviation per bin, like the paper's Figure 7."""
     figure = Figure(figsize=(7, 4.5))
     axes = figure.add_subplot()

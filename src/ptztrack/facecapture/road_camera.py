@@ -28,11 +28,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ptztrack.facecapture.parameters import RoadCameraParameters
 from ptztrack.facecapture.roads import RoadScene
 from ptztrack.facecapture.tracklets import FaceCapture, Observation, UnitSighting
-
-# The zoomed view is 1.2 m wide on the ground: a 0.15 m face then spans 1/8 of the image (80 px of 640).
-ZOOMED_HALF_WIDTH_M = 0.6
 
 
 @dataclass(frozen=True)
@@ -83,7 +81,7 @@ class RoadCamera:
         scene: RoadScene,
         camera_m: tuple[float, float],
         rng: np.random.Generator,
-        zoomed_half_width_m: float = ZOOMED_HALF_WIDTH_M,
+        zoomed_half_width_m: float = RoadCameraParameters.zoomed_half_width_m,
     ):
         self.scene, self.camera_m, self.zoomed_half_width_m = scene, np.asarray(camera_m, float), zoomed_half_width_m
         self.capture_draws = rng.random(scene.group_id.shape)

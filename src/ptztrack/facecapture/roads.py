@@ -32,59 +32,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ptztrack.facecapture.parameters import RoadSceneParameters
+
 _EPS = 1e-9
 # Direction codes 0-3 walk along +w1, +w2, -w1, -w2: axis = code % 2, back = (code + 2) % 4.
 _HEADINGS = np.array([[1.0, 1.0], [1.0, -1.0], [-1.0, -1.0], [-1.0, 1.0]]) / np.sqrt(2)
-
-
-@dataclass(frozen=True)
-class RoadSceneConfig:
-    """Parameters of the road-grid scene; times in seconds, lengths in metres. Checked when made:
-    a ValueError names the parameter."""
-
-    area_m: float = 40.0
-    road_spacing_m: float = 10.0
-    duration_s: float = 120.0
-    frame_rate_hz: float = 5.0
-    people: int = 12
-    entry_window_s: tuple[float, float] = (0.0, 90.0)
-    speed_m_s: tuple[float, float] = (0.8, 1.6)
-    turn_probability: float = 0.5
-    meet_radius_m: float = 1.5
-    join_probability: float = 0.5
-    group_duration_s: tuple[float, float] = (5.0, 25.0)
-    refractory_s: float = 5.0
-    # How long a walker wants to stay; until then it turns away from the border at intersections.
-    # None: it leaves at the first border it walks to.
-    stay_s: tuple[float, float] | None = None
-
-    def __post_init__(self):
-        for name in ("area_m", "road_spacing_m", "duration_s", "frame_rate_hz", "meet_radius_m"):
-            if not getattr(self, name) > 0:
-                raise ValueError(f"{name} must be positive (got {getattr(self, name)!r})")
-        for name in ("people", "refractory_s"):
-            if not getattr(self, name) >= 0:
-                raise ValueError(f"{name} must be at least 0 (got {getattr(self, name)!r})")
-        for name in ("turn_probability", "join_probability"):
-            if not 0 <= getattr(self, name) <= 1:
-                raise ValueError(f"{name} must be a probability in [0, 1] (got {getattr(self, name)!r})")
-        for name in ("entry_window_s", "speed_m_s", "group_duration_s", "stay_s"):
-            if getattr(self, name) is None:
-                continue
-            low, high = getattr(self, name)
-            if not 0 <= low <= high:
-                raise ValueError(f"{name} must be [low, high] with 0 <= low <= high (got {[low, high]})")
-        if self.speed_m_s[0] <= 0:
-            raise ValueError(f"speed_m_s must be positive (got {list(self.speed_m_s)})")
-        if self.entry_window_s[1] > self.duration_s:
-            raise ValueError("entry_window_s must end within duration_s")
-        # The stepping handles one intersection per step, and a unit within
-        # meet_radius_m of an intersection must have it as its next one.
-        block_m = self.road_spacing_m / np.sqrt(2)
-        if self.speed_m_s[1] / self.frame_rate_hz >= block_m:
-            raise ValueError("speed_m_s / frame_rate_hz must stay below road_spacing_m / sqrt(2)")
-        if self.meet_radius_m >= block_m:
-            raise ValueError("meet_radius_m must stay below road_spacing_m / sqrt(2)")
 
 
 @dataclass(frozen=True)
@@ -129,7 +81,7 @@ def joins_and_splits(scene: RoadScene) -> np.ndarray:
     return (present[:-1] & present[1:] & ~alone[:-1] & alone[1:]).sum(axis=0)
 
 
-def walk_roads(config: RoadSceneConfig, rng: np.random.Generator) -> RoadScene:
+def walk_roads(config: RoadSceneParameters, rng: np.random.Generator) -> RoadScene:
     """Simulate ``config.people`` walkers for ``config.duration_s``; the same rng state gives the same scene."""
     return _Walk(config, rng).run()
 
@@ -158,7 +110,7 @@ class _Walk:
     the unit's state (position, direction, speed), so walking everybody walks the groups.
     """
 
-    def __init__(self, config: RoadSceneConfig, rng: np.random.Generator):
+    def __init__(self, config: RoadSceneParameters, rng: np.random.Generator):
         self.c, self.rng, n = config, rng, config.people
         self.idx, self.dt = np.arange(n), 1.0 / config.frame_rate_hz
         self.bound = 2 * config.area_m / config.road_spacing_m

@@ -35,12 +35,10 @@ from dataclasses import dataclass
 import networkx as nx
 
 from ptztrack.facecapture.msg import refresh
+from ptztrack.facecapture.parameters import SchedulerParameters
 from ptztrack.facecapture.tracklets import TrackletTracker
 
-# alpha's boost for a source and beta for a target expected to leave within this many zoom durations.
-SOURCE_WEIGHT = 2.0
-SINK_WEIGHT = 2.0
-SINK_HORIZON_ZOOMS = 2.0
+_WEIGHTS = SchedulerParameters()
 
 
 @dataclass(frozen=True)
@@ -87,8 +85,10 @@ def labeling_score(graph: nx.DiGraph, candidate: Candidate, zoom_steps: int, fut
     node = graph.nodes[candidate.vertex]
     future = future_term * candidate.joins_soon * node["n_notL"] / node["n_o"]
     past = (node["dL_dir"] + node["L_notdir"]) / node["n_o"]
-    alpha = min(candidate.steps_to_exit, 1e6) * (SOURCE_WEIGHT if graph.in_degree(candidate.vertex) == 0 else 1.0)
-    beta = SINK_WEIGHT if candidate.steps_to_exit <= SINK_HORIZON_ZOOMS * zoom_steps else 1.0
+    alpha = min(candidate.steps_to_exit, 1e6) * (
+        _WEIGHTS.source_weight if graph.in_degree(candidate.vertex) == 0 else 1.0
+    )
+    beta = _WEIGHTS.sink_weight if candidate.steps_to_exit <= _WEIGHTS.sink_horizon_zooms * zoom_steps else 1.0
     return alpha * future + beta * past
 
 

@@ -39,6 +39,7 @@ import networkx as nx
 import numpy as np
 
 from ptztrack.facecapture import msg
+from ptztrack.facecapture.parameters import TrackletTrackerParameters
 
 
 @dataclass(frozen=True)
@@ -79,25 +80,6 @@ class Observation:
 
 
 @dataclass(frozen=True)
-class TrackletTrackerConfig:
-    """The tracker's parameters (all fixed a priori; the face-capture page of the docs lists their sources).
-
-    zoom_steps : how long a face capture keeps the camera zoomed in; the capture comes at its last step.
-    join_horizon_s : how far ahead a predicted meeting counts as Join(v).
-    meeting_distance_m : a closest approach within this is a predicted meeting.
-    gate_margin_m : gate radius for a unit seen again after a blind gap, on top of the distance the lost
-        tracklet walks in the gap at its own speed.
-    prior_speed_m_s : the walking speed assumed for a unit not seen at the step before.
-    """
-
-    zoom_steps: int = 10
-    join_horizon_s: float = 8.0
-    meeting_distance_m: float = 2.0
-    gate_margin_m: float = 0.5
-    prior_speed_m_s: float = 1.2
-
-
-@dataclass(frozen=True)
 class Track:
     """A unit's state when last seen: at ``step``, position_m (2,), velocity_m_s (2,), heading (2,), count."""
 
@@ -120,7 +102,7 @@ class TrackletTracker:
     area_m: float
     frame_rate_hz: float
     camera_m: tuple[float, float]
-    config: TrackletTrackerConfig = TrackletTrackerConfig()
+    config: TrackletTrackerParameters = TrackletTrackerParameters()
     untangling: bool = True
     graph: nx.DiGraph = field(default_factory=msg.new_graph)
     vertex_of: dict[int, int] = field(default_factory=dict)  # blob in view -> its tracklet

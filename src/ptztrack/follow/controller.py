@@ -44,6 +44,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ptztrack.follow.parameters import FollowParameters
 from ptztrack.geometry.ptz import PAN, TILT, ZOOM, PTZCamera, aim_at, project_people
 from ptztrack.types import DecisionContext
 
@@ -54,40 +55,37 @@ FRAMING_ITERATIONS = 3
 
 
 @dataclass(frozen=True)
-class FollowParameters:
-    """The controller's parameters.
+class FramingParameters:
+    """The controller's parameters: the follow camera's (its target height, motion limits and zoom range)
+    and what the camera and the run fix.
 
-    target_point_px : (2,) (x*, y*) where the person's middle should be; target_height_px : their height.
+    follow : the follow camera's parameters (:class:`~ptztrack.follow.parameters.FollowParameters`).
+    target_point_px : (2,) (x*, y*) where the person's middle should be (``follow.target_point_px``, or
+    the image centre where that is None).
     person_height_m, person_width_m : the person assumed (their middle is at half the height).
-    max_speed_deg_s, max_acceleration_deg_s2 : of pan and of tilt.
-    max_zoom_speed, max_zoom_acceleration : of the natural logarithm of the zoom, per s and per s^2.
-    zoom_range : (lowest, highest) zoom.
     step_s : seconds per step.
     """
 
+    follow: FollowParameters
     target_point_px: np.ndarray
-    target_height_px: float
     person_height_m: float
     person_width_m: float
-    max_speed_deg_s: float
-    max_acceleration_deg_s2: float
-    max_zoom_speed: float
-    max_zoom_acceleration: float
-    zoom_range: tuple[float, float]
     step_s: float
 
     @property
     def max_speed(self) -> np.ndarray:
         """(3,) pan deg/s, tilt deg/s, log zoom per s."""
-        return np.array([self.max_speed_deg_s, self.max_speed_deg_s, self.max_zoom_speed])
+        follow = self.follow
+        return np.array([follow.max_speed_deg_s, follow.max_speed_deg_s, follow.max_zoom_speed])
 
     @property
     def max_acceleration(self) -> np.ndarray:
         """(3,) pan deg/s^2, tilt deg/s^2, log zoom per s^2."""
-        return np.array([self.max_acceleration_deg_s2, self.max_acceleration_deg_s2, self.max_zoom_acceleration])
+        follow = self.follow
+        return np.array([follow.max_acceleration_deg_s2, follow.max_acceleration_deg_s2, follow.max_zoom_acceleration])
 
 
-def framing_pose(camera: PTZCamera, position_m, current_pose, parameters: FollowParameters) -> np.ndarray:
+def framing_pose(camera: PTZCamera, position_m, current_pose, parameters: FramingParameters) -> np.ndarray:
     """The pose (3,) that shows a person standing at ``position_m`` (2,) at (x*, y*), target_height_px tall.
 
     The zoom is within ``zoom_range`` and no more than keeps the person's whole box in the image at
@@ -98,12 +96,12 @@ def framing_pose(camera: PTZCamera, position_m, current_pose, parameters: Follow
     zoom = float(current_pose[ZOOM])
     for _ in range(FRAMING_ITERATIONS):
         pose = aim_at(camera, middle_m, parameters.target_point_px, zoom)
-        wanted = parameters.target_height_px / _height_at_zoom_1(camera, pose, position_m, parameters)
-        zoom = float(np.clip(min(wanted, in_view_zoom), *parameters.zoom_range))
+        wanted = parameters.follow.target_height_px / _height_at_zoom_1(camera, pose, position_m, parameters)
+        zoom = float(np.clip(min(wanted, in_view_zoom), *parameters.follow.zoom_range))
     return aim_at(camera, middle_m, parameters.target_point_px, zoom)
 
 
-def _height_at_zoom_1(camera: PTZCamera, pose, position_m, parameters: FollowParameters) -> float:
+def _height_at_zoom_1(camera: PTZCamera, pose, position_m, parameters: FramingParameters) -> float:
     """The person's height in pixels at ``pose``'s pan and tilt and zoom 1 (pixel sizes scale with the zoom)."""
     people = project_people(
         camera,
@@ -115,13 +113,13 @@ def _height_at_zoom_1(camera: PTZCamera, pose, position_m, parameters: FollowPar
     return float(people.height_px[0])
 
 
-def _zoom_keeping_in_view(camera: PTZCamera, pose, position_m, parameters: FollowParameters) -> float:
+def _zoom_keeping_in_view(camera: PTZCamera, pose, position_m, parameters: FramingParameters) -> float:
     """The highest zoom at ``pose``'s pan and tilt at which the person's box lies inside the image."""
     people = project_people(
         camera, pose, np.asarray(position_m)[None], parameters.person_height_m, parameters.person_width_m
     )
     if not people.in_front[0]:
-        return parameters.zoom_range[0]
+        return parameters.follow.zoom_range[0]
     corners = people.box_px[0].reshape(2, 2)  # (left, top), (right, bottom)
     # Zooming about the principal point scales every offset from it by the zoom ratio.
     offset = np.abs(corners - camera.principal_point_px).max(axis=0)
@@ -135,7 +133,7 @@ class FollowPolicy:
     :class:`ptztrack.roles.Policy`); holds still while there is none."""
 
     camera: PTZCamera
-    parameters: FollowParameters
+    parameters: FramingParameters
     velocity: np.ndarray = field(default_factory=lambda: np.zeros(3))
 
     def choose(self, context: DecisionContext) -> np.ndarray:
@@ -156,7 +154,7 @@ class FollowPolicy:
         self.velocity = self.velocity + change
         pan_deg, tilt_deg = current[:ZOOM] + self.velocity[:ZOOM] * p.step_s
         log_zoom = np.log(current[ZOOM]) + self.velocity[ZOOM] * p.step_s
-        held = float(np.clip(log_zoom, *np.log(p.zoom_range)))
+        held = float(np.clip(log_zoom, *np.log(p.follow.zoom_range)))
         if held != log_zoom:  # at a zoom limit the zoom stops
             self.velocity[ZOOM] = (held - np.log(current[ZOOM])) / p.step_s
         return np.array([(pan_deg + 180.0) % 360.0 - 180.0, tilt_deg, np.exp(held)])

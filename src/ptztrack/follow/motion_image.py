@@ -13,7 +13,7 @@ previous view did not see are *unknown*: they hold no motion and the
 likelihood ignores them.
 
 While the camera moves between poses. The closed loop images each step at
-the pose the camera lands on (:func:`ptztrack.loop.run_loop`), so two
+the pose the camera lands on (:func:`ptztrack.loop.simulated.run_loop`), so two
 frames are two exact views of one centre and the homography registers
 them up to resampling. What a real camera adds (the pose known only to the
 pose source's accuracy, a frame exposed while turning) misregisters edges

@@ -8,7 +8,7 @@ from typing import Literal
 
 
 @dataclass(frozen=True)
-class FollowSettings:
+class FollowParameters:
     """The follow camera (the robot-cameraman paper, Nair et al. 2008): one person kept at an image point
     and size. Each default's source is in the docs (the follow camera's parameters); none was tuned on PETS.
 

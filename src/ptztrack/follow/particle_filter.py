@@ -82,7 +82,7 @@ import numpy as np
 
 from ptztrack.follow import colour_model
 from ptztrack.follow.motion_image import MotionImage, first_motion_image, next_motion_image, non_motion_fraction
-from ptztrack.follow.parameters import FollowSettings
+from ptztrack.follow.parameters import FollowParameters
 from ptztrack.geometry.ptz import apply_homography
 
 # A box is never smaller than this many pixels high: the random walk would otherwise shrink one
@@ -155,7 +155,7 @@ def smoothing_pole(cutoff_hz: float, frame_rate_hz: float) -> float:
     return float(np.exp(-2 * np.pi * cutoff_hz / frame_rate_hz))
 
 
-def particle_filter_parameters(settings: FollowSettings, frame_rate_hz: float) -> ParticleFilterParameters:
+def particle_filter_parameters(settings: FollowParameters, frame_rate_hz: float) -> ParticleFilterParameters:
     """The filter's per-step parameters from the follow camera's (rates per second) at ``frame_rate_hz``."""
     step_s = 1.0 / frame_rate_hz
     return ParticleFilterParameters(

@@ -10,7 +10,8 @@ the "detector and clustering" baseline of the multi-view literature.
 * :mod:`~ptztrack.occupancy.locus`: the person model (connected cones) and a pixel's locus;
 * :mod:`~ptztrack.occupancy.lpom`: the ground grid, the locus tables, the map and its modes;
 * :mod:`~ptztrack.occupancy.pom`: the probabilistic occupancy map of Fleuret et al. (TPAMI 2008) from
-  foreground masks, by mean field;
+  foreground masks, by mean field, and :mod:`~ptztrack.occupancy.pom_rectangles`: its person rectangles
+  and masks at the working resolution;
 * :mod:`~ptztrack.occupancy.feet`: a candidate's position from the views' box feet near it;
 * :mod:`~ptztrack.occupancy.motion_edges`: a view's evidence (motion edges, box outlines);
 * :mod:`~ptztrack.occupancy.foreground`: a view's evidence from a background model (silhouettes, their edges);

@@ -30,9 +30,9 @@ from ptztrack.occupancy.lpom import (
     sampled_heights,
     table_map,
 )
-from ptztrack.occupancy.motion_edges import MotionEdgeParameters, box_outline_points, motion_edges
+from ptztrack.occupancy.motion_edges import box_outline_points, motion_edges
 from ptztrack.occupancy.multiview import CameraView, MultiViewRecording
-from ptztrack.occupancy.parameters import OccupancyParameters
+from ptztrack.occupancy.parameters import MotionEdgeParameters, OccupancyParameters
 
 
 @dataclass(frozen=True)
@@ -70,8 +70,7 @@ def lpom_parameters(parameters: OccupancyParameters) -> LpomParameters:
         kernel_sigma_m=parameters.kernel_sigma_m,
         separation_m=parameters.separation_m,
         window_m=parameters.window_m,
-        # Candidates well below any threshold the fit may choose (its smallest is 0.05).
-        candidate_strength=0.02,
+        candidate_strength=parameters.candidate_strength,
         block_px=parameters.block_px,
         edges=edges,
         outline_points_per_box=parameters.outline_points_per_box,

@@ -36,6 +36,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ptztrack.occupancy.parameters import ConeShapeParameters, OccupancyParameters
+
 
 @dataclass(frozen=True)
 class ConeModel:
@@ -61,16 +63,11 @@ class ConeModel:
             raise ValueError("radius_fraction must be non-negative")
 
 
-# The default person: legs together as one cone from the feet (0.10 m radius
-# at 0.5 m width) to the hips at half the height, the torso widening to the
-# shoulders (0.25 m radius, so the model is 0.5 m wide, the synthetic
-# scene's person width), then narrowing through the neck to the top of the
-# head. Knot heights follow the usual proportions of an adult body
-# (hips at about 0.5 of the height, shoulders at 0.8, chin at 0.87).
+# The default person (:class:`~ptztrack.occupancy.parameters.ConeShapeParameters`).
 PERSON = ConeModel(
-    height_fraction=(0.0, 0.5, 0.8, 0.87, 0.93, 1.0),
-    radius_fraction=(0.2, 0.34, 0.5, 0.2, 0.2, 0.08),
-    width_m=0.5,
+    height_fraction=ConeShapeParameters.height_fraction,
+    radius_fraction=ConeShapeParameters.radius_fraction,
+    width_m=OccupancyParameters.width_m,
 )
 
 

@@ -10,22 +10,10 @@ sides of a box are where the person's silhouette touches the rays, as the
 locus's touch constraint assumes, which the box's interior is not.
 """
 
-from dataclasses import dataclass
-
 import cv2
 import numpy as np
 
-
-@dataclass(frozen=True)
-class MotionEdgeParameters:
-    """canny_low, canny_high : Canny's hysteresis thresholds (grey levels of the gradient);
-    difference_threshold : grey levels of change that count as motion; dilation_px : how far
-    (square neighbourhood of this half-size) from a changed pixel an edge still counts."""
-
-    canny_low: float
-    canny_high: float
-    difference_threshold: float
-    dilation_px: int
+from ptztrack.occupancy.parameters import MotionEdgeParameters
 
 
 def motion_edges(previous_bgr, current_bgr, parameters: MotionEdgeParameters) -> np.ndarray:

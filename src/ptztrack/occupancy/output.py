@@ -18,9 +18,9 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from ptztrack.evaluate.video import write_video
 from ptztrack.files import write_atomically, write_json
 from ptztrack.occupancy.evaluation import MATCH_RADIUS_M, OccupancyRun
+from ptztrack.view.video import write_video
 
 PICTURE_WIDTH_PX = 600
 CAPTION_PX = 28

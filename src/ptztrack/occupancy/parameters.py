@@ -3,6 +3,40 @@ configuration maps onto (:mod:`ptztrack.config` takes its defaults from here).""
 
 from dataclasses import dataclass
 
+from ptztrack.scene.parameters import PersonParameters
+
+
+@dataclass(frozen=True)
+class MotionEdgeParameters:
+    """A view's motion edges (:mod:`ptztrack.occupancy.motion_edges`).
+
+    canny_low, canny_high : Canny's hysteresis thresholds (grey levels of the gradient);
+    difference_threshold : grey levels of change that count as motion; dilation_px : how far
+    (square neighbourhood of this half-size) from a changed pixel an edge still counts.
+    """
+
+    canny_low: float = 50.0
+    canny_high: float = 150.0
+    difference_threshold: float = 15.0
+    dilation_px: int = 2
+
+
+@dataclass(frozen=True)
+class ConeShapeParameters:
+    """The default person of the locus model (:class:`ptztrack.occupancy.locus.ConeModel`, equation 4):
+    legs together as one cone from the feet (0.10 m radius at 0.5 m width) to the hips at half the
+    height, the torso widening to the shoulders (0.25 m radius, so the model is 0.5 m wide, the
+    synthetic scene's person width), then narrowing through the neck to the top of the head. Knot
+    heights follow the usual proportions of an adult body (hips at about 0.5 of the height, shoulders
+    at 0.8, chin at 0.87).
+
+    height_fraction : the knots' heights as fractions of the person's height; radius_fraction : the
+    radius at each knot as a fraction of the width.
+    """
+
+    height_fraction: tuple[float, ...] = (0.0, 0.5, 0.8, 0.87, 0.93, 1.0)
+    radius_fraction: tuple[float, ...] = (0.2, 0.34, 0.5, 0.2, 0.2, 0.08)
+
 
 @dataclass(frozen=True)
 class OccupancyParameters:
@@ -12,8 +46,11 @@ class OccupancyParameters:
     height_step_m (at the steps' midpoints), width_m, samples_per_height tangent points per height.
     Map: cell_m, kernel_sigma_m (the Gaussian kernel), block_px (locus tables per block of pixels).
     Modes: separation_m (closest two people), window_m (their mean and covariance); the strength a
-    mode needs (a fraction of the frame's strongest) is fitted on the other half of the frames.
-    Motion edges: canny_low, canny_high, difference_threshold (grey levels), dilation_px.
+    mode needs (a fraction of the frame's strongest) is fitted on the other half of the frames;
+    candidate_strength: modes weaker than this fraction of the strongest are not even candidates, well
+    below any threshold the fit may choose (its smallest is 0.05).
+    Motion edges: canny_low, canny_high, difference_threshold (grey levels), dilation_px
+    (:class:`MotionEdgeParameters`'s defaults).
     Boxes: outline_points_per_box, min_box_score. Baseline: linkage_m (complete-linkage cut),
     blob_min_area_px (blob boxes of views without detections); the views a cluster needs are fitted
     like the modes' strength.
@@ -29,14 +66,15 @@ class OccupancyParameters:
     block_px: int = 4
     separation_m: float = 0.5
     window_m: float = 0.25
-    canny_low: float = 50.0
-    canny_high: float = 150.0
-    difference_threshold: float = 15.0
-    dilation_px: int = 2
+    canny_low: float = MotionEdgeParameters.canny_low
+    canny_high: float = MotionEdgeParameters.canny_high
+    difference_threshold: float = MotionEdgeParameters.difference_threshold
+    dilation_px: int = MotionEdgeParameters.dilation_px
     outline_points_per_box: int = 64
     min_box_score: float = 0.5
     linkage_m: float = 1.0
     blob_min_area_px: int = 400
+    candidate_strength: float = 0.02
 
 
 @dataclass(frozen=True)
@@ -49,9 +87,10 @@ class PomParameters:
     :func:`ptztrack.occupancy.evaluation.fitted_prior`); sigma scales the pseudo-distance Psi between a foreground
     mask and a synthetic image, 0.01, that software's value too (there the spread of a Gaussian on the same
     normalised distance, here its scale as in the paper's equation). A person at a cell is a vertical cylinder
-    height_m tall and width_m across, whose projection's bounding box is the cell's rectangle: 1.75 m, the middle of
-    OccupancyParameters' heights (1.6-1.9 m, the synthetic room's people), and 0.5 m, OccupancyParameters.width_m
-    (the cone model's widest diameter, the room's person width). Grid: cell_m, 0.25 m, half a person's width (the
+    height_m tall and width_m across, whose projection's bounding box is the cell's rectangle: 1.75 m,
+    PersonParameters.height_m (the middle of OccupancyParameters' heights, 1.6-1.9 m, the synthetic room's
+    people), and 0.5 m, OccupancyParameters.width_m (the cone model's widest diameter, the room's person
+    width). Grid: cell_m, 0.25 m, half a person's width (the
     prior is per cell, so it goes with the cell).
     Working resolution: the masks are averaged over block_px x block_px pixel blocks and the rectangles
     snapped to the blocks; 4 makes the room's 1024 x 768 views 256 x 192, near the 360 x 288 video of
@@ -77,8 +116,8 @@ class PomParameters:
 
     prior: float = 0.01
     sigma: float = 0.01
-    height_m: float = 1.75
-    width_m: float = 0.5
+    height_m: float = PersonParameters.height_m
+    width_m: float = OccupancyParameters.width_m
     cell_m: float = 0.25
     block_px: int = 4
     damping: float = 0.8

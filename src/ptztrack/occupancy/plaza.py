@@ -4,7 +4,7 @@ The synthetic room (:mod:`ptztrack.occupancy.room`) has four near, steep cameras
 are far and shallow: three stand 8-70 m outside the area people walk in, 6-7 m high, four at its
 edge about 2 m high, all looking down at 3-21 degrees. The plaza renders any calibrated cameras
 (the builders pass S2.L1's seven, with its ground area and frame rate:
-:func:`ptztrack.builders.occupancy.plaza_recording`) with the shared renderer
+:func:`ptztrack.builders.occupancy_synthetic.plaza_recording`) with the shared renderer
 (:mod:`ptztrack.scene.render`): paving of 1 m slabs over the whole ground, facades 15 m high
 standing 5 m beyond the area and every camera, a plain sky above. People walk over the area as in
 :mod:`ptztrack.scene.synthetic`, most of them in pairs side by side 0.6 m apart, as S2.L1's groups
@@ -16,7 +16,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ptztrack.geometry.calibration import PinholeCalibration
-from ptztrack.scene.parameters import Crowd
+from ptztrack.scene.parameters import CrowdParameters
 from ptztrack.scene.render import Stage, stage_around
 from ptztrack.scene.synthetic import walk_people
 from ptztrack.types import GroundTruth
@@ -52,10 +52,10 @@ def plaza_stage(layout: PlazaLayout, cameras: list[PinholeCalibration]) -> Stage
     return stage_around(layout.area_m, cameras, layout.margin_m, layout.facade_height_m, layout.tile_m)
 
 
-def plaza_crowd(layout: PlazaLayout, people: int) -> Crowd:
+def plaza_crowd(layout: PlazaLayout, people: int) -> CrowdParameters:
     """The walkers of :func:`plaza_truth`: ``people`` of them, present throughout, turning as the
-    synthetic scene's walkers do (:class:`~ptztrack.scene.parameters.Crowd`'s defaults)."""
-    return Crowd(
+    synthetic scene's walkers do (:class:`~ptztrack.scene.parameters.CrowdParameters`'s defaults)."""
+    return CrowdParameters(
         count=people,
         speed_m_s=layout.speed_m_s,
         height_m=layout.height_m,

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ptztrack.geometry.calibration import PinholeCalibration, aimed_pinhole
-from ptztrack.scene.parameters import Crowd
+from ptztrack.scene.parameters import CrowdParameters
 from ptztrack.scene.render import SceneRenderer, Stage
 from ptztrack.scene.synthetic import walk_people
 from ptztrack.types import GroundTruth
@@ -72,7 +72,7 @@ class RoomRenderer(SceneRenderer):
 def room_truth(layout: RoomLayout, people: int, frames: int, seed: int) -> GroundTruth:
     """People walking in the room for ``frames`` frames: 0.5-1.2 m/s (indoor walking), 1.6-1.9 m tall,
     0.5 m wide, present throughout."""
-    crowd = Crowd(
+    crowd = CrowdParameters(
         count=people,
         paired_fraction=0.0,
         pair_spacing_m=0.0,

@@ -1,11 +1,22 @@
-"""The synthetic crowd's parameters and their defaults, plain data that the configuration maps onto
-(:mod:`ptztrack.config` takes its defaults from here)."""
+"""The synthetic crowd's and the assumed person's parameters and their defaults, plain data that the
+configuration maps onto (:mod:`ptztrack.config` takes its defaults from here)."""
 
 from dataclasses import dataclass
 
 
 @dataclass(frozen=True)
-class Crowd:
+class PersonParameters:
+    """The standing person the policies, the baselines and the occupancy maps assume when they do not
+    know who stands there.
+
+    height_m : their height (m), the middle of the synthetic crowd's heights (1.6-1.9 m).
+    """
+
+    height_m: float = 1.75
+
+
+@dataclass(frozen=True)
+class CrowdParameters:
     """Who walks in the synthetic scene (:func:`ptztrack.scene.synthetic.walk_people`).
 
     count : people; speed_m_s, height_m : [low, high] of the uniform draws per person;

@@ -18,7 +18,7 @@ average, close to the 49 px the paper reports for its 'fix' strategy.
 
 import numpy as np
 
-from ptztrack.scene.parameters import Crowd
+from ptztrack.scene.parameters import CrowdParameters
 from ptztrack.types import GroundTruth
 
 TURN_TIME_CONSTANT_S = 2.0
@@ -32,7 +32,7 @@ def _wrap_angle(angle_rad):
 
 
 def walk_people(
-    people: Crowd, area_m: tuple[float, float], frames: int, frame_rate_hz: float, rng: np.random.Generator
+    people: CrowdParameters, area_m: tuple[float, float], frames: int, frame_rate_hz: float, rng: np.random.Generator
 ) -> GroundTruth:
     """Draw the trajectories of ``people.count`` walkers in the area ``[0, w] x [0, d]``.
 

@@ -11,8 +11,8 @@ from scipy.stats import chi2, f
 def gated_innovations(predicted_px, pairable, S, feet_px, gate_probability: float):
     """Innovations of every track w.r.t. every detection, and the chi-square gate.
 
-    predicted_px : (n, 2) from :func:`~ptztrack.track.tracker.predicted_feet_px`; pairable : (n,) the
-    tracks a detection may be paired with (:func:`~ptztrack.track.tracker.gate_in_front`);
+    predicted_px : (n, 2) from :func:`~ptztrack.track.observation.predicted_feet_px`; pairable : (n,) the
+    tracks a detection may be paired with (:func:`~ptztrack.track.observation.gate_in_front`);
     S : (n, 2, 2) innovation covariances; feet_px : (K, 2) detections.
     Returns the innovations (n, K, 2) ``feet - predicted``, their squared
     Mahalanobis distances (n, K), and which pairs are allowed (n, K): those

@@ -5,7 +5,7 @@ registration error of multisensor tracking, modelled, as there, by a constant bi
 sensor's measurement, ``z = h(x) + b + r`` (Friedland, IEEE TAC 1969, "Treatment of bias in recursive
 filtering"). Each detection paired with a track predicted at ``x-`` has the raw innovation
 ``z - h(x-) = b + e`` with ``e`` of covariance ``S / w``: ``S = C P- C^T + V`` and ``w`` its Student-t
-weight (:func:`ptztrack.track.tracker.student_t_weight`; 1 for Gaussian noise), so that a far detection
+weight (:func:`ptztrack.track.pixel_noise.student_t_weight`; 1 for Gaussian noise), so that a far detection
 says less. With the prior ``b ~ N(0, V0)``, a bias a priori no larger than the pixel noise ``V0`` that
 was meant to hold the calibration's error, the posterior mean after the detections ``j`` so far is
 

@@ -26,7 +26,8 @@ from ptztrack.geometry.ptz import (
 from ptztrack.roles import ImageSource
 from ptztrack.track import kalman
 from ptztrack.track.appearance import Spatiogram, search, spatiogram
-from ptztrack.track.tracker import EkfTracker, observation_matrix, predicted_feet_px, update_own_tracks
+from ptztrack.track.observation import observation_matrix, predicted_feet_px
+from ptztrack.track.tracker import EkfTracker, update_own_tracks
 from ptztrack.types import Detections, Tracks, TrackUpdate
 
 MIN_SIMILARITY = 0.6

@@ -6,6 +6,10 @@ state (the paper's section 3.1). Detections are associated with tracks by
 the Hungarian assignment (default; :mod:`ptztrack.track.association`) or by
 the Cheap JPDAF of :mod:`ptztrack.track.jpdaf` (``TrackerParameters.association``).
 
+The observation model is :mod:`ptztrack.track.observation`, the pixel noise :mod:`ptztrack.track.pixel_noise`,
+a track's birth and the Bayes update of its existence :mod:`ptztrack.track.lifecycle`, and what a step tells
+the learning models :mod:`ptztrack.track.evidence`; this module holds the tracker's steps and the tracker.
+
 Track lifecycle. A PTZ camera looks at a few people at a time; a person it
 does not look at is still there, only more uncertain, and the information
 gain policies come back to exactly such people. So a track is not deleted
@@ -43,49 +47,31 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 from scipy.stats import chi2
 
-from ptztrack.geometry.ptz import (
-    PTZCamera,
-    apply_homography,
-    feet_jacobian,
-    ground_to_image,
-    image_to_ground,
-    inside_image,
-    pose_noise_px2,
-)
+from ptztrack.geometry.ptz import PTZCamera, inside_image, pose_noise_px2
 from ptztrack.roles import ImageSource
 from ptztrack.track import jpdaf, kalman
 from ptztrack.track.association import assign_gated, associate, gated_innovations, student_t_gate
+from ptztrack.track.evidence import birth_exposure, paired_innovations, tracker_evidence
+from ptztrack.track.lifecycle import (
+    existence_after_detection,
+    existence_after_miss,
+    start_ground_tracks,
+    start_tracks,
+)
+from ptztrack.track.observation import gate_in_front, ground_points, observation_matrix, predicted_feet_px
 from ptztrack.track.parameters import TrackerParameters
+from ptztrack.track.pixel_noise import innovation_likelihood, squared_distances, student_t_noise, student_t_weight
 from ptztrack.track.sensor_bias import PixelBias
 from ptztrack.types import Detections, TrackerEvidence, Tracks, TrackUpdate
 
-# The image's pixels are sampled every 2 px for the share outside the gates: the smallest gate, of the
-# half-pixel noise floor at the 0.99 chi-square gate, is 3 px across.
-EXPOSURE_GRID_PX = 2
-
-# Feet are found on a pixel grid: the tracker trusts them to half a pixel at
-# best, which also keeps the innovation covariance invertible for a
-# noiseless simulated detector.
-MIN_PIXEL_NOISE_PX = 0.5
 # A picture taken at the very moment of the camera's last one repeats it: it weighs (almost) nothing, and
 # its noise V / w stays finite.
 MIN_LOOK_WEIGHT = 1e-6
 
 
-def pixel_noise_covariance(pixel_noise_px: float) -> np.ndarray:
-    """``V`` (2, 2) px^2: the feet-pixel noise the tracker and the policies assume."""
-    return max(pixel_noise_px, MIN_PIXEL_NOISE_PX) ** 2 * np.eye(2)
-
-
 DetectionModel = Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray]
 """``model(mean_m (n, 2), position_cov_m2 (n, 2, 2), pose (3,)) -> (n,)``: the probability that the
 detector finds each predicted person at the pose, were the person there."""
-
-
-def observation_matrix(camera: PTZCamera, pose, mean) -> np.ndarray:
-    """``C_x(a)``: (n, 2, 4) Jacobian of the feet pixel w.r.t. the state, at the states ``mean``."""
-    position_block = feet_jacobian(camera, pose, mean[:, :2])
-    return np.concatenate([position_block, np.zeros_like(position_block)], axis=-1)
 
 
 def predict_tracks(tracks: Tracks, F, U) -> Tracks:
@@ -97,79 +83,6 @@ def tracks_ahead(tracks: Tracks, dt_s: float, acceleration_sigma_m_s2: float) ->
     """``tracks`` predicted ``dt_s`` seconds on by the constant-velocity model whose white acceleration
     has ``acceleration_sigma_m_s2`` (m/s^2) per axis."""
     return predict_tracks(tracks, *kalman.constant_velocity_model(dt_s, acceleration_sigma_m_s2))
-
-
-def predicted_feet_px(camera: PTZCamera, pose, mean) -> tuple[np.ndarray, np.ndarray]:
-    """Where the states ``mean`` (n, 4) put the feet in the image at ``pose``.
-
-    Returns the pixels (n, 2) and whether each point is in front of the camera (n,).
-    """
-    H = ground_to_image(camera, pose)
-    in_front = (mean[:, :2] @ H[2, :2] + H[2, 2]) > 0
-    return apply_homography(H, mean[:, :2]), in_front
-
-
-def gate_in_front(camera: PTZCamera, pose, mean, covariance, gate_probability: float) -> np.ndarray:
-    """Whether each track's gate on the ground lies wholly in front of the camera at ``pose``; (n,) bool.
-
-    The gate is the ellipse ``(x - m)^T P^-1 (x - m) <= g`` of the predicted position (``mean`` (n, 4),
-    ``covariance`` (n, 4, 4); ``g`` the chi-square quantile ``gate_probability``, 2 degrees of freedom). A
-    ground point's depth along the optical axis is ``w = h . (x, y, 1)``, ``h`` the ground-to-image
-    homography's last row, and over the ellipse it is at least ``w(m) - sqrt(g h^T P h)``, so the gate lies
-    in front where that is positive. Only there is the feet pixel a smooth function of the position
-    over the gate: an ellipse that reaches the camera's principal plane (``w = 0``) projects to pixels
-    without bound, and its linearised innovation covariance, huge as well, would gate in any detection.
-    """
-    h = ground_to_image(camera, pose)[2]
-    depth = mean[:, :2] @ h[:2] + h[2]
-    depth_variance = np.einsum("i,nij,j->n", h[:2], covariance[:, :2, :2], h[:2])
-    return depth > np.sqrt(chi2.ppf(gate_probability, df=2) * depth_variance)
-
-
-def ground_points(feet_px, camera: PTZCamera, pose) -> tuple[np.ndarray, np.ndarray]:
-    """The ground points (K, 2) m of feet pixels (K, 2) at ``pose``, and which lie in front of the
-    camera (K,): a pixel at or above the horizon has no ground point (its row is then meaningless)."""
-    G = image_to_ground(camera, pose)
-    # G (u, v, 1) = (x, y, 1) / depth, so its last entry is positive only for
-    # pixels whose ray meets the ground in front of the camera.
-    homogeneous = np.asarray(feet_px, dtype=float).reshape(-1, 2) @ G[:, :2].T + G[:, 2]
-    ok = homogeneous[:, 2] > 0
-    with np.errstate(divide="ignore", invalid="ignore"):
-        return homogeneous[:, :2] / homogeneous[:, 2:], ok
-
-
-def start_tracks(
-    feet_px, camera: PTZCamera, pose, V, initial_speed_sigma_m_s: float, first_id: int, existence: float = 0.5
-) -> Tracks:
-    """New tracks at the ground points of detections, with the pixel noise carried to the ground.
-
-    Velocity starts at 0 with spread ``initial_speed_sigma_m_s`` per axis; the existence probability
-    at ``existence``. Detections at or above the horizon cannot start a track and are dropped.
-    """
-    ground_xy, ok = ground_points(feet_px, camera, pose)
-    ground_xy = ground_xy[ok]
-    J_inv = np.linalg.inv(feet_jacobian(camera, pose, ground_xy))
-    covariance_m2 = J_inv @ V @ np.swapaxes(J_inv, -1, -2)
-    return start_ground_tracks(ground_xy, covariance_m2, initial_speed_sigma_m_s, first_id, existence)
-
-
-def start_ground_tracks(
-    position_m, covariance_m2, initial_speed_sigma_m_s: float, first_id: int, existence: float = 0.5
-) -> Tracks:
-    """New tracks at ground positions (K, 2) m with position covariances (K, 2, 2) m^2; velocity 0
-    with spread ``initial_speed_sigma_m_s`` per axis; the existence probability at ``existence``."""
-    count = len(position_m)
-    covariance = np.zeros((count, 4, 4))
-    covariance[:, :2, :2] = covariance_m2
-    covariance[:, 2:, 2:] = initial_speed_sigma_m_s**2 * np.eye(2)
-    return Tracks(
-        ids=first_id + np.arange(count),
-        mean=np.concatenate([np.reshape(position_m, (count, 2)), np.zeros((count, 2))], axis=-1),
-        covariance=covariance,
-        existence=np.full(count, existence),
-        hits=np.ones(count, dtype=int),
-        next_id=first_id + count,
-    )
 
 
 def update_tracks(
@@ -321,81 +234,6 @@ def _with_births(tracks: Tracks, survivors: Tracks, keep, born: Tracks, track_in
     )
 
 
-def innovation_likelihood(innovation, S, noise_dof: float = np.inf) -> np.ndarray:
-    """The density of innovations (k, d) of covariances (k, d, d), in the inverse units of ``S``'s
-    determinant's square root (1/px^2 for feet pixels); (k,). Gaussian, ``N(nu; 0, S)``, for ``noise_dof``
-    inf; else the Student-t of scale ``S`` (d = 2 only): ``(1 + d2 / nu) ^ -(nu / 2 + 1) / (2 pi sqrt|S|)``,
-    ``d2 = nu^T S^-1 nu``."""
-    innovation, S = np.asarray(innovation, dtype=float), np.asarray(S, dtype=float)
-    if len(innovation) == 0:
-        return np.zeros(0)
-    d2 = squared_distances(innovation, S)
-    if np.isinf(noise_dof):
-        return np.exp(-0.5 * d2) / np.sqrt(np.linalg.det(2 * np.pi * S))
-    return (1 + d2 / noise_dof) ** -(noise_dof / 2 + 1) / np.sqrt(np.linalg.det(2 * np.pi * S))
-
-
-def student_t_weight(d2, noise_dof: float) -> np.ndarray:
-    """``w = (nu + 2) / (nu + d2)`` (k,): the expected precision scale of a detection whose innovation has
-    the squared Mahalanobis distance ``d2`` (k,) under bivariate Student-t noise of ``noise_dof`` degrees of
-    freedom (the variational Student-t filter's, Piche, Sarkka & Hartikainen, MLSP 2012, at the predicted
-    state); 1 for Gaussian noise (``noise_dof`` inf)."""
-    d2 = np.asarray(d2, dtype=float)
-    if np.isinf(noise_dof):
-        return np.ones_like(d2)
-    return (noise_dof + 2) / (noise_dof + d2)
-
-
-def squared_distances(innovation, S) -> np.ndarray:
-    """``d2 = nu^T S^-1 nu`` (k,) of innovations (k, 2) of covariances (k, 2, 2)."""
-    return np.einsum("ki,kij,kj->k", innovation, np.linalg.inv(S), innovation)
-
-
-def student_t_noise(V, innovation, S, noise_dof: float) -> np.ndarray:
-    """The noise each detection updates its track with under Student-t pixel noise of ``noise_dof`` degrees
-    of freedom and scale ``V`` (2, 2) px^2: ``V / w`` (k, 2, 2), ``w`` the :func:`student_t_weight` of its
-    innovation (k, 2) px of covariance ``S`` (k, 2, 2) px^2. A detection far from its track updates it less.
-    ``V`` itself for Gaussian noise (``noise_dof`` inf)."""
-    if np.isinf(noise_dof):
-        return V
-    return V / student_t_weight(squared_distances(innovation, S), noise_dof)[:, None, None]
-
-
-def paired_innovations(tracks: Tracks, update: TrackUpdate, feet_px, camera: PTZCamera, pose, V):
-    """The innovations ``z - h(x-)`` (k, 2) px of the detections ``feet_px`` (K, 2) that ``update`` paired
-    with the predicted ``tracks`` (new tracks left out), and their covariances ``S`` (k, 2, 2) px^2 under
-    the noise ``V`` (2, 2) px^2."""
-    index_of_id = {track_id: index for index, track_id in enumerate(tracks.ids.tolist())}
-    pairs = [
-        (index_of_id[track_id], measurement)
-        for track_id, measurement in zip(update.track_ids.tolist(), update.measurement_index.tolist(), strict=True)
-        if track_id in index_of_id
-    ]
-    index, measurement = np.array(pairs, dtype=int).reshape(-1, 2).T
-    predicted_px, _ = predicted_feet_px(camera, pose, tracks.mean[index])
-    C = observation_matrix(camera, pose, tracks.mean[index])
-    feet_px = np.asarray(feet_px, dtype=float).reshape(-1, 2)
-    return feet_px[measurement] - predicted_px, kalman.innovation_covariance(tracks.covariance[index], C, V)
-
-
-def existence_after_detection(existence, detectable, likelihood, clutter_density, cap: float) -> np.ndarray:
-    """Bayes' rule for a detected track (the module's docstring): ``r (1 - q + q g / kappa) / (1 - r q +
-    r q g / kappa)`` for existence ``r``, detection probability ``q`` and the detection's likelihood ``g``
-    (all (n,)) against clutter of density ``kappa``, at most ``cap``; ``cap`` where ``kappa`` is 0."""
-    r, q, g = (np.asarray(value, dtype=float) for value in (existence, detectable, likelihood))
-    if clutter_density <= 0:
-        return np.full(r.shape, cap)
-    ratio = 1.0 - q + q * g / clutter_density
-    return np.minimum(r * ratio / (1.0 - r + r * ratio), cap)
-
-
-def existence_after_miss(existence, detectable) -> np.ndarray:
-    """Bayes' rule for a track not detected: ``r (1 - q) / (1 - r q)`` for existence ``r`` and the
-    probability ``q`` that the detector would have found the person were it there (both (n,))."""
-    existence, detectable = np.asarray(existence, dtype=float), np.asarray(detectable, dtype=float)
-    return existence * (1.0 - detectable) / (1.0 - existence * detectable)
-
-
 def _after_update(
     tracks: Tracks, mean, covariance, track_index, detectable, parameters: TrackerParameters, likelihood=None
 ):
@@ -445,59 +283,6 @@ def update_own_tracks(
     )
     updated = replace(tracks, mean=mean, covariance=covariance)
     return updated.select(updated.position_sigma_m <= max_position_sigma_m)
-
-
-def tracker_evidence(
-    tracks: Tracks, update: TrackUpdate, feet_px, camera: PTZCamera, pose, detectable, parameters: TrackerParameters
-) -> TrackerEvidence:
-    """What the step that took the predicted ``tracks`` to ``update`` tells about the detector
-    (:class:`~ptztrack.types.TrackerEvidence`); ``detectable`` (n,) as :func:`update_tracks` was given it."""
-    detected = np.isin(tracks.ids, update.track_ids)
-    feet_px = np.asarray(feet_px, dtype=float).reshape(-1, 2)
-    measurement_of = dict(zip(update.track_ids.tolist(), update.measurement_index.tolist(), strict=True))
-    index = np.flatnonzero(detected)
-    predicted_px, _ = predicted_feet_px(camera, pose, tracks.mean[index])
-    C = observation_matrix(camera, pose, tracks.mean[index])
-    spread_px2 = np.trace(C @ tracks.covariance[index] @ np.swapaxes(C, -1, -2), axis1=-2, axis2=-1)
-    measured_px = feet_px[[measurement_of[track_id] for track_id in tracks.ids[index].tolist()]].reshape(-1, 2)
-    excess_px2 = np.sum((measured_px - predicted_px) ** 2, axis=-1) - spread_px2
-    missed_away = ~detected & (existence_after_miss(tracks.existence, detectable) < parameters.existence_to_delete)
-    return TrackerEvidence(
-        pose=np.asarray(pose, dtype=float),
-        mean_m=tracks.mean[:, :2],
-        position_sigma_m=tracks.position_sigma_m,
-        existence=tracks.existence,
-        hits=tracks.hits,
-        detected=detected,
-        excess_px2=excess_px2,
-        false_births=int(np.sum(missed_away & (tracks.hits == 1))),
-    )
-
-
-def birth_exposure(
-    tracks: Tracks, update: TrackUpdate, camera: PTZCamera, pose, V, parameters: TrackerParameters
-) -> float:
-    """The share of the image where a detection at ``pose`` would have started a track in the step that took
-    the predicted ``tracks`` to ``update`` under the noise ``V`` (2, 2) px^2: 1 for ``birth`` 'unassigned'
-    (the CJPDAF's included, though it starts no track in a gate either); for 'outside_gates', the share of
-    the image (sampled every :data:`EXPOSURE_GRID_PX` px) in the gate of no surviving track, as
-    :func:`update_tracks` gates its births."""
-    if parameters.birth == "unassigned":
-        return 1.0
-    surviving = np.isin(tracks.ids, update.tracks.ids)
-    mean = tracks.mean[surviving]
-    covariance = tracks.covariance[surviving]
-    predicted_px, _ = predicted_feet_px(camera, pose, mean)
-    S = kalman.innovation_covariance(covariance, observation_matrix(camera, pose, mean), V)
-    half = EXPOSURE_GRID_PX / 2
-    u, v = np.meshgrid(
-        np.arange(half, camera.image_width_px, EXPOSURE_GRID_PX),
-        np.arange(half, camera.image_height_px, EXPOSURE_GRID_PX),
-    )
-    gate = student_t_gate(parameters.gate_probability, parameters.noise_dof)
-    pairable = gate_in_front(camera, pose, mean, covariance, gate)
-    _, _, gated = gated_innovations(predicted_px, pairable, S, np.c_[u.ravel(), v.ravel()], gate)
-    return float(1.0 - np.mean(gated.any(axis=0)))
 
 
 @dataclass

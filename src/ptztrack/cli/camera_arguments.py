@@ -1,0 +1,90 @@
+"""The command line's arguments of the real and virtual cameras: ``ptztrack live``, ``ptztrack camera
+calibrate`` and ``ptztrack serve-camera``.
+"""
+
+from pathlib import Path
+
+from ptztrack.cli.options import (
+    RUN_FOLDER_FILES,
+    add_detector_model_arguments,
+    add_recording_arguments,
+    add_view_argument,
+    non_negative_int,
+    port_number,
+    positive_float,
+    positive_int,
+)
+from ptztrack.names import PASSWORD_VARIABLE
+
+
+def add_camera_commands(commands, policies: list[str]) -> None:
+    """``ptztrack live`` and ``ptztrack serve-camera``: real ONVIF cameras, and a virtual one to test with."""
+    live = commands.add_parser("live", help="drive an ONVIF PTZ camera in real time: capture, detect, track, decide")
+    live.add_argument(
+        "--camera",
+        required=True,
+        action="append",
+        help="onvif://[user[:password]@]host[:port]; repeated: a network of cameras with one ground belief",
+    )
+    live.add_argument("--credentials", type=Path, help="a YAML file with username and password")
+    live.add_argument(
+        "--calibration",
+        required=True,
+        action="append",
+        help="the camera's calibration YAML, or 'virtual' for ptztrack serve-camera; one for every camera, "
+        "or one per --camera in their order",
+    )
+    live.add_argument(
+        "--coordination",
+        choices=("joint", "independent"),
+        default="joint",
+        help="a network's decisions: joint (greedy, each camera on the views before it) or each camera alone",
+    )
+    live.add_argument("--policy", choices=policies, default="smpl")
+    live.add_argument("--scenario", default="pets", help="'pets' (built in) or a scenario YAML file")
+    add_recording_arguments(live, files=False)
+    live.add_argument("--detector", default="hog", help="the scenario's detector (default hog)")
+    add_detector_model_arguments(live)
+    live.add_argument(
+        "--steps", type=positive_int, help="use at most this many pictures (default: the scenario's frames)"
+    )
+    live.add_argument(
+        "--time-scale", type=positive_float, default=1.0, help="the scenario's seconds per second (serve-camera's)"
+    )
+    live.add_argument("--transport", choices=("tcp", "udp"), default="tcp", help="RTSP's transport (default tcp)")
+    live.add_argument("--timeout-s", type=positive_float, default=5.0, help="the longest wait for any camera call")
+    live.add_argument(
+        "--truth", type=Path, help="score against a virtual camera's truth log (serve-camera --truth-log)"
+    )
+    live.add_argument("--seed", type=non_negative_int, default=0)
+    live.add_argument(
+        "--out", type=Path, help=f"directory for {', '.join(RUN_FOLDER_FILES)}; written whole, Ctrl-C too"
+    )
+    live.add_argument("--overwrite", action="store_true", help="replace a non-empty --out folder")
+    add_view_argument(live)
+    live.set_defaults(handler="ptztrack.cli.camera:live_command")
+
+    camera = commands.add_parser("camera", help="tools for a real camera").add_subparsers(dest="tool", required=True)
+    calibrate = camera.add_parser("calibrate", help="time the camera's moves and write them into its calibration")
+    calibrate.add_argument("--camera", required=True, help="onvif://[user[:password]@]host[:port]")
+    calibrate.add_argument("--credentials", type=Path, help="a YAML file with username and password")
+    calibrate.add_argument("--calibration", type=Path, required=True, help="the camera's calibration YAML (updated)")
+    calibrate.add_argument("--timeout-s", type=positive_float, default=5.0, help="the longest wait for any camera call")
+    calibrate.set_defaults(handler="ptztrack.cli.camera:calibrate_camera_command")
+
+    serve = commands.add_parser(
+        "serve-camera", help="serve a recording's virtual PTZ camera over ONVIF on 127.0.0.1 (default PETS 2009 S2.L1)"
+    )
+    serve.add_argument("--port", type=port_number, default=8080, help="the first camera's port (0: any free port each)")
+    serve.add_argument(
+        "--cameras", type=positive_int, default=1, help="serve this many cameras, on --port and the ports after it"
+    )
+    serve.add_argument("--scenario", default="pets", help="'pets' (built in) or a recording scenario YAML file")
+    add_recording_arguments(serve, files=False)
+    serve.add_argument("--time-scale", type=positive_float, default=1.0, help="the recording's speed")
+    serve.add_argument("--user", help=f"require this user (password: --credentials or ${PASSWORD_VARIABLE})")
+    serve.add_argument("--credentials", type=Path, help="a YAML file with username and password to require")
+    serve.add_argument(
+        "--truth-log", type=Path, help="append every picture's time, step and pose here (CSV; the first camera's)"
+    )
+    serve.set_defaults(handler="ptztrack.cli.camera:serve_camera_command")
