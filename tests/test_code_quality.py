@@ -36,3 +36,18 @@ def test_the_readme_example_runs_a_policy_defined_in_its_own_script(tmp_path):
     )
     assert result.returncode == 0, result.stderr
     assert "follow_the_most_uncertain" in result.stdout and "one episode: MOTA" in result.stdout
+
+
+def test_no_module_is_over_500_lines_and_no_step_loop_lives_outside_the_loop_package():
+    """A module a reader takes in whole; the closed loops (a camera observes, the belief is updated, a
+    policy decides, step by step) written once, in ``ptztrack.loop``."""
+    modules = sorted((ROOT / "src").rglob("*.py")) + sorted((ROOT / "tests").glob("*.py"))
+    long = {str(path.relative_to(ROOT)): n for path in modules if (n := len(path.read_text().splitlines())) > 500}
+    assert long == {}
+    loop = ROOT / "src" / "ptztrack" / "loop"
+    stepping = [
+        str(path.relative_to(ROOT))
+        for path in (ROOT / "src" / "ptztrack").rglob("*.py")
+        if loop not in path.parents and "for step in range(" in path.read_text()
+    ]
+    assert stepping == []

@@ -82,6 +82,21 @@ class PetsProtocol:
     seeds: int = field(default=5, metadata={"help": "runs of a strategy whose run depends on its seed"})
 
 
+@dataclass(frozen=True)
+class NetworkProtocol:
+    """The camera network's tables, ``ptztrack experiment network synthetic`` and ``pets``: each setting's
+    options and their defaults (an option of the other setting is refused)."""
+
+    sequences: int = field(default=12, metadata={"help": "synthetic: sequences"})
+    first_sequence: int = field(
+        default=0,
+        metadata={"help": "synthetic: the first sequence's seed (the table's; from 1000: development sequences)"},
+    )
+    max_ptz: int = field(default=4, metadata={"help": "synthetic: the most PTZ cameras"})
+    seeds: int = field(default=5, metadata={"help": "pets: seeds of the runs with the PTZ camera"})
+    beta: float = field(default=9.0, metadata={"help": "pets: the PTZ camera's weight of the patrolling term"})
+
+
 FOLLOW_TRACKERS = ("particle", "csrt", "mil")
 """The follow camera's trackers: the paper's particle filter and OpenCV's two."""
 OTB_TRACKS = 5
@@ -92,9 +107,9 @@ experiment every frame's map and modes."""
 ROOM_FRAMES = 300
 """Frames of each synthetic-room sequence of the occupancy experiment."""
 PLAZA_FRAMES = 200
+"""Frames of each synthetic-plaza sequence of the occupancy experiment (20 s at PETS's 10 Hz)."""
 # The occupancy experiment's methods beside LPOM and the clustering baseline, which always run.
 OCCUPANCY_MAP_METHODS = ("lpom-foreground", "pom")
-"""Frames of each synthetic-plaza sequence of the occupancy experiment (20 s at PETS's 10 Hz)."""
 EXECUTORS = ("local", "ray", "serial")
 """Where an experiment's cells run (:mod:`ptztrack.loop.executors`)."""
 PASSWORD_VARIABLE = "PTZTRACK_CAMERA_PASSWORD"

@@ -16,8 +16,15 @@ from ptztrack.cli.options import (
     occupancy_frames,
     occupancy_lead_in,
     positive_int,
+    protocol_field,
 )
-from ptztrack.names import OCCUPANCY_MAP_METHODS, PLAZA_FRAMES, ROOM_FRAMES
+from ptztrack.names import OCCUPANCY_MAP_METHODS, PLAZA_FRAMES, ROOM_FRAMES, NetworkProtocol
+
+
+def network_help(name: str) -> str:
+    """The help of the network experiment's option ``name``: its :class:`~ptztrack.names.NetworkProtocol`
+    field's, with the default (None in the parser: an option of the other setting is refused)."""
+    return protocol_field(NetworkProtocol, name)["help"]
 
 
 def add_occupancy_parser(experiments) -> None:
@@ -80,18 +87,12 @@ def add_network_parser(experiments, detectors: list[str]) -> None:
         help="the cameras' detector (synthetic: default realistic; pets, the PTZ camera's: hog or ideal, default hog)",
     )
     add_detector_model_arguments(network)
-    network.add_argument("--sequences", type=positive_int, help="synthetic: sequences (default 12)")
-    network.add_argument(
-        "--first-sequence",
-        type=non_negative_int,
-        help="synthetic: the first sequence's seed (default 0, the table's; from 1000: development sequences)",
-    )
+    network.add_argument("--sequences", type=positive_int, help=network_help("sequences"))
+    network.add_argument("--first-sequence", type=non_negative_int, help=network_help("first_sequence"))
     network.add_argument("--frames", type=positive_int, help="overrides the scenario's number of frames")
-    network.add_argument("--max-ptz", type=positive_int, help="synthetic: the most PTZ cameras (default 4)")
-    network.add_argument("--seeds", type=positive_int, help="pets: seeds of the runs with the PTZ camera (default 5)")
-    network.add_argument(
-        "--beta", type=non_negative_float, help="pets: the PTZ camera's weight of the patrolling term (default 9)"
-    )
+    network.add_argument("--max-ptz", type=positive_int, help=network_help("max_ptz"))
+    network.add_argument("--seeds", type=positive_int, help=network_help("seeds"))
+    network.add_argument("--beta", type=non_negative_float, help=network_help("beta"))
     network.add_argument(
         "--method", choices=("intg", "smpl"), default="intg", help="the PTZ cameras' expected information"
     )

@@ -8,10 +8,11 @@ from ptztrack.config import ScenarioError
 from ptztrack.experiments.cells import Execution
 from ptztrack.experiments.network import format_network_table, network_cells, network_title, run_network_table
 from ptztrack.files import write_json
+from ptztrack.names import NetworkProtocol
 
 # The options of one setting only, and their defaults.
-SYNTHETIC_OPTIONS = {"sequences": 12, "first_sequence": 0, "max_ptz": 4}
-PETS_OPTIONS = {"seeds": 5, "beta": 9.0, "dataset": None, "dataset_view": None}
+SYNTHETIC_OPTIONS = {name: getattr(NetworkProtocol, name) for name in ("sequences", "first_sequence", "max_ptz")}
+PETS_OPTIONS = {"seeds": NetworkProtocol.seeds, "beta": NetworkProtocol.beta, "dataset": None, "dataset_view": None}
 
 
 def network_experiment_command(args: argparse.Namespace) -> int:

@@ -8,17 +8,18 @@ from ptztrack.scene.parameters import PersonParameters
 
 @dataclass(frozen=True)
 class MotionEdgeParameters:
-    """A view's motion edges (:mod:`ptztrack.occupancy.motion_edges`).
+    """A view's motion edges (:mod:`ptztrack.occupancy.motion_edges`), with
+    :class:`OccupancyParameters`' values (its defaults are theirs).
 
     canny_low, canny_high : Canny's hysteresis thresholds (grey levels of the gradient);
     difference_threshold : grey levels of change that count as motion; dilation_px : how far
     (square neighbourhood of this half-size) from a changed pixel an edge still counts.
     """
 
-    canny_low: float = 50.0
-    canny_high: float = 150.0
-    difference_threshold: float = 15.0
-    dilation_px: int = 2
+    canny_low: float
+    canny_high: float
+    difference_threshold: float
+    dilation_px: int
 
 
 @dataclass(frozen=True)
@@ -49,8 +50,8 @@ class OccupancyParameters:
     mode needs (a fraction of the frame's strongest) is fitted on the other half of the frames;
     candidate_strength: modes weaker than this fraction of the strongest are not even candidates, well
     below any threshold the fit may choose (its smallest is 0.05).
-    Motion edges: canny_low, canny_high, difference_threshold (grey levels), dilation_px
-    (:class:`MotionEdgeParameters`'s defaults).
+    Motion edges (:class:`MotionEdgeParameters`): canny_low, canny_high, difference_threshold (grey
+    levels), dilation_px.
     Boxes: outline_points_per_box, min_box_score. Baseline: linkage_m (complete-linkage cut),
     blob_min_area_px (blob boxes of views without detections); the views a cluster needs are fitted
     like the modes' strength.
@@ -66,10 +67,10 @@ class OccupancyParameters:
     block_px: int = 4
     separation_m: float = 0.5
     window_m: float = 0.25
-    canny_low: float = MotionEdgeParameters.canny_low
-    canny_high: float = MotionEdgeParameters.canny_high
-    difference_threshold: float = MotionEdgeParameters.difference_threshold
-    dilation_px: int = MotionEdgeParameters.dilation_px
+    canny_low: float = 50.0
+    canny_high: float = 150.0
+    difference_threshold: float = 15.0
+    dilation_px: int = 2
     outline_points_per_box: int = 64
     min_box_score: float = 0.5
     linkage_m: float = 1.0
