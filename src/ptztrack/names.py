@@ -33,25 +33,6 @@ PROTOCOLS = ("a-priori", "two-fold")
 
 
 @dataclass(frozen=True)
-class Tunable:
-    """A parameter's one-line doc, unit and bounds, as ``typing.Annotated`` metadata on a field of a
-    parameters dataclass; the configuration validates the field with them
-    (:func:`ptztrack.config.fields.tunable`).
-
-    gt, ge, lt, le : open and closed bounds; at_most : (limit, reason) a bound on a size, count or rate
-    whose error message gives the reason (memory, time, physics).
-    """
-
-    doc: str
-    unit: str = ""
-    gt: float | None = None
-    ge: float | None = None
-    lt: float | None = None
-    le: float | None = None
-    at_most: tuple[float, str] | None = None
-
-
-@dataclass(frozen=True)
 class SyntheticProtocol:
     """The PTZ paper's synthetic tables (Tables 1-2, section 5.1), ``ptztrack experiment synthetic``."""
 

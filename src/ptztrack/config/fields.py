@@ -1,12 +1,12 @@
 """The pieces the configuration models are built from: the strict base model, bounded field types
 (each bound with its reason) and fields that name a registered implementation."""
 
-from typing import Annotated, Any, get_type_hints
+from typing import Annotated, Any
 
 from pydantic import AfterValidator, BaseModel, ConfigDict, Field
 
 from ptztrack import registry
-from ptztrack.names import MAX_FRAMES, Tunable
+from ptztrack.names import MAX_FRAMES
 
 PositiveFloat = Annotated[float, Field(gt=0)]
 NonNegativeFloat = Annotated[float, Field(ge=0)]
@@ -32,21 +32,6 @@ def at_most_items(limit: int, why: str):
         return values
 
     return AfterValidator(check)
-
-
-def tunable(parameters_type: type, name: str) -> tuple[Any, ...]:
-    """The pydantic metadata of the field ``name`` of the parameters dataclass ``parameters_type``, from its
-    :class:`~ptztrack.names.Tunable`: a ``Field`` of its bounds, described by its doc and unit, then its
-    ``at_most`` bound with the reason. Use as ``Annotated[type, *tunable(parameters_type, name)]``."""
-    (found,) = (
-        item
-        for item in get_type_hints(parameters_type, include_extras=True)[name].__metadata__
-        if isinstance(item, Tunable)
-    )
-    bounds = {bound: getattr(found, bound) for bound in ("gt", "ge", "lt", "le") if getattr(found, bound) is not None}
-    description = f"{found.doc} ({found.unit})" if found.unit else found.doc
-    limit = () if found.at_most is None else (at_most(*found.at_most),)
-    return (Field(description=description, **bounds), *limit)
 
 
 _MAX_FRAMES = MAX_FRAMES

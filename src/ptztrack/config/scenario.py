@@ -23,7 +23,6 @@ from ptztrack.config.fields import (
     _Strict,
     at_most,
     at_most_items,
-    tunable,
 )
 from ptztrack.config.follow import Follow
 from ptztrack.config.reading import ScenarioError, _first_error_line, read_yaml
@@ -31,7 +30,7 @@ from ptztrack.control.parameters import ControlParameters
 from ptztrack.detect.parameters import BoxDetectorParameters, DetectorPriorParameters, HogParameters
 from ptztrack.names import DETECTOR_MODELS
 from ptztrack.scene.parameters import CrowdParameters
-from ptztrack.track.parameters import Association, ExistenceUpdate, TrackerParameters
+from ptztrack.track.parameters import TrackerParameters
 
 _Speed = Annotated[PositiveFloat, at_most(15, "metres per second: faster than anyone runs")]
 _Height = Annotated[PositiveFloat, at_most(3, "metres: taller than anyone")]
@@ -197,41 +196,25 @@ class Tracker(_Strict):
 
     kind: Annotated[str, _registered("trackers")] = "ekf"
     options: Options = Field(default_factory=dict)
-    acceleration_sigma_m_s2: Annotated[float, *tunable(TrackerParameters, "acceleration_sigma_m_s2")] = (
+    acceleration_sigma_m_s2: Annotated[PositiveFloat, at_most(100, "metres per second squared")] = (
         TrackerParameters.acceleration_sigma_m_s2
     )
-    initial_speed_sigma_m_s: Annotated[float, *tunable(TrackerParameters, "initial_speed_sigma_m_s")] = (
+    initial_speed_sigma_m_s: Annotated[PositiveFloat, at_most(100, "metres per second")] = (
         TrackerParameters.initial_speed_sigma_m_s
     )
-    gate_probability: Annotated[float, *tunable(TrackerParameters, "gate_probability")] = (
-        TrackerParameters.gate_probability
-    )
-    existence_at_birth: Annotated[float, *tunable(TrackerParameters, "existence_at_birth")] = (
-        TrackerParameters.existence_at_birth
-    )
-    existence_when_detected: Annotated[float, *tunable(TrackerParameters, "existence_when_detected")] = (
-        TrackerParameters.existence_when_detected
-    )
-    existence_to_delete: Annotated[float, *tunable(TrackerParameters, "existence_to_delete")] = (
-        TrackerParameters.existence_to_delete
-    )
-    max_position_sigma_m: Annotated[float, *tunable(TrackerParameters, "max_position_sigma_m")] = (
-        TrackerParameters.max_position_sigma_m
-    )
-    confirmation_hits: Annotated[int, *tunable(TrackerParameters, "confirmation_hits")] = (
-        TrackerParameters.confirmation_hits
-    )
-    report_position_sigma_m: Annotated[float, *tunable(TrackerParameters, "report_position_sigma_m")] = (
+    gate_probability: float = Field(TrackerParameters.gate_probability, gt=0, lt=1)
+    existence_at_birth: float = Field(TrackerParameters.existence_at_birth, gt=0, lt=1)
+    existence_when_detected: float = Field(TrackerParameters.existence_when_detected, gt=0, lt=1)
+    existence_to_delete: float = Field(TrackerParameters.existence_to_delete, gt=0, lt=1)
+    max_position_sigma_m: Annotated[PositiveFloat, at_most(10_000, "metres")] = TrackerParameters.max_position_sigma_m
+    confirmation_hits: Annotated[int, Field(ge=1), at_most(_MAX_FRAMES, "steps")] = TrackerParameters.confirmation_hits
+    report_position_sigma_m: Annotated[PositiveFloat, at_most(10_000, "metres")] = (
         TrackerParameters.report_position_sigma_m
     )
-    existence_update: Annotated[ExistenceUpdate, *tunable(TrackerParameters, "existence_update")] = (
-        TrackerParameters.existence_update
-    )
-    existence_to_report: Annotated[float, *tunable(TrackerParameters, "existence_to_report")] = (
-        TrackerParameters.existence_to_report
-    )
-    association: Annotated[Association, *tunable(TrackerParameters, "association")] = TrackerParameters.association
-    clutter_density_per_px2: Annotated[float, *tunable(TrackerParameters, "clutter_density_per_px2")] = (
+    existence_update: Literal["bayes", "fixed"] = TrackerParameters.existence_update
+    existence_to_report: float = Field(TrackerParameters.existence_to_report, gt=0, lt=1)
+    association: Literal["hungarian", "cjpdaf"] = TrackerParameters.association
+    clutter_density_per_px2: Annotated[NonNegativeFloat, at_most(1, "detections per pixel")] = (
         TrackerParameters.clutter_density_per_px2
     )
     measurement_source: Literal["detector", "spatiogram"] = "detector"
