@@ -82,8 +82,8 @@ def _without_password(url: str) -> str:
 
 @dataclass(frozen=True)
 class CameraStatus:
-    """GetStatus: position (3,) in the normalised spaces (pan, tilt in [-1, 1], zoom in [0, 1]), and
-    whether any axis is still moving."""
+    """GetStatus: position (3,) in the normalised spaces (pan, tilt in [-1, 1], zoom in [0, 1]; NaN where
+    the camera reports none), and whether any axis is still moving."""
 
     position: np.ndarray
     moving: bool
@@ -111,9 +111,12 @@ class ONVIFClient:
 
     def status(self) -> CameraStatus:
         status = self._call(self._ptz.GetStatus({"ProfileToken": self._profile}))
-        pan_tilt, zoom = status.Position.PanTilt, status.Position.Zoom
+        # Position is optional in PTZStatus: a camera that reports none gives NaN.
+        position = getattr(status, "Position", None)
+        pan_tilt, zoom = getattr(position, "PanTilt", None), getattr(position, "Zoom", None)
         moving = any(str(getattr(status.MoveStatus, axis, "IDLE")) == "MOVING" for axis in ("PanTilt", "Zoom"))
-        return CameraStatus(np.array([pan_tilt.x, pan_tilt.y, zoom.x], dtype=float), moving)
+        xyz = [getattr(pan_tilt, "x", None), getattr(pan_tilt, "y", None), getattr(zoom, "x", None)]
+        return CameraStatus(np.array([np.nan if value is None else value for value in xyz], dtype=float), moving)
 
     def wait_still(self, until_s: float) -> CameraStatus:
         """GetStatus every ``POLL_S`` until the camera stands still or ``until_s`` passes (on
@@ -162,6 +165,9 @@ class ONVIFClient:
         """{token: name} of the camera's presets."""
         found = self._call(self._ptz.GetPresets({"ProfileToken": self._profile})) or []
         return {str(preset.token): str(preset.Name) for preset in found}
+
+    def remove_preset(self, token: str) -> None:
+        self._call(self._ptz.RemovePreset({"ProfileToken": self._profile, "PresetToken": token}))
 
     def goto_preset(self, token: str) -> None:
         self._call(self._ptz.GotoPreset({"ProfileToken": self._profile, "PresetToken": token}))

@@ -166,6 +166,12 @@ def read_truth_log(path: Path) -> np.ndarray:
 
 
 def calibrate_camera_command(args: argparse.Namespace) -> int:
+    if args.geometry:
+        from ptztrack.cli.calibrate import calibrate_geometry_command
+
+        return calibrate_geometry_command(args, _credentials(args))
+    if args.snapshot is not None or args.ground_points is not None:
+        raise ScenarioError("camera calibrate: --snapshot and --ground-points go with --geometry")
     calibration = load_camera_calibration(args.calibration)
     check_output_file(args.calibration, "--calibration")  # rewritten after minutes of timed moves
     client = ONVIFClient(camera_address(args.camera, _credentials(args)), args.timeout_s)

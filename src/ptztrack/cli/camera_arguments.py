@@ -65,10 +65,28 @@ def add_camera_commands(commands, policies: list[str]) -> None:
     live.set_defaults(handler="ptztrack.cli.camera:live_command")
 
     camera = commands.add_parser("camera", help="tools for a real camera").add_subparsers(dest="tool", required=True)
-    calibrate = camera.add_parser("calibrate", help="time the camera's moves and write them into its calibration")
+    calibrate = camera.add_parser(
+        "calibrate",
+        help="time the camera's moves, or (--geometry) measure its focal lengths, pan and tilt mapping and "
+        "place on the ground from its pictures, and write them into its calibration",
+    )
     calibrate.add_argument("--camera", required=True, help="onvif://[user[:password]@]host[:port]")
     calibrate.add_argument("--credentials", type=Path, help="a YAML file with username and password")
-    calibrate.add_argument("--calibration", type=Path, required=True, help="the camera's calibration YAML (updated)")
+    calibrate.add_argument(
+        "--calibration", type=Path, required=True, help="the camera's calibration YAML (updated; --geometry: created)"
+    )
+    calibrate.add_argument(
+        "--geometry", action="store_true", help="measure the geometry from the camera's pictures (docs: Real cameras)"
+    )
+    calibrate.add_argument(
+        "--snapshot", type=Path, help="--geometry's first step: store the widest view as a preset, save its picture"
+    )
+    calibrate.add_argument(
+        "--ground-points", type=Path, help="--geometry: 4+ ground points in the snapshot (YAML, CSV u_px,v_px,x_m,y_m)"
+    )
+    calibrate.add_argument(
+        "--zoom-steps", type=positive_int, default=20, help="--geometry: zoom steps from the widest view (default 20)"
+    )
     calibrate.add_argument("--timeout-s", type=positive_float, default=5.0, help="the longest wait for any camera call")
     calibrate.set_defaults(handler="ptztrack.cli.camera:calibrate_camera_command")
 

@@ -12,6 +12,7 @@ from ptztrack.config.camera import Actions, AxisRange, Camera, LiveView, PoseErr
 from ptztrack.config.camera_calibration import (
     VIRTUAL_CAMERA_CALIBRATION,
     CameraCalibrationFile,
+    GroundViewSection,
     MoveTimesSection,
     load_camera_calibration,
     write_camera_calibration,
@@ -68,6 +69,7 @@ __all__ = [
     "AxisRange",
     "Camera",
     "CameraCalibrationFile",
+    "GroundViewSection",
     "Control",
     "DatasetView",
     "Degrees",

@@ -36,6 +36,20 @@ class MoveTimesSection(_Strict):
     zoom: _MoveTime = (0.0, 0.0)
 
 
+class GroundViewSection(_Strict):
+    """Where the camera saw the ground points (``camera calibrate --geometry``): a preset of the camera at
+    its widest zoom, and the world pose there (pan_deg, tilt_deg in the model's sense: the bearing from the
+    ground's +y axis towards +x, and the depression), found from the points; ``roll_deg`` is how far the
+    mount leans about the optical axis (the model takes a level mount), ``reprojection_error_px`` the points'
+    root-mean-square error through the fitted camera."""
+
+    preset: Annotated[str, Field(min_length=1, max_length=64)]
+    pan_deg: Degrees
+    tilt_deg: Degrees
+    roll_deg: Degrees = 0.0
+    reprojection_error_px: Annotated[NonNegativeFloat, at_most(1e4, "pixels")] = 0.0
+
+
 class CameraCalibrationFile(_Strict):
     """How a camera's normalised ONVIF spaces map to the camera model, and how long its moves take.
 
@@ -46,6 +60,11 @@ class CameraCalibrationFile(_Strict):
     its images show where it stands (a frame interval and the stream's latency; 0.1 s: a 10 fps stream);
     capture_time_sd_s : how uncertain a picture's capture time is (0.02 s, half a frame at 25 fps, until
     ``ptztrack camera calibrate`` measures it: the spread of its delays).
+    zoom_curve_sd : the standard deviation of each zoom_curve point's zoom factor (as measured by
+    ``camera calibrate --geometry``; null: not measured); positions : whether the camera reports its
+    position (false: pan_deg and tilt_deg are the degrees at normalised -1 and +1 from the ground view's
+    preset, which stands at 0, and the camera is moved by relative moves); ground_view : see
+    :class:`GroundViewSection` (null: not measured).
     """
 
     pan_deg: tuple[Degrees, Degrees]
@@ -58,6 +77,12 @@ class CameraCalibrationFile(_Strict):
     move_times: MoveTimesSection = MoveTimesSection()
     image_delay_s: Annotated[NonNegativeFloat, at_most(10, "seconds")] = 0.1
     capture_time_sd_s: Annotated[NonNegativeFloat, at_most(1, "seconds")] = 0.02
+    zoom_curve_sd: (
+        Annotated[list[Annotated[NonNegativeFloat, at_most(100, "a zoom factor")]], at_most_items(1000, "a table")]
+        | None
+    ) = None
+    positions: bool = True
+    ground_view: GroundViewSection | None = None
 
     @model_validator(mode="after")
     def _monotonic(self):
@@ -66,6 +91,10 @@ class CameraCalibrationFile(_Strict):
         curve = np.asarray(self.zoom_curve, dtype=float)
         if np.any(np.diff(curve, axis=0) <= 0):
             raise ValueError("zoom_curve must increase in both columns, point after point")
+        if self.zoom_curve_sd is not None and len(self.zoom_curve_sd) != len(self.zoom_curve):
+            raise ValueError(f"zoom_curve_sd has {len(self.zoom_curve_sd)} values for {len(self.zoom_curve)} points")
+        if not self.positions and self.ground_view is None:
+            raise ValueError("a camera without positions (positions: false) needs its ground_view's preset")
         return self
 
 
@@ -81,10 +110,11 @@ def load_camera_calibration(path: str | Path) -> CameraCalibrationFile:
 
 
 # The virtual ONVIF camera of `ptztrack serve-camera` over PETS: spaces wider than the PETS grid, as a
-# real camera's are, and the zoom range of the virtual camera.
+# real camera's are, and the zoom range of the virtual camera. Its tilt is ONVIF's (normalised +1 looks
+# up): the model's depression is 45 degrees at -1 and -45 at +1.
 VIRTUAL_CAMERA_CALIBRATION = {
     "pan_deg": (-90.0, 90.0),
-    "tilt_deg": (-45.0, 45.0),
+    "tilt_deg": (45.0, -45.0),
     "zoom_curve": [(0.0, 1.0), (1.0, 8.0)],
 }
 

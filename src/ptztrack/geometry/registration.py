@@ -53,10 +53,12 @@ from ptztrack.geometry.ptz import PTZCamera, inside_image, intrinsics, rotation_
 RATIO_TEST = 0.75
 RANSAC_THRESHOLD_PX = 3.0
 MIN_INLIERS = 12
-# SIFT runs on the image halved: OpenCV's SIFT doubles its input first, so at full size a 640 x 480
-# view costs over 100 ms, and a PTZ view zoomed past the recording's resolution holds no detail at
-# the finest scales anyway. Keypoints are reported in full-size pixels.
+# SIFT runs on an image wider than SIFT_HALVED_FROM_PX halved: OpenCV's SIFT doubles its input first, so
+# at full size a 640 x 480 view costs over 100 ms, and a PTZ view zoomed past the recording's resolution
+# holds no detail at the finest scales anyway. A narrower image (a 160 x 120 stream) keeps its size: halved
+# it holds a few dozen features. Keypoints are reported in full-size pixels.
 SIFT_IMAGE_SCALE = 0.5
+SIFT_HALVED_FROM_PX = 320
 # A PTZ view zoomed in on the recording is an enlarged, blurred image: at SIFT's default contrast
 # threshold (0.04) a 3.4x view of PETS has 12 features, at 0.01 it has the 1000 asked for (the
 # strongest are kept, so a sharp view loses nothing).
@@ -130,13 +132,15 @@ def sift_features(image_bgr: np.ndarray, features: int) -> tuple[np.ndarray, np.
     (col + 0.5, row + 0.5).
     """
     gray = cv2.cvtColor(image_bgr, cv2.COLOR_BGR2GRAY)
-    halved = cv2.resize(gray, None, fx=SIFT_IMAGE_SCALE, fy=SIFT_IMAGE_SCALE, interpolation=cv2.INTER_AREA)
+    scale = SIFT_IMAGE_SCALE if gray.shape[1] >= SIFT_HALVED_FROM_PX else 1.0
+    if scale != 1.0:
+        gray = cv2.resize(gray, None, fx=scale, fy=scale, interpolation=cv2.INTER_AREA)
     detector = cv2.SIFT.create(nfeatures=features, contrastThreshold=SIFT_CONTRAST_THRESHOLD)
-    keypoints, descriptors = detector.detectAndCompute(halved, None)
+    keypoints, descriptors = detector.detectAndCompute(gray, None)
     if descriptors is None:
         return np.zeros((0, 2)), np.zeros((0, 128), dtype=np.float32)
     # OpenCV puts pixel centres at whole coordinates.
-    return (np.array([k.pt for k in keypoints], dtype=float) + 0.5) / SIFT_IMAGE_SCALE, descriptors
+    return (np.array([k.pt for k in keypoints], dtype=float) + 0.5) / scale, descriptors
 
 
 def ratio_matches(query: np.ndarray, train: np.ndarray, ratio: float = RATIO_TEST) -> np.ndarray:

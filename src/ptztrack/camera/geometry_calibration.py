@@ -1,0 +1,268 @@
+"""A real (or virtual) ONVIF PTZ camera's geometry measured from its own pictures
+(:mod:`ptztrack.geometry.self_calibration` has the maths): what ``ptztrack camera calibrate --geometry``
+does with the camera.
+
+Every move is a RelativeMove, which cameras without AbsoluteMove or positions have too, and every
+picture is taken once the camera stands still (GetStatus's MoveStatus, then a picture that arrived
+``image_delay_s`` later). The ground view is a preset of the camera (:data:`GROUND_PRESET`) at its
+widest zoom, set where the ground points were picked (:func:`take_ground_snapshot`); the measurement
+starts there and ends there:
+
+1. turns of a few tenths of the view, both ways in pan and in tilt and along the diagonals, each
+   pictured and matched to the ground view (their size from a small probe turn first): the widest focal
+   length and each axis' degrees per unit of the normalised translation space;
+2. the zoom from the widest view to the narrowest in steps that each magnify by about
+   ``TARGET_ZOOM_RATIO``, each picture matched to the one and the two before: the focal length at every
+   step.
+"""
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from ptztrack.camera.onvif_client import CameraError, ONVIFClient
+from ptztrack.camera.stream import LatestFrame
+from ptztrack.geometry.self_calibration import (
+    RotationFit,
+    focal_from_rotations,
+    focals_from_ratios,
+    matched_points,
+    zoom_ratio,
+)
+
+GROUND_PRESET = "ptztrack-ground"
+# A probe turn of this much of the normalised range sizes the turns; the turns then move the picture by
+# TURN_FRACTION of its width (pan) or height (tilt), within [MIN_TURN, MAX_TURN] of the range.
+PROBE_TURN, TURN_FRACTION, MIN_TURN, MAX_TURN = 0.02, 0.4, 0.002, 0.5
+# The zoom's steps each magnify by about this much (SIFT matches a 160 x 120 view to one 1.35 times
+# larger at times only), none less than MIN_ZOOM_STEP of the normalised range.
+TARGET_ZOOM_RATIO, MIN_ZOOM_STEP = 1.2, 0.004
+# A turn that comes out shorter than this fraction of its opposite stopped at a limit of the head.
+CLIPPED_TURN = 0.8
+# How long a camera may take to begin moving before GetStatus is trusted to say it has (seconds), and to
+# stand still at most.
+MOVE_START_S, STILL_TIMEOUT_S = 0.3, 30.0
+# A picture counts as taken where the camera stands once it arrived at least this long after the camera
+# stood still, whatever the calibration's image_delay_s: an RTSP stream holds pictures back by 0.2-1 s, and
+# a picture of the move would spoil the measurement, where waiting costs a second a picture.
+SETTLED_AFTER_S = 1.0
+
+
+class GeometryError(CameraError):
+    """A step of the geometry's measurement that the camera's pictures cannot support (one line)."""
+
+
+@dataclass(frozen=True)
+class GeometryMeasurement:
+    """What the camera's pictures tell of its geometry.
+
+    ground_image : (h, w, 3) the ground view at the widest zoom; ground_position : (3,) its normalised
+    position (NaN where the camera reports none); rotations : the widest focal length's fit;
+    pan_deg_per_unit, tilt_deg_per_unit : the model's pan and tilt (depression) degrees per unit of the
+    normalised translation (signed); zoom_normalised : (K,) the zoom steps from 0 to 1; focal_px,
+    focal_sd_px : (K,) the focal length at each and its standard deviation.
+    """
+
+    ground_image: np.ndarray
+    ground_position: np.ndarray
+    rotations: RotationFit
+    pan_deg_per_unit: float
+    tilt_deg_per_unit: float
+    zoom_normalised: np.ndarray
+    focal_px: np.ndarray
+    focal_sd_px: np.ndarray
+
+    @property
+    def image_size_px(self) -> tuple[int, int]:
+        return self.ground_image.shape[1], self.ground_image.shape[0]
+
+
+def moved(client: ONVIFClient, translation) -> None:
+    """RelativeMove by ``translation`` (3,) (normalised) and wait until the camera stands still: a relative
+    move counts from where the camera is when it arrives, so the next one must wait."""
+    client.relative_move(translation)
+    stood_still(client)
+
+
+def stood_still(client: ONVIFClient) -> None:
+    """Wait until the camera, sent a move just before, stands still (GetStatus's MoveStatus)."""
+    time.sleep(MOVE_START_S)
+    if client.wait_still(time.monotonic() + STILL_TIMEOUT_S).moving:
+        raise CameraError(f"{client.address}: still moving after {STILL_TIMEOUT_S:g} s")
+
+
+def settled_picture(client: ONVIFClient, latest: LatestFrame, image_delay_s: float, translation) -> np.ndarray:
+    """RelativeMove by ``translation`` (3,), then the first picture that arrived ``image_delay_s`` after the
+    camera stood still."""
+    moved(client, translation)
+    still_s = time.time()
+    deadline_s = time.monotonic() + STILL_TIMEOUT_S
+    number = 0
+    while time.monotonic() < deadline_s:
+        frame = latest.newer(number, 1.0)
+        if frame is None:
+            continue
+        if frame.time_s >= still_s + max(image_delay_s, SETTLED_AFTER_S):
+            return frame.image
+        number = frame.number
+    raise CameraError(f"{client.address}: no picture from its stream for {STILL_TIMEOUT_S:g} s")
+
+
+def ground_preset(client: ONVIFClient) -> str | None:
+    """The token of the camera's :data:`GROUND_PRESET`, None if it has none."""
+    return next((token for token, name in client.presets().items() if name == GROUND_PRESET), None)
+
+
+def take_ground_snapshot(client: ONVIFClient, latest: LatestFrame, image_delay_s: float) -> np.ndarray:
+    """Zoom the camera out fully where it looks, store that as :data:`GROUND_PRESET` (replacing an
+    earlier one) and return its picture (h, w, 3): the picture to pick ground points in."""
+    image = settled_picture(client, latest, image_delay_s, (0.0, 0.0, -1.0))
+    token = ground_preset(client)
+    if token is not None:
+        client.remove_preset(token)
+    client.set_preset(GROUND_PRESET)
+    return image
+
+
+def _turn(
+    client: ONVIFClient,
+    latest: LatestFrame,
+    image_delay_s: float,
+    ground: np.ndarray,
+    translation,
+    name: str,
+    report: Callable[[str], None],
+) -> tuple[np.ndarray, np.ndarray]:
+    """Turn by ``translation`` (3,), picture, match with the ground view, turn back; the matches."""
+    image = settled_picture(client, latest, image_delay_s, translation)
+    moved(client, -np.asarray(translation, dtype=float))
+    points = matched_points(ground, image)
+    if len(points[0]) == 0:
+        raise GeometryError(f"the {name} did not register against the ground view: too few features match")
+    report(f"{name}: {len(points[0])} matches")
+    return points
+
+
+def _turn_size(client, latest, image_delay_s: float, ground: np.ndarray, axis: int, report) -> float:
+    """The normalised turn on ``axis`` (0 pan, 1 tilt) that moves the picture by TURN_FRACTION of its size."""
+    probe = np.zeros(3)
+    probe[axis] = PROBE_TURN
+    name = ("pan", "tilt")[axis]
+    points_a, points_b = _turn(client, latest, image_delay_s, ground, probe, f"{name} probe of {PROBE_TURN:g}", report)
+    shift_px = abs(float(np.median(points_b[:, axis] - points_a[:, axis])))
+    size_px = ground.shape[1 - axis]
+    return float(np.clip(PROBE_TURN * TURN_FRACTION * size_px / max(shift_px, 1e-3), MIN_TURN, MAX_TURN))
+
+
+def _degrees_per_unit(fit: RotationFit, turns: np.ndarray, axis: int) -> float:
+    """The model's degrees per normalised unit on ``axis`` from the turns both ways (the first two of the
+    fit on pan, the next two on tilt): their angles over their sizes, a turn stopped by a limit left out.
+    A positive pan (tilt) moves the picture's content left (up): the sign follows the centre's shift."""
+    pair = slice(2 * axis, 2 * axis + 2)
+    angles, sizes = fit.angles_deg[pair], np.abs(turns[pair])
+    per_unit = angles / sizes
+    kept = per_unit >= CLIPPED_TURN * per_unit.max()
+    shift = fit.centre_shift_px[pair][:, axis] * np.sign(turns[pair])
+    sign = -np.sign(np.sum(shift[kept]))
+    return float(sign * np.mean(per_unit[kept]))
+
+
+def _zoom_ladder(
+    client: ONVIFClient,
+    latest: LatestFrame,
+    image_delay_s: float,
+    widest: np.ndarray,
+    first_step: float,
+    report: Callable[[str], None],
+) -> tuple[np.ndarray, list[tuple[int, int, float, float]]]:
+    """Zoom from the widest view (normalised 0) to normalised 1 in steps sized so that each magnifies by
+    about ``TARGET_ZOOM_RATIO`` (the first ``first_step``; a step that does not register is halved, down to
+    ``MIN_ZOOM_STEP``), each picture matched to the one and the two before. The steps' normalised zooms
+    (K + 1,) and the scales (i, j, s_ij, sd_ij) between them."""
+    pictures, zooms = [widest], [0.0]
+    ratios: list[tuple[int, int, float, float]] = []
+    step_size = first_step
+    while zooms[-1] < 1.0 - 1e-9:
+        step_size = min(step_size, 1.0 - zooms[-1])
+        picture = settled_picture(client, latest, image_delay_s, (0.0, 0.0, step_size))
+        step = len(pictures)
+        where = f"zoom step {step} (normalised zoom {zooms[-1] + step_size:.3f})"
+        found = []
+        for before in range(step - 1, max(step - 3, -1), -1):
+            points_a, points_b = matched_points(pictures[before], picture, refine=False)
+            if len(points_a):
+                found.append((before, step, *zoom_ratio(points_a, points_b, widest.shape[1::-1])))
+        if not found or found[0][0] != step - 1 or found[0][2] <= 1.0:
+            if step_size / 2 < MIN_ZOOM_STEP:
+                raise GeometryError(f"{where} did not register against the step before: too few features match")
+            report(f"{where} did not register against the step before: half the step")
+            step_size /= 2
+            moved(client, (0.0, 0.0, -step_size))
+            continue
+        ratio = found[0][2]
+        report(f"{where}: x{ratio:.4f} +- {found[0][3]:.4f} on the step before")
+        pictures.append(picture)
+        zooms.append(zooms[-1] + step_size)
+        ratios.extend(found)
+        step_size *= np.log(TARGET_ZOOM_RATIO) / np.log(ratio)
+    return np.array(zooms), ratios
+
+
+def measure_geometry(
+    client: ONVIFClient,
+    latest: LatestFrame,
+    image_delay_s: float,
+    zoom_steps: int = 20,
+    report: Callable[[str], None] = print,
+) -> GeometryMeasurement:
+    """Measure the camera's geometry from its ground preset (see the module); the camera ends there.
+
+    latest : its stream's newest picture (a started :class:`~ptztrack.camera.stream.FrameStream`);
+    image_delay_s : how late its pictures are; report : where each step's line goes. A
+    :class:`GeometryError` names the step whose pictures did not register.
+    """
+    token = ground_preset(client)
+    if token is None:
+        raise GeometryError(
+            f"the camera has no preset {GROUND_PRESET!r}: take the ground view first (camera calibrate --geometry "
+            "--snapshot PATH)"
+        )
+    client.goto_preset(token)
+    stood_still(client)
+    ground = settled_picture(client, latest, image_delay_s, (0.0, 0.0, -1.0))
+    ground_position = client.status().position
+    report(f"ground view: {ground.shape[1]}x{ground.shape[0]} px")
+    pan_turn = _turn_size(client, latest, image_delay_s, ground, 0, report)
+    tilt_turn = _turn_size(client, latest, image_delay_s, ground, 1, report)
+    turns = np.array([pan_turn, -pan_turn, tilt_turn, -tilt_turn])
+    # Each axis both ways, then the four diagonals: a pan's axis, vertical, is tilted in a tilted view, so
+    # the diagonals turn the picture as well as shift it, which pins the focal length further.
+    signs = [(1, 0), (-1, 0), (0, 1), (0, -1), (1, 1), (-1, -1), (1, -1), (-1, 1)]
+    matches = []
+    for pan_sign, tilt_sign in signs:
+        translation = np.array([pan_sign * pan_turn, tilt_sign * tilt_turn, 0.0])
+        name = f"turn of {translation[0]:+.3f} pan, {translation[1]:+.3f} tilt"
+        matches.append(_turn(client, latest, image_delay_s, ground, translation, name, report))
+    size_px = (ground.shape[1], ground.shape[0])
+    rotations = focal_from_rotations(matches, size_px, float(size_px[0]))
+    report(
+        f"widest focal length {rotations.focal_px:.1f} +- {rotations.focal_sd_px:.1f} px "
+        f"(rms {rotations.rms_px:.2f} px over {len(matches)} turns)"
+    )
+    zoom_normalised, ratios = _zoom_ladder(client, latest, image_delay_s, ground, 1.0 / zoom_steps, report)
+    client.goto_preset(token)
+    focal_px, focal_sd_px = focals_from_ratios(
+        rotations.focal_px, rotations.focal_sd_px, len(zoom_normalised) - 1, ratios
+    )
+    return GeometryMeasurement(
+        ground_image=ground,
+        ground_position=np.asarray(ground_position, dtype=float),
+        rotations=rotations,
+        pan_deg_per_unit=_degrees_per_unit(rotations, turns, 0),
+        tilt_deg_per_unit=_degrees_per_unit(rotations, turns, 1),
+        zoom_normalised=zoom_normalised,
+        focal_px=focal_px,
+        focal_sd_px=focal_sd_px,
+    )

@@ -1,0 +1,284 @@
+"""A PTZ camera's geometry from its own pictures, no pattern (Sinha and Pollefeys, "Pan-tilt-zoom camera
+calibration and high-resolution mosaic generation", CVIU 2006).
+
+* **The widest focal length, from rotations.** A camera turning about its optical centre maps the
+  pixels of one view onto another by ``H = K R K^-1`` with ``K = [[f, 0, c_x], [0, f, c_y], [0, 0, 1]]``
+  (the principal point at the image centre). Over the matched points ``(p_a, p_b)`` of a few small
+  pans and tilts, ``f`` and each turn's rotation ``R_j`` (a rotation vector) minimise
+  ``sum |p_b - pi(K R_j K^-1 p_a)|^2`` (soft L1, 1 px). Only the perspective part of ``H`` tells
+  ``f`` from the turn's angle (a point at ``x`` from the centre moves by ``f tan(atan(x / f) + theta) - x``,
+  ``theta (f + x^2 / f)`` to second order), so the turns are made a good fraction of the view wide.
+  Its standard deviation is the Gauss-Newton one, ``sigma^2 (J^T J)^-1`` at the optimum.
+* **The focal length at every zoom, from homologies.** At a fixed pan and tilt a zoom maps view ``a``
+  onto view ``b`` by ``p_b - c = s (p_a - c) + t`` (``s = f_b / f_a``; ``t`` the lens's axis drifting
+  with the zoom), fitted by least squares on RANSAC's inliers; from the widest view's, the focal
+  lengths follow from the scales between neighbouring steps and between steps two apart by weighted
+  least squares in ``log f``.
+* **The ground, from four points or more.** Pixels of ground points of known (x, y) metres in one view
+  of known focal length give the camera's rotation and centre by planar PnP (OpenCV's IPPE, both of its
+  solutions tried, the one that puts the camera above the ground and the points in front, refined by
+  Levenberg-Marquardt): the centre ``-R^T t`` is the camera's position and height, the optical axis its
+  pan (bearing from +y towards +x) and tilt (depression), and what is left of ``R`` its roll, the mount's
+  lean. The model's mount is level, so the position, pan and tilt are then fitted again without roll
+  (five parameters, least squares of the reprojection error), which a few noisy points pin better.
+
+Pixels are in the model's convention: the picture's top left corner at (0, 0), pixel (row, col)'s
+centre at (col + 0.5, row + 0.5).
+"""
+
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+from scipy.optimize import least_squares
+from scipy.spatial.transform import Rotation
+
+from ptztrack.geometry.ptz import rotation_world_to_camera
+from ptztrack.geometry.registration import (
+    MIN_INLIERS,
+    RANSAC_THRESHOLD_PX,
+    pose_from_rotation,
+    ratio_matches,
+    sift_features,
+)
+
+# Features per picture for matching two views of the calibration.
+CALIBRATION_FEATURES = 2000
+# ECC's alignment: at most this many iterations, until the warp changes by less than ECC_EPSILON, on
+# pictures smoothed by a Gaussian this wide (px, odd); the correspondences then come from a grid of
+# MATCH_GRID (columns, rows) points.
+ECC_ITERATIONS, ECC_EPSILON, ECC_BLUR_PX = 100, 1e-6, 5
+MATCH_GRID = (16, 12)
+# Ground points whose spread across their second direction is below this fraction of the first lie on
+# one line: the ground's pose is then not pinned.
+COLLINEAR_RATIO = 0.05
+
+
+@dataclass(frozen=True)
+class RotationFit:
+    """The widest focal length from pure rotations.
+
+    focal_px, focal_sd_px : the focal length and its standard deviation; angles_deg : (J,) each turn's
+    angle; centre_shift_px : (J, 2) where view a's centre lands in view b, less the centre; rms_px : the
+    residuals' root mean square.
+    """
+
+    focal_px: float
+    focal_sd_px: float
+    angles_deg: np.ndarray
+    centre_shift_px: np.ndarray
+    rms_px: float
+
+
+@dataclass(frozen=True)
+class GroundPose:
+    """The camera's pose on the ground: position_m (3,) its optical centre (x, y, height), pan_deg,
+    tilt_deg (the model's, on a level mount), roll_deg (the roll about the optical axis that the points
+    show when it is let free), residuals_px (N,) each ground point's reprojection error on the level mount."""
+
+    position_m: np.ndarray
+    pan_deg: float
+    tilt_deg: float
+    roll_deg: float
+    residuals_px: np.ndarray
+
+    @property
+    def rms_px(self) -> float:
+        return float(np.sqrt(np.mean(self.residuals_px**2)))
+
+
+def matched_points(image_a: np.ndarray, image_b: np.ndarray, refine: bool = True) -> tuple[np.ndarray, np.ndarray]:
+    """Correspondences (M, 2) and (M, 2) of two views: SIFT, Lowe's ratio test and a RANSAC homography's
+    inliers (within ``RANSAC_THRESHOLD_PX``). With ``refine`` the homography is refined on every pixel by
+    OpenCV's ECC (enhanced correlation coefficient) alignment, and the correspondences are the points of a
+    ``MATCH_GRID`` grid of view a that it carries into view b (where ECC does not converge, the inliers):
+    sharp views of a turn gain from it, the blurred views of a lens zoomed past the scene's detail do not.
+    Empty (0, 2) arrays when fewer than ``MIN_INLIERS`` features agree."""
+    keypoints_a, descriptors_a = sift_features(image_a, CALIBRATION_FEATURES)
+    keypoints_b, descriptors_b = sift_features(image_b, CALIBRATION_FEATURES)
+    pairs = ratio_matches(descriptors_a, descriptors_b)
+    empty = np.zeros((0, 2)), np.zeros((0, 2))
+    if len(pairs) < MIN_INLIERS:
+        return empty
+    points_a, points_b = keypoints_a[pairs[:, 0]], keypoints_b[pairs[:, 1]]
+    H, inliers = cv2.findHomography(points_a, points_b, cv2.RANSAC, RANSAC_THRESHOLD_PX)
+    if H is None or inliers is None or inliers.sum() < MIN_INLIERS:
+        return empty
+    keep = inliers.ravel().astype(bool)
+    refined = _aligned(image_a, image_b, H) if refine else None
+    if refined is None:
+        return points_a[keep], points_b[keep]
+    height_px, width_px = image_a.shape[:2]
+    u, v = np.meshgrid(np.linspace(0, width_px, MATCH_GRID[0]), np.linspace(0, height_px, MATCH_GRID[1]))
+    grid = np.c_[u.ravel(), v.ravel()]
+    mapped = cv2.perspectiveTransform(grid.reshape(-1, 1, 2), refined)[:, 0, :]
+    inside = (mapped[:, 0] >= 0) & (mapped[:, 0] <= width_px) & (mapped[:, 1] >= 0) & (mapped[:, 1] <= height_px)
+    return grid[inside], mapped[inside]
+
+
+def _aligned(image_a: np.ndarray, image_b: np.ndarray, H_a_to_b: np.ndarray) -> np.ndarray | None:
+    """The homography (3, 3) of view a's pixels to view b's (the model's pixel convention) that ECC refines
+    from ``H_a_to_b``; None where it does not converge. OpenCV's pixel centres are at whole coordinates."""
+    to_opencv = np.array([[1.0, 0.0, -0.5], [0.0, 1.0, -0.5], [0.0, 0.0, 1.0]])
+    warp = (to_opencv @ H_a_to_b @ np.linalg.inv(to_opencv)).astype(np.float32)
+    grey_a, grey_b = (cv2.cvtColor(image, cv2.COLOR_BGR2GRAY).astype(np.float32) for image in (image_a, image_b))
+    # Where the recording (or the lens) shows nothing, there is nothing to align.
+    mask = (grey_a > 0).astype(np.uint8)
+    criteria = (cv2.TERM_CRITERIA_EPS | cv2.TERM_CRITERIA_COUNT, ECC_ITERATIONS, ECC_EPSILON)
+    try:
+        _, warp = cv2.findTransformECC(grey_a, grey_b, warp, cv2.MOTION_HOMOGRAPHY, criteria, mask, ECC_BLUR_PX)
+    except cv2.error:
+        return None
+    return np.linalg.inv(to_opencv) @ warp.astype(float) @ to_opencv
+
+
+def _rotated_px(focal_px: float, rotation_vector, centred_a: np.ndarray) -> np.ndarray:
+    """Centred pixels (M, 2) of view a carried into view b by ``K R K^-1`` (pixels centred on the principal point)."""
+    rays = np.c_[centred_a / focal_px, np.ones(len(centred_a))] @ Rotation.from_rotvec(rotation_vector).as_matrix().T
+    return focal_px * rays[:, :2] / rays[:, 2:]
+
+
+def focal_from_rotations(
+    matches: list[tuple[np.ndarray, np.ndarray]], image_size_px: tuple[int, int], focal_guess_px: float
+) -> RotationFit:
+    """The focal length shared by views related by pure rotations (the module's first part).
+
+    matches : (points_a (M, 2), points_b (M, 2)) per turn; image_size_px : (width, height), the principal
+    point at its centre; focal_guess_px : where the search starts (the image's width is a fair one).
+    """
+    centre = np.array(image_size_px, dtype=float) / 2.0
+    centred = [(a - centre, b - centre) for a, b in matches]
+    shifts = np.array([np.median(b - a, axis=0) for a, b in centred])
+    # A small turn about the camera's y axis moves the image by +f omega in u, about x by -f omega in v.
+    initial_rotations = np.c_[-shifts[:, 1], shifts[:, 0], np.zeros(len(shifts))] / focal_guess_px
+
+    def residuals(parameters: np.ndarray) -> np.ndarray:
+        focal_px = float(np.exp(parameters[0]))
+        rotations = parameters[1:].reshape(-1, 3)
+        return np.concatenate(
+            [(_rotated_px(focal_px, r, a) - b).ravel() for r, (a, b) in zip(rotations, centred, strict=True)]
+        )
+
+    start = np.r_[np.log(focal_guess_px), initial_rotations.ravel()]
+    result = least_squares(residuals, start, loss="soft_l1", f_scale=1.0, x_scale="jac")
+    focal_px = float(np.exp(result.x[0]))
+    rotations = result.x[1:].reshape(-1, 3)
+    dof = max(len(result.fun) - len(result.x), 1)
+    sigma2 = float(np.sum(result.fun**2) / dof)
+    covariance = sigma2 * np.linalg.pinv(result.jac.T @ result.jac)
+    centre_shift = np.array([_rotated_px(focal_px, r, np.zeros((1, 2)))[0] for r in rotations])
+    return RotationFit(
+        focal_px=focal_px,
+        focal_sd_px=focal_px * float(np.sqrt(max(covariance[0, 0], 0.0))),
+        angles_deg=np.rad2deg(np.linalg.norm(rotations, axis=1)),
+        centre_shift_px=centre_shift,
+        rms_px=float(np.sqrt(np.mean(residuals(result.x) ** 2))),
+    )
+
+
+def zoom_ratio(points_a: np.ndarray, points_b: np.ndarray, image_size_px: tuple[int, int]) -> tuple[float, float]:
+    """The homology's scale ``s = f_b / f_a`` between two views at one pan and tilt, and its standard
+    deviation: least squares of ``p_b - c = s (p_a - c) + t`` over the matches (M, 2), (M, 2)."""
+    centre = np.array(image_size_px, dtype=float) / 2.0
+    a, b = points_a - centre, points_b - centre
+    design = np.zeros((2 * len(a), 3))
+    design[0::2, 0], design[1::2, 0] = a[:, 0], a[:, 1]
+    design[0::2, 1], design[1::2, 2] = 1.0, 1.0
+    solution, *_ = np.linalg.lstsq(design, b.ravel(), rcond=None)
+    fitted = design @ solution - b.ravel()
+    sigma2 = float(fitted @ fitted / max(len(fitted) - 3, 1))
+    covariance = sigma2 * np.linalg.inv(design.T @ design)
+    return float(solution[0]), float(np.sqrt(covariance[0, 0]))
+
+
+def focals_from_ratios(
+    widest_px: float, widest_sd_px: float, steps: int, ratios: list[tuple[int, int, float, float]]
+) -> tuple[np.ndarray, np.ndarray]:
+    """The focal lengths (steps + 1,) of zoom steps 0 (the widest) to ``steps`` from homology scales
+    ``(i, j, s_ij, sd_ij)`` between steps i < j, and their standard deviations: weighted least squares of
+    ``log f_j - log f_i = log s_ij`` (each of weight ``(s_ij / sd_ij)^2``) with ``log f_0 = log widest_px``;
+    the widest's relative variance adds to every step's. Scales over two steps as well as one keep the
+    chain's small biases from adding up step after step."""
+    design = np.zeros((len(ratios), steps))
+    observed, weights = np.zeros(len(ratios)), np.zeros(len(ratios))
+    for row, (i, j, ratio, ratio_sd) in enumerate(ratios):
+        if i > 0:
+            design[row, i - 1] = -1.0
+        design[row, j - 1] = 1.0
+        observed[row], weights[row] = np.log(ratio), (ratio / max(ratio_sd, 1e-6)) ** 2
+    normal = design.T @ (weights[:, None] * design)
+    log_ratios = np.linalg.solve(normal, design.T @ (weights * observed))
+    covariance = np.linalg.inv(normal)
+    focals = widest_px * np.exp(np.r_[0.0, log_ratios])
+    relative_variance = (widest_sd_px / widest_px) ** 2 + np.r_[0.0, np.diag(covariance)]
+    return focals, focals * np.sqrt(relative_variance)
+
+
+def ground_points_problem(pixels_px, ground_m, image_size_px: tuple[int, int] | None) -> str | None:
+    """What makes ground points (N, 2) px and (N, 2) m unusable to place a camera, in a few words (fewer
+    than four, not finite, a pixel outside an ``image_size_px`` (width, height) picture where given, two
+    at one place, on one line); None if nothing."""
+    pixels_px, ground_m = np.asarray(pixels_px, dtype=float), np.asarray(ground_m, dtype=float)
+    if pixels_px.shape != ground_m.shape or pixels_px.ndim != 2 or pixels_px.shape[1:] != (2,):
+        return "expected as many pixel (u, v) as ground (x, y) points"
+    if len(pixels_px) < 4:
+        return f"{len(pixels_px)} ground points: at least 4 are needed"
+    if not (np.all(np.isfinite(pixels_px)) and np.all(np.isfinite(ground_m))):
+        return "a ground point is not finite"
+    width_px, height_px = (np.inf, np.inf) if image_size_px is None else image_size_px
+    outside = np.flatnonzero(
+        (pixels_px[:, 0] < 0) | (pixels_px[:, 0] > width_px) | (pixels_px[:, 1] < 0) | (pixels_px[:, 1] > height_px)
+    )
+    if len(outside) and image_size_px is None:
+        return f"point {outside[0] + 1}'s pixel is negative: pixels count from the picture's top left corner"
+    if len(outside):
+        u, v = pixels_px[outside[0]]
+        return f"point {outside[0] + 1}'s pixel ({u:g}, {v:g}) is outside the {width_px}x{height_px} px picture"
+    for name, points in (("ground", ground_m), ("pixel", pixels_px)):
+        distances = np.linalg.norm(points[:, None] - points[None, :], axis=-1)[np.triu_indices(len(points), 1)]
+        if distances.min() == 0:
+            return f"two points share their {name} position"
+        spread = np.linalg.svd(points - points.mean(axis=0), compute_uv=False)
+        if spread[1] < COLLINEAR_RATIO * spread[0]:
+            return f"the points' {name} positions lie on one line: spread them over the ground"
+    return None
+
+
+def ground_pose(pixels_px, ground_m, focal_px: float, image_size_px: tuple[int, int]) -> GroundPose:
+    """The camera's pose from ground points (the module's third part): pixels (N, 2) of ground points
+    (N, 2) m (on z = 0) in a view of focal length ``focal_px``, the principal point at the centre of an
+    ``image_size_px`` (width, height) picture. Raises ValueError when no solution puts the camera above
+    the ground with the points in front of it."""
+    pixels_px, ground_m = np.asarray(pixels_px, dtype=float), np.asarray(ground_m, dtype=float)
+    K = np.array([[focal_px, 0, image_size_px[0] / 2.0], [0, focal_px, image_size_px[1] / 2.0], [0, 0, 1.0]])
+    object_points = np.c_[ground_m, np.zeros(len(ground_m))]
+    # K's principal point is in the model's pixel convention, as are the points: OpenCV's is not needed.
+    image_points = pixels_px.reshape(-1, 1, 2)
+    count, rotations, translations, _ = cv2.solvePnPGeneric(
+        object_points, image_points, K, None, flags=cv2.SOLVEPNP_IPPE
+    )
+    best = None
+    for rvec, tvec in zip(rotations[:count], translations[:count], strict=True):
+        rvec, tvec = cv2.solvePnPRefineLM(object_points, image_points, K, None, rvec.copy(), tvec.copy())
+        R = cv2.Rodrigues(rvec)[0]
+        centre_m = -R.T @ tvec.ravel()
+        in_front = np.all((object_points @ R.T + tvec.ravel())[:, 2] > 0)
+        projected, _ = cv2.projectPoints(object_points, rvec, tvec, K, None)
+        errors_px = np.linalg.norm(projected[:, 0, :] - image_points[:, 0, :], axis=1)
+        if centre_m[2] > 0 and in_front and (best is None or errors_px.mean() < best[2].mean()):
+            best = (R, centre_m, errors_px)
+    if best is None:
+        raise ValueError("no camera pose puts the camera above the ground with every point in front of it")
+    R, centre_m, _ = best
+    pan_deg, tilt_deg = pose_from_rotation(R)
+    rolled = R @ rotation_world_to_camera(pan_deg, tilt_deg).T
+    roll_deg = float(np.rad2deg(np.arctan2(rolled[1, 0], rolled[0, 0])))
+
+    def level_residuals(level: np.ndarray) -> np.ndarray:
+        camera_points = (object_points - level[:3]) @ rotation_world_to_camera(level[3], level[4]).T
+        projected = camera_points[:, :2] / camera_points[:, 2:] @ K[:2, :2].T + K[:2, 2]
+        return (projected - image_points[:, 0, :]).ravel()
+
+    level = least_squares(level_residuals, np.r_[centre_m, pan_deg, tilt_deg], xtol=1e-12, ftol=1e-12, gtol=1e-12).x
+    errors = np.linalg.norm(level_residuals(level).reshape(-1, 2), axis=1)
+    return GroundPose(level[:3], float(level[3]), float(level[4]), roll_deg, errors)
