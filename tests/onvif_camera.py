@@ -16,7 +16,8 @@ from ptztrack.virtual_onvif.server import VirtualONVIFCamera  # noqa: E402
 
 HOST = "127.0.0.1"
 USER, PASSWORD = "operator", "s3cret-pass"
-SPACES = CameraSpaces(pan_deg=(-170.0, 170.0), tilt_deg=(-10.0, 80.0), zoom_curve=((0.0, 1.0), (1.0, 8.0)))
+# ONVIF's tilt: normalised +1 looks up, 10 degrees above the horizon (a depression of -10).
+SPACES = CameraSpaces(pan_deg=(-170.0, 170.0), tilt_deg=(80.0, -10.0), zoom_curve=((0.0, 1.0), (1.0, 8.0)))
 FAST = AxisSpeeds(pan_deg_s=340.0, tilt_deg_s=180.0, zoom_per_s=14.0)
 START_POSE = (0.0, 20.0, 1.0)
 WIDTH_PX, HEIGHT_PX, F_MIN_PX = 320, 240, 300.0

@@ -211,7 +211,7 @@ def test_every_operation_answers_schema_valid_xml_and_faults_are_soap_1_2_with_t
     are SOAP 1.2 faults with ONVIF subcodes, 400 for env:Sender and 500 for env:Receiver."""
     settings = MediaSettings("x", "http://x", 1, 1, 1, 1, "http://x", "rtsp://x")
     ptz = PTZService(None, SPACES, np.zeros(3), (WIDTH_PX, HEIGHT_PX), F_MIN_PX)
-    supported = set(DeviceMediaService(settings).operations()) | set(ptz.operations())
+    supported = set(DeviceMediaService(settings, ptz).operations()) | set(ptz.operations())
     assert {(NAMESPACES[prefix], name) for prefix, name in REQUESTS} == supported
     with camera() as cam:
         for (prefix, name), body in REQUESTS.items():
@@ -281,6 +281,62 @@ def test_every_operation_answers_schema_valid_xml_and_faults_are_soap_1_2_with_t
         status, root = post(cam.onvif_port, soap_1_1)
         assert status == 500
         assert_soap_1_2_fault(root.find(f"{{{SOAP}}}Body")[0], "VersionMismatch", [])
+
+
+@pytest.mark.parametrize(("positions", "absolute_moves"), [(False, True), (True, False)])
+def test_a_camera_without_positions_or_absolute_moves_answers_schema_valid_xml_that_says_so(
+    schema, positions, absolute_moves
+):
+    """--no-positions: GetStatus has MoveStatus and UtcTime but no Position, a preset no PTZPosition, and
+    the capabilities say StatusPosition="false". --relative-only: no absolute position space in the node
+    or the configuration options, no default absolute space or limits in any configuration (a profile's
+    included), and AbsoluteMove is the SOAP 1.2 fault env:Receiver ter:ActionNotSupported
+    ter:OptionalActionNotSupported (HTTP 500). Every other answer is as before, valid against the schemas."""
+    tt, tptz = f"{{{NAMESPACES['tt']}}}", f"{{{NAMESPACES['tptz']}}}"
+    answers = {}
+    with camera(positions=positions, absolute_moves=absolute_moves) as cam:
+        for (prefix, name), body in REQUESTS.items():
+            status, answer = soap(cam.onvif_port, body)
+            answers[prefix, name] = answer
+            if (name, absolute_moves) == ("AbsoluteMove", False):
+                assert status == 500
+                assert_soap_1_2_fault(answer, "Receiver", ["ActionNotSupported", "OptionalActionNotSupported"])
+                assert "AbsoluteMove" in answer.findtext(f".//{{{SOAP}}}Text")
+                continue
+            assert (status, answer.tag) == (200, f"{{{NAMESPACES[prefix]}}}{name}Response"), (name, status)
+            assert schema.validate(answer), (name, str(schema.error_log))
+    status = answers["tptz", "GetStatus"].find(f"{tptz}PTZStatus")
+    assert [child.tag for child in status] == [
+        *([f"{tt}Position"] if positions else []),
+        f"{tt}MoveStatus",
+        f"{tt}UtcTime",
+    ]
+    presets = answers["tptz", "GetPresets"].findall(f"{tptz}Preset")  # asked after SetPreset
+    assert presets and all((preset.find(f"{tt}PTZPosition") is None) != positions for preset in presets)
+    ptz_capabilities = answers["tptz", "GetServiceCapabilities"].find(f"{tptz}Capabilities")
+    assert ptz_capabilities.get("StatusPosition") == str(positions).lower()
+    assert str(positions).lower() in [
+        element.get("StatusPosition") for element in answers["tds", "GetServices"].iter(f"{tptz}Capabilities")
+    ]
+    absolute = {f"{tt}AbsolutePanTiltPositionSpace", f"{tt}AbsoluteZoomPositionSpace"}
+    defaults = {f"{tt}DefaultAbsolutePantTiltPositionSpace", f"{tt}DefaultAbsoluteZoomPositionSpace"}
+    limits = {f"{tt}PanTiltLimits", f"{tt}ZoomLimits"}
+    for key, element in (
+        (("tptz", "GetNodes"), f"{tt}SupportedPTZSpaces"),
+        (("tptz", "GetNode"), f"{tt}SupportedPTZSpaces"),
+        (("tptz", "GetConfigurationOptions"), f"{tt}Spaces"),
+    ):
+        spaces = {child.tag for child in answers[key].iter(element) for child in child}
+        assert (absolute <= spaces) == absolute_moves and f"{tt}RelativePanTiltTranslationSpace" in spaces, key
+    for key, tag in (
+        (("tptz", "GetConfigurations"), f"{tptz}PTZConfiguration"),
+        (("tptz", "GetConfiguration"), f"{tptz}PTZConfiguration"),
+        (("tptz", "GetCompatibleConfigurations"), f"{tptz}PTZConfiguration"),
+        (("trt", "GetProfiles"), f"{tt}PTZConfiguration"),
+    ):
+        configuration = {child.tag for child in next(answers[key].iter(tag))}
+        assert ((defaults | limits) <= configuration) == absolute_moves, key
+        assert not (defaults | limits) & configuration or absolute_moves, key
 
 
 def test_a_replayed_or_stale_usernametoken_is_refused_and_the_nonce_store_forgets_past_the_window():

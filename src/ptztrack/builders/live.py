@@ -13,6 +13,7 @@ import threading
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
+from pathlib import Path
 from typing import TYPE_CHECKING, cast, get_args
 
 import cv2
@@ -27,7 +28,13 @@ from ptztrack.camera.onvif_spaces import AxisSpeeds, CameraSpaces, MoveTimes
 from ptztrack.camera.pose_timeline import PoseTimeline
 from ptztrack.camera.recorded import RecordedPTZ
 from ptztrack.camera.stream import thumbnail
-from ptztrack.config import VIRTUAL_CAMERA_CALIBRATION, CameraCalibrationFile, Scenario
+from ptztrack.config import (
+    VIRTUAL_CAMERA_CALIBRATION,
+    CameraCalibrationFile,
+    Scenario,
+    ScenarioError,
+    load_camera_calibration,
+)
 from ptztrack.control.information_policy import InformationMethod
 from ptztrack.loop.alone import AlonePolicy, AloneTracker
 from ptztrack.loop.live import LiveEpisode, PlanAhead, run_live_network, warm_up
@@ -38,6 +45,7 @@ from ptztrack.roles import NetworkPolicy, NetworkTracker, Policy
 from ptztrack.track.tracker import tracks_ahead
 from ptztrack.types import GroundTruth
 from ptztrack.view.video import RenderView
+from ptztrack.virtual_onvif.head import MOVE_LATENCY_S
 
 if TYPE_CHECKING:
     from ptztrack.virtual_onvif.server import VirtualONVIFCamera
@@ -154,7 +162,8 @@ def live_pictures(live: LiveEpisode) -> RenderView:
 
 
 # The virtual camera's mechanics, a priori: an IP PTZ dome's preset moves (Axis and Sony domes turn at
-# 100-450 deg/s; 90 deg/s is a slow one) and a zoom through 1x-4x in a second; its stream at PAL's 25 fps.
+# 100-450 deg/s; 90 deg/s is a slow one) and a zoom through 1x-4x in a second, each move starting
+# MOVE_LATENCY_S after its command (virtual_onvif.head); its stream at PAL's 25 fps.
 VIRTUAL_SPEEDS = AxisSpeeds(pan_deg_s=90.0, tilt_deg_s=90.0, zoom_per_s=3.0)
 VIRTUAL_FRAME_RATE_HZ = 25.0
 # A stream holds a picture back by about one frame interval (the encoder's and the decoder's pipelines).
@@ -163,16 +172,123 @@ VIRTUAL_IMAGE_DELAY_S = 1.0 / VIRTUAL_FRAME_RATE_HZ
 
 def virtual_calibration() -> CameraCalibrationFile:
     """The calibration of ``ptztrack serve-camera``'s camera (``--calibration virtual``): its spaces, its
-    moves' times from its speeds, and its stream's delay."""
-    speeds = VIRTUAL_SPEEDS
+    moves' times from its latency and speeds, and its stream's delay."""
+    return _with_virtual_mechanics(VIRTUAL_CAMERA_CALIBRATION)
+
+
+def _with_virtual_mechanics(spaces: dict) -> CameraCalibrationFile:
+    """The calibration of a virtual camera of ``spaces`` (the fields of a calibration): its moves' times,
+    ``MOVE_LATENCY_S + distance / speed`` per axis, and its stream's delay."""
+    speeds, latency_s = VIRTUAL_SPEEDS, MOVE_LATENCY_S
     move_times = {
-        "pan": (0.0, 1 / speeds.pan_deg_s),
-        "tilt": (0.0, 1 / speeds.tilt_deg_s),
-        "zoom": (0.0, 1 / speeds.zoom_per_s),
+        "pan": (latency_s, 1 / speeds.pan_deg_s),
+        "tilt": (latency_s, 1 / speeds.tilt_deg_s),
+        "zoom": (latency_s, 1 / speeds.zoom_per_s),
     }
     return CameraCalibrationFile.model_validate(
-        {**VIRTUAL_CAMERA_CALIBRATION, "move_times": move_times, "image_delay_s": VIRTUAL_IMAGE_DELAY_S}
+        {**spaces, "move_times": move_times, "image_delay_s": VIRTUAL_IMAGE_DELAY_S}
     )
+
+
+@dataclass(frozen=True)
+class GeometryPriors:
+    """The a-priori ranges a hidden geometry of the virtual camera is drawn from (:func:`virtual_geometry`),
+    each uniform; the geometry maps the normalised ONVIF spaces to the model's pose.
+
+    pan_span_deg : the pan from normalised -1 to +1 (a dome's 180 degrees to a 350-degree head);
+    start_pan : where in the normalised pan the recording's start pose falls (the offset of the pan);
+    tilt_down_deg : the depression at normalised tilt -1 (ONVIF's sign: +1 looks up), 60-90 degrees
+    down; tilt_up_deg : the depression at +1, 5-30 degrees above the horizon;
+    widest_zoom : the zoom factor z0 at normalised 0 (relative to the recording's focal length: a
+    camera at most a little narrower than the recording); longest_zoom : zmax at normalised 1;
+    zoom_gamma : the curve's shape, through ``zoom_points`` points n in [0, 1]:
+    ``zoom(n) = z0 (zmax / z0) ** (n ** gamma)`` (a lens's zoom grows faster or slower than its motor).
+    """
+
+    pan_span_deg: tuple[float, float] = (180.0, 350.0)
+    start_pan: tuple[float, float] = (-0.6, 0.6)
+    tilt_down_deg: tuple[float, float] = (60.0, 90.0)
+    tilt_up_deg: tuple[float, float] = (-30.0, -5.0)
+    widest_zoom: tuple[float, float] = (1.0, 1.15)
+    longest_zoom: tuple[float, float] = (6.0, 10.0)
+    zoom_gamma: tuple[float, float] = (0.7, 1.4)
+    zoom_points: int = 11
+
+
+def virtual_geometry(
+    scenario: Scenario, seed: int | None = None, path: str | Path | None = None
+) -> CameraCalibrationFile:
+    """The true calibration of the virtual camera over ``scenario``'s recording: its geometry (pan_deg,
+    tilt_deg, zoom_curve), the recording camera's position_m and f_min_px, and the virtual camera's
+    mechanics and stream (:func:`virtual_calibration`'s move times and delay).
+
+    The geometry is drawn from ``numpy.random.default_rng(seed)`` within :class:`GeometryPriors`, or
+    read from the calibration file at ``path`` (its pan_deg, tilt_deg and zoom_curve; its position_m and
+    f_min_px, if given, must be the recording camera's: the virtual camera stands at the recording's
+    optical centre, its zoom factor relative to the recording's f_min_px), or with neither is
+    :func:`virtual_calibration`'s. The recording's start pan and tilt must lie within it (its zoom is
+    brought within the zoom curve: :func:`_virtual_start_pose`). A :class:`ScenarioError` of one line
+    otherwise, or for a negative seed, or for both a seed and a path.
+    """
+    if seed is not None and path is not None:
+        raise ScenarioError("a virtual camera's geometry is drawn from a seed or read from a file, not both")
+    if seed is None and path is None:
+        return virtual_calibration()
+    world = episode_world(scenario, 0)
+    camera, start = world.camera, world.grid.poses[world.start_action]
+    recording: dict[str, tuple[float, ...] | float] = {
+        "position_m": tuple(float(value) for value in camera.position_m),
+        "f_min_px": float(camera.f_min_px),
+    }
+    if path is not None:
+        source, given = str(path), load_camera_calibration(path)
+        for name, value in recording.items():
+            if getattr(given, name) is not None and not np.allclose(getattr(given, name), value, rtol=1e-6, atol=0.0):
+                raise ScenarioError(
+                    f"{path}: {name} {getattr(given, name)} is not the recording camera's {value}: the virtual "
+                    f"camera stands at the recording's optical centre (leave {name} out, or give {value})"
+                )
+        spaces = {"pan_deg": given.pan_deg, "tilt_deg": given.tilt_deg, "zoom_curve": given.zoom_curve}
+    else:
+        assert seed is not None
+        if seed < 0:
+            raise ScenarioError(f"the geometry's seed {seed} is negative; expected a whole number >= 0")
+        source, spaces = f"the geometry of seed {seed}", _drawn_geometry(np.random.default_rng(seed), start)
+    truth = _with_virtual_mechanics({**spaces, **recording})
+    for axis, name in ((0, "pan_deg"), (1, "tilt_deg")):
+        ends = sorted(getattr(truth, name))
+        if not ends[0] <= start[axis] <= ends[1]:
+            raise ScenarioError(
+                f"{source}: {name} {list(getattr(truth, name))} does not contain the recording's start "
+                f"{name.partition('_')[0]} {start[axis]:.6g} deg"
+            )
+    return truth
+
+
+def _drawn_geometry(rng: np.random.Generator, start, priors: GeometryPriors = GeometryPriors()) -> dict:
+    """pan_deg, tilt_deg and zoom_curve drawn within ``priors`` around the start pose ``start`` (3,)."""
+    span_deg, start_pan = rng.uniform(*priors.pan_span_deg), rng.uniform(*priors.start_pan)
+    low_deg = float(start[0]) - (start_pan + 1.0) / 2.0 * span_deg
+    tilt_deg = (float(rng.uniform(*priors.tilt_down_deg)), float(rng.uniform(*priors.tilt_up_deg)))
+    widest, longest = rng.uniform(*priors.widest_zoom), rng.uniform(*priors.longest_zoom)
+    gamma = rng.uniform(*priors.zoom_gamma)
+    normalised = np.linspace(0.0, 1.0, priors.zoom_points)
+    factors = widest * (longest / widest) ** (normalised**gamma)
+    return {
+        "pan_deg": (low_deg, low_deg + float(span_deg)),
+        "tilt_deg": tilt_deg,
+        "zoom_curve": [(float(n), float(z)) for n, z in zip(normalised, factors, strict=True)],
+    }
+
+
+def _virtual_start_pose(world: World, spaces: CameraSpaces) -> np.ndarray:
+    """Where the virtual camera starts, and its home: the recording's start pose (3,), its zoom brought
+    within the spaces' zoom range (a camera whose widest view is narrower than the recording's starts at
+    its widest)."""
+    start = np.array(world.grid.poses[world.start_action], dtype=float)
+    zoom_factors = [factor for _, factor in spaces.zoom_curve]
+    start[2] = np.clip(start[2], zoom_factors[0], zoom_factors[-1])
+    return start
 
 
 def pose_timeline(calibration: CameraCalibrationFile) -> PoseTimeline:
@@ -188,9 +304,20 @@ def virtual_onvif_camera(
     username: str = "",
     password: str = "",
     feed: RecordingFeed | None = None,
+    geometry: CameraCalibrationFile | None = None,
+    positions: bool = True,
+    absolute_moves: bool = True,
+    presets_path: Path | None = None,
+    move_latency_s: float = MOVE_LATENCY_S,
 ) -> tuple["VirtualONVIFCamera", RecordingFeed]:
     """The virtual ONVIF camera over ``scenario``'s recording (not started) and the feed that logs its
-    truth (``feed``, to go on with one)."""
+    truth (``feed``, to go on with one).
+
+    geometry : the camera's true spaces (:func:`virtual_geometry`; None: :func:`virtual_calibration`'s);
+    positions, absolute_moves, presets_path, move_latency_s : as
+    :class:`~ptztrack.virtual_onvif.server.VirtualONVIFCamera` takes them (a presets file that is not one
+    raises an InputError naming it).
+    """
     try:  # the server is ipycam's, installed apart (it must not bring opencv-python): only here is it needed
         from ptztrack.virtual_onvif.server import VirtualONVIFCamera
     except ImportError:
@@ -200,11 +327,12 @@ def virtual_onvif_camera(
     if feed is None:
         feed = RecordingFeed(episode_world(scenario, 0), 1.0 / scenario.frame_rate_hz, time_scale)
     world = feed.world
+    spaces = camera_spaces(virtual_calibration() if geometry is None else geometry)
     camera = VirtualONVIFCamera(
         feed.render,
-        camera_spaces(virtual_calibration()),
+        spaces,
         VIRTUAL_SPEEDS,
-        world.grid.poses[world.start_action],
+        _virtual_start_pose(world, spaces),
         (world.camera.image_width_px, world.camera.image_height_px),
         port=port,
         username=username,
@@ -212,27 +340,53 @@ def virtual_onvif_camera(
         # A camera's stream rate, and at least twice per step of the recording.
         frame_rate_hz=max(VIRTUAL_FRAME_RATE_HZ, 2.0 * scenario.frame_rate_hz * time_scale),
         f_min_px=world.camera.f_min_px,
+        move_latency_s=move_latency_s,
+        positions=positions,
+        absolute_moves=absolute_moves,
+        presets_path=presets_path,
     )
     return camera, feed
 
 
+def camera_presets_path(path: Path, number: int) -> Path:
+    """The presets file of camera ``number`` (from 1) of several given ``path``: ``path`` for the first,
+    ``-number`` before its suffix for the others (presets.json, presets-2.json, ...)."""
+    return path if number == 1 else path.with_name(f"{path.stem}-{number}{path.suffix}")
+
+
 def virtual_onvif_cameras(
-    scenario: Scenario, time_scale: float, ports: Sequence[int], username: str = "", password: str = ""
+    scenario: Scenario,
+    time_scale: float,
+    ports: Sequence[int],
+    username: str = "",
+    password: str = "",
+    geometry: CameraCalibrationFile | None = None,
+    positions: bool = True,
+    absolute_moves: bool = True,
+    presets_path: Path | None = None,
 ) -> list[tuple["VirtualONVIFCamera", RecordingFeed]]:
     """Virtual ONVIF cameras over one play of ``scenario``'s recording (not started), one on each of
     ``ports`` (0: any free port), each with the feed that logs its truth: they show the same recording
     step at the same moment, each at its own pose, and move each by its own mechanics (as
-    :func:`virtual_onvif_camera`)."""
-    first_camera, first_feed = virtual_onvif_camera(scenario, time_scale, ports[0], username, password)
+    :func:`virtual_onvif_camera`, each of the one ``geometry`` and modes); camera k keeps its presets in
+    :func:`camera_presets_path` of ``presets_path``."""
+
+    def camera(number: int, port: int, feed: RecordingFeed | None) -> tuple["VirtualONVIFCamera", RecordingFeed]:
+        presets = None if presets_path is None else camera_presets_path(presets_path, number)
+        return virtual_onvif_camera(
+            scenario, time_scale, port, username, password, feed, geometry, positions, absolute_moves, presets
+        )
+
+    first_camera, first_feed = camera(1, ports[0], None)
     # The recording's clock starts now for every camera, not at each one's first picture.
     first_feed.started_s = time.time()
     cameras = [(first_camera, first_feed)]
-    for port in ports[1:]:
+    for number, port in enumerate(ports[1:], start=2):
         feed = RecordingFeed(
             first_feed.world, first_feed.step_s, time_scale, started_s=first_feed.started_s,
             render_lock=first_feed.render_lock,
         )  # fmt: skip
-        cameras.append(virtual_onvif_camera(scenario, time_scale, port, username, password, feed))
+        cameras.append(camera(number, port, feed))
     return cameras
 
 

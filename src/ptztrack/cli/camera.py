@@ -12,11 +12,13 @@ import numpy as np
 
 from ptztrack.builders.live import (
     TRUTH_LOG_HEADER,
+    camera_presets_path,
     camera_spaces,
     live_as_episode,
     live_pictures,
     run_live_episode,
     virtual_calibration,
+    virtual_geometry,
     virtual_onvif_cameras,
 )
 from ptztrack.camera.move_timing import measure_image_delay, measure_move_times, timed_move
@@ -226,7 +228,22 @@ def serve_camera_command(args: argparse.Namespace) -> int:
     ports = [args.port + k if args.port else 0 for k in range(args.cameras)]
     if ports[-1] > 65535:
         raise ScenarioError(f"serve-camera: {args.cameras} cameras from port {args.port} go past port 65535")
-    cameras = virtual_onvif_cameras(scenario, args.time_scale, ports, username, password)
+    # A geometry of its own is the camera's truth, not told to its clients: they must calibrate it.
+    geometry, hidden = None, args.geometry is not None or args.geometry_seed is not None
+    shown = "hidden" if hidden else "virtual"
+    if hidden:
+        option = "--geometry" if args.geometry is not None else f"--geometry-seed {args.geometry_seed}"
+        try:
+            geometry = virtual_geometry(scenario, args.geometry_seed, args.geometry)
+        except ScenarioError as error:
+            raise ScenarioError(f"serve-camera {option}: {error}") from None
+    if args.presets is not None:
+        for number in range(1, args.cameras + 1):
+            check_output_file(camera_presets_path(args.presets, number), "--presets")
+    cameras = virtual_onvif_cameras(
+        scenario, args.time_scale, ports, username, password, geometry, not args.no_positions,
+        not args.relative_only, args.presets,
+    )  # fmt: skip
     # The cameras share the recording's clock, so the first camera's log gives every camera's steps.
     feed = cameras[0][1]
     log_file = None if args.truth_log is None else open(args.truth_log, "w", encoding="utf-8")  # noqa: SIM115
@@ -236,7 +253,7 @@ def serve_camera_command(args: argparse.Namespace) -> int:
         for camera, _ in cameras:
             camera.start()
             started.append(camera)
-            print(f"virtual ONVIF camera: onvif://127.0.0.1:{camera.onvif_port} (calibration: virtual)", flush=True)
+            print(f"virtual ONVIF camera: onvif://127.0.0.1:{camera.onvif_port} (calibration: {shown})", flush=True)
             if camera.rtsp_port is not None:
                 print(f"RTSP: rtsp://127.0.0.1:{camera.rtsp_port}/", flush=True)
         print(f"the recording plays in a loop, {feed.duration_s:.0f} s a play at this time scale", flush=True)

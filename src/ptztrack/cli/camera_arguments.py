@@ -105,4 +105,25 @@ def add_camera_commands(commands, policies: list[str]) -> None:
     serve.add_argument(
         "--truth-log", type=Path, help="append every picture's time, step and pose here (CSV; the first camera's)"
     )
+    serve.add_argument(
+        "--presets",
+        type=Path,
+        help="keep the presets in this JSON file across restarts, as a real camera does (default: in memory); "
+        "with --cameras, camera k >= 2 in FILE with -k before its suffix",
+    )
+    serve.add_argument(
+        "--no-positions", action="store_true", help="a camera that does not report its position (GetStatus, presets)"
+    )
+    serve.add_argument(
+        "--relative-only", action="store_true", help="a camera without AbsoluteMove and absolute position spaces"
+    )
+    hidden = serve.add_mutually_exclusive_group()
+    hidden.add_argument(
+        "--geometry",
+        type=Path,
+        help="the camera's true pan, tilt and zoom mapping, not told to clients (a calibration YAML)",
+    )
+    hidden.add_argument(
+        "--geometry-seed", type=non_negative_int, help="a true mapping drawn from this seed, not told to clients"
+    )
     serve.set_defaults(handler="ptztrack.cli.camera:serve_camera_command")

@@ -223,6 +223,9 @@ class HTTPServer(socketserver.ThreadingTCPServer):
     """The camera's HTTP server. Request threads are not daemons, so that server_close() joins them."""
 
     allow_reuse_address = True  # a new camera can take the port at once, past the closed connections' TIME_WAIT
+    # The listen backlog: with socketserver's 5, connections beyond it that arrive at once are reset or
+    # their clients try again a second later.
+    request_queue_size = 128
     daemon_threads = False
     block_on_close = True
 

@@ -53,10 +53,11 @@ class MediaSettings:
 
 
 class DeviceMediaService:
-    """The device and media operations describing ``settings``."""
+    """The device and media operations describing ``settings``, with the PTZ configuration and
+    capabilities of ``ptz``."""
 
-    def __init__(self, settings: MediaSettings):
-        self.settings = settings
+    def __init__(self, settings: MediaSettings, ptz: onvif_ptz.PTZService):
+        self.settings, self.ptz = settings, ptz
 
     def operations(self) -> dict[tuple[str, str], Operation]:
         """The device and media services' operations by qualified name."""
@@ -173,7 +174,7 @@ class DeviceMediaService:
         capabilities = {
             TDS: self._device_capabilities_xml(),
             TRT: self._media_capabilities_xml(),
-            TPTZ: onvif_ptz.capabilities_xml(),
+            TPTZ: self.ptz.capabilities_xml(),
         }
         return (
             "<tds:GetServicesResponse>"
@@ -242,7 +243,7 @@ class DeviceMediaService:
             f'<{tag} token="{onvif_ptz.PROFILE}" fixed="true"><tt:Name>Main</tt:Name>'
             f"{self._video_source_configuration_xml('tt:VideoSourceConfiguration')}"
             f"{self._video_encoder_configuration_xml('tt:VideoEncoderConfiguration')}"
-            f"{onvif_ptz.configuration_xml('tt:PTZConfiguration')}</{tag}>"
+            f"{self.ptz.configuration_xml('tt:PTZConfiguration')}</{tag}>"
         )
 
     def _get_media_service_capabilities(self, operation: Element) -> str:

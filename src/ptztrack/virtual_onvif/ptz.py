@@ -3,8 +3,21 @@
 Positions, translations and velocities are in ONVIF's generic spaces, mapped to the model's pose by
 :class:`~ptztrack.camera.onvif_spaces.CameraSpaces`: a position is the normalised one (pan, tilt in
 [-1, 1], zoom in [0, 1]); a generic translation is added to it and clipped (a translation of 1 is
-half the pan range); a velocity is a fraction of the axis's full speed; a Speed in (0, 1] scales the
-full speed (default 1). Presets are kept in memory.
+half the pan range); a velocity is a fraction of the axis's full speed, signed in the normalised
+space's direction, so that on an axis whose degrees fall from -1 to +1 (ONVIF's tilt, +1 up, over the
+model's depression) a positive velocity runs the model's axis down its degrees; a Speed in (0, 1]
+scales the full speed (default 1). Presets are kept in memory and, given a file, in it
+(:class:`PTZService`).
+
+Two modes leave out what some cameras lack. Without positions, GetStatus has no Position and a
+preset no PTZPosition (both optional in the schema), and the capabilities say
+``StatusPosition="false"``. Without absolute moves, the node and the configuration options list no
+absolute position space, the configuration has no default absolute spaces nor the limits given in
+them, and AbsoluteMove is refused with env:Receiver ter:ActionNotSupported
+ter:OptionalActionNotSupported: the PTZ Service Specification makes a move whose spaces the node
+lacks unavailable ("Capabilities": a node without an AbsolutePanTiltPositionSpace fails AbsoluteMove)
+and answers an operation the device does not implement so (GetCompatibleConfigurations); ONVIF Core's
+generic fault for an optional action not implemented is env:Receiver ter:ActionNotSupported.
 
 With the focal length ``f_min_px`` the node also offers the relative pan/tilt translation space in
 FOV (``.../PanTiltSpaces/TranslationSpaceFov``, ONVIF PTZ Service Specification, "Pan/tilt
@@ -13,17 +26,20 @@ a move by (x, y) centres the scene point seen there (:func:`fov_target`). Its ad
 [-1, 1] on both axes, the current image.
 """
 
+import json
 import math
 import re
 import threading
 from collections.abc import Sequence
 from datetime import UTC, datetime
+from pathlib import Path
 from xml.etree.ElementTree import Element
 from xml.sax.saxutils import escape, quoteattr
 
 import numpy as np
 
 from ptztrack.camera.onvif_spaces import CameraSpaces
+from ptztrack.files import InputError, read_json, write_atomically
 from ptztrack.geometry.ptz import rotation_world_to_camera
 from ptztrack.virtual_onvif.head import Head
 from ptztrack.virtual_onvif.soap import TPTZ, TT, Fault, Operation, child_text, invalid, require_token
@@ -41,6 +57,7 @@ ZOOM_SPEED = _SPACES + "ZoomSpaces/ZoomGenericSpeedSpace"
 
 PROFILE, CONFIGURATION, NODE = "Profile_Main", "PTZ_Config_1", "PTZ_Node_1"
 _MAX_PRESETS = 32
+_MAX_PRESETS_FILE_BYTES = 1 << 20
 # ContinuousMove without a Timeout runs for the configuration's DefaultPTZTimeout; longer ones are refused.
 DEFAULT_TIMEOUT_S, MAX_TIMEOUT_S = 10.0, 60.0
 # xs:duration from days to seconds (years and months have no fixed length): P1D, PT10S, PT0.5S, PT1M30S.
@@ -81,35 +98,6 @@ def _range_xml(tag: str, uri: str, x: tuple[float, float], y: tuple[float, float
     return f"<tt:{tag}><tt:URI>{uri}</tt:URI>{limits('X', x)}{limits('Y', y) if y else ''}</tt:{tag}>"
 
 
-def configuration_xml(tag: str) -> str:
-    """The PTZ configuration as the element ``tag`` (tt:PTZConfiguration type)."""
-    # "PantTilt" is the ONVIF schema's own spelling.
-    return (
-        f'<{tag} token="{CONFIGURATION}"><tt:Name>PTZ</tt:Name><tt:UseCount>1</tt:UseCount>'
-        f"<tt:NodeToken>{NODE}</tt:NodeToken>"
-        f"<tt:DefaultAbsolutePantTiltPositionSpace>{PAN_TILT_POSITION}</tt:DefaultAbsolutePantTiltPositionSpace>"
-        f"<tt:DefaultAbsoluteZoomPositionSpace>{ZOOM_POSITION}</tt:DefaultAbsoluteZoomPositionSpace>"
-        f"<tt:DefaultRelativePanTiltTranslationSpace>{PAN_TILT_TRANSLATION}</tt:DefaultRelativePanTiltTranslationSpace>"
-        f"<tt:DefaultRelativeZoomTranslationSpace>{ZOOM_TRANSLATION}</tt:DefaultRelativeZoomTranslationSpace>"
-        f"<tt:DefaultContinuousPanTiltVelocitySpace>{PAN_TILT_VELOCITY}</tt:DefaultContinuousPanTiltVelocitySpace>"
-        f"<tt:DefaultContinuousZoomVelocitySpace>{ZOOM_VELOCITY}</tt:DefaultContinuousZoomVelocitySpace>"
-        f'<tt:DefaultPTZSpeed><tt:PanTilt x="1.0" y="1.0" space="{PAN_TILT_SPEED}"/>'
-        f'<tt:Zoom x="1.0" space="{ZOOM_SPEED}"/></tt:DefaultPTZSpeed>'
-        f"<tt:DefaultPTZTimeout>PT{DEFAULT_TIMEOUT_S:g}S</tt:DefaultPTZTimeout>"
-        f"<tt:PanTiltLimits>{_range_xml('Range', PAN_TILT_POSITION, (-1.0, 1.0), (-1.0, 1.0))}</tt:PanTiltLimits>"
-        f"<tt:ZoomLimits>{_range_xml('Range', ZOOM_POSITION, (0.0, 1.0))}</tt:ZoomLimits></{tag}>"
-    )
-
-
-def capabilities_xml() -> str:
-    """The PTZ service's capabilities (tptz:Capabilities); MoveStatus and StatusPosition are later
-    versions' attributes, which this schema's anyAttribute admits."""
-    return (
-        '<tptz:Capabilities EFlip="false" Reverse="false" GetCompatibleConfigurations="true" '
-        'MoveStatus="true" StatusPosition="true"/>'
-    )
-
-
 def _position_xml(tag: str, position: np.ndarray) -> str:
     x, y, zoom = (repr(float(value)) for value in position)
     return (
@@ -118,11 +106,38 @@ def _position_xml(tag: str, position: np.ndarray) -> str:
     )
 
 
+def read_presets(path: Path) -> dict[str, tuple[str, np.ndarray]]:
+    """The presets kept in ``path`` (none if there is no such file), token -> (name, pose (3,) pan_deg,
+    tilt_deg, zoom); an :class:`InputError` of one line naming the file if it is not a presets file.
+
+    The file is JSON: ``{"presets": [{"token": "1", "name": "door", "pose": [pan_deg, tilt_deg, zoom]}, ...]}``,
+    the poses the head's own (the model's), so that a preset keeps its view whatever the spaces.
+    """
+    if not path.exists():
+        return {}
+    document = read_json(path, "presets", _MAX_PRESETS_FILE_BYTES)
+    expected = f'{path}: expected {{"presets": [{{"token": ..., "name": ..., "pose": [pan_deg, tilt_deg, zoom]}}]}}'
+    entries = document.get("presets") if isinstance(document, dict) else None
+    if not isinstance(entries, list) or len(entries) > _MAX_PRESETS:
+        raise InputError(f"{expected}, at most {_MAX_PRESETS} presets")
+    presets = {}
+    for entry in entries:
+        token, name, pose = (entry.get(key) if isinstance(entry, dict) else None for key in ("token", "name", "pose"))
+        numbers = isinstance(pose, list) and len(pose) == 3 and all(type(value) in (int, float) for value in pose)
+        if not (isinstance(token, str) and token and isinstance(name, str) and numbers) or token in presets:
+            raise InputError(f"{expected}, each token a different non-empty string; not {entry!r:.80}")
+        presets[token] = (name, np.array(pose, dtype=float))
+    return presets
+
+
 class PTZService:
     """The PTZ operations over ``head``; positions through ``spaces``; ``home_pose`` (3,) is the home.
 
     image_size_px : (width, height) of the images; f_min_px : the focal length in pixels at zoom 1,
-    None for a node without the FOV translation space.
+    None for a node without the FOV translation space; positions : GetStatus and GetPresets give
+    positions; absolute_moves : the node has the absolute position spaces and AbsoluteMove (module
+    docstring); presets_path : the JSON file the presets are read from at the start and written to,
+    atomically, on every change (:func:`read_presets`), None to keep them in memory only.
     """
 
     def __init__(
@@ -132,12 +147,57 @@ class PTZService:
         home_pose: np.ndarray,
         image_size_px: tuple[int, int],
         f_min_px: float | None,
+        positions: bool = True,
+        absolute_moves: bool = True,
+        presets_path: Path | None = None,
     ):
         self.head, self.spaces, self.home_pose = head, spaces, home_pose
         self.image_size_px, self.f_min_px = image_size_px, f_min_px
-        self._presets: dict[str, tuple[str, np.ndarray]] = {}  # token -> (name, pose (3,))
+        self.positions, self.absolute_moves, self.presets_path = positions, absolute_moves, presets_path
+        # token -> (name, pose (3,))
+        self._presets = {} if presets_path is None else read_presets(presets_path)
         self._presets_lock = threading.Lock()
-        self._next_preset = 1
+        self._next_preset = 1 + max((int(token) for token in self._presets if token.isdecimal()), default=0)
+        # The sign of each axis's degrees from normalised -1 to +1: a velocity's direction in the model's.
+        self._directions = (
+            float(np.sign(spaces.pan_deg[1] - spaces.pan_deg[0])),
+            float(np.sign(spaces.tilt_deg[1] - spaces.tilt_deg[0])),
+            1.0,
+        )
+
+    def configuration_xml(self, tag: str) -> str:
+        """The PTZ configuration as the element ``tag`` (tt:PTZConfiguration type): without absolute moves,
+        no default absolute spaces and no limits (which are given in the absolute position space)."""
+        absolute = (
+            f"<tt:DefaultAbsolutePantTiltPositionSpace>{PAN_TILT_POSITION}</tt:DefaultAbsolutePantTiltPositionSpace>"
+            f"<tt:DefaultAbsoluteZoomPositionSpace>{ZOOM_POSITION}</tt:DefaultAbsoluteZoomPositionSpace>"
+        )
+        limits = (
+            f"<tt:PanTiltLimits>{_range_xml('Range', PAN_TILT_POSITION, (-1.0, 1.0), (-1.0, 1.0))}</tt:PanTiltLimits>"
+            f"<tt:ZoomLimits>{_range_xml('Range', ZOOM_POSITION, (0.0, 1.0))}</tt:ZoomLimits>"
+        )
+        # "PantTilt" is the ONVIF schema's own spelling.
+        return (
+            f'<{tag} token="{CONFIGURATION}"><tt:Name>PTZ</tt:Name><tt:UseCount>1</tt:UseCount>'
+            f"<tt:NodeToken>{NODE}</tt:NodeToken>"
+            f"{absolute if self.absolute_moves else ''}"
+            f"<tt:DefaultRelativePanTiltTranslationSpace>{PAN_TILT_TRANSLATION}</tt:DefaultRelativePanTiltTranslationSpace>"
+            f"<tt:DefaultRelativeZoomTranslationSpace>{ZOOM_TRANSLATION}</tt:DefaultRelativeZoomTranslationSpace>"
+            f"<tt:DefaultContinuousPanTiltVelocitySpace>{PAN_TILT_VELOCITY}</tt:DefaultContinuousPanTiltVelocitySpace>"
+            f"<tt:DefaultContinuousZoomVelocitySpace>{ZOOM_VELOCITY}</tt:DefaultContinuousZoomVelocitySpace>"
+            f'<tt:DefaultPTZSpeed><tt:PanTilt x="1.0" y="1.0" space="{PAN_TILT_SPEED}"/>'
+            f'<tt:Zoom x="1.0" space="{ZOOM_SPEED}"/></tt:DefaultPTZSpeed>'
+            f"<tt:DefaultPTZTimeout>PT{DEFAULT_TIMEOUT_S:g}S</tt:DefaultPTZTimeout>"
+            f"{limits if self.absolute_moves else ''}</{tag}>"
+        )
+
+    def capabilities_xml(self) -> str:
+        """The PTZ service's capabilities (tptz:Capabilities); MoveStatus and StatusPosition are later
+        versions' attributes, which this schema's anyAttribute admits."""
+        return (
+            '<tptz:Capabilities EFlip="false" Reverse="false" GetCompatibleConfigurations="true" '
+            f'MoveStatus="true" StatusPosition="{str(self.positions).lower()}"/>'
+        )
 
     def operations(self) -> dict[tuple[str, str], Operation]:
         """The PTZ service's operations by qualified name."""
@@ -204,13 +264,15 @@ class PTZService:
     # The node and the configuration.
 
     def _spaces_xml(self) -> str:
-        """The spaces: positions pan/tilt [-1, 1], zoom [0, 1]; translations and velocities [-1, 1]; speeds
-        [0, 1]; with a focal length, the FOV translation [-1, 1] x [-1, 1] too."""
+        """The spaces: positions pan/tilt [-1, 1], zoom [0, 1] (with absolute moves); translations and
+        velocities [-1, 1]; speeds [0, 1]; with a focal length, the FOV translation [-1, 1] x [-1, 1] too."""
         both, zero_one = (-1.0, 1.0), (0.0, 1.0)
         fov = "" if self.f_min_px is None else _range_xml("RelativePanTiltTranslationSpace", PAN_TILT_FOV, both, both)
+        absolute = _range_xml("AbsolutePanTiltPositionSpace", PAN_TILT_POSITION, both, both) + _range_xml(
+            "AbsoluteZoomPositionSpace", ZOOM_POSITION, zero_one
+        )
         return (
-            _range_xml("AbsolutePanTiltPositionSpace", PAN_TILT_POSITION, both, both)
-            + _range_xml("AbsoluteZoomPositionSpace", ZOOM_POSITION, zero_one)
+            (absolute if self.absolute_moves else "")
             + _range_xml("RelativePanTiltTranslationSpace", PAN_TILT_TRANSLATION, both, both)
             + fov
             + _range_xml("RelativeZoomTranslationSpace", ZOOM_TRANSLATION, both)
@@ -229,7 +291,7 @@ class PTZService:
         )
 
     def _get_service_capabilities(self, operation: Element) -> str:
-        return f"<tptz:GetServiceCapabilitiesResponse>{capabilities_xml()}</tptz:GetServiceCapabilitiesResponse>"
+        return f"<tptz:GetServiceCapabilitiesResponse>{self.capabilities_xml()}</tptz:GetServiceCapabilitiesResponse>"
 
     def _get_nodes(self, operation: Element) -> str:
         return f"<tptz:GetNodesResponse>{self._node_xml('tptz:PTZNode')}</tptz:GetNodesResponse>"
@@ -239,17 +301,17 @@ class PTZService:
         return f"<tptz:GetNodeResponse>{self._node_xml('tptz:PTZNode')}</tptz:GetNodeResponse>"
 
     def _get_configurations(self, operation: Element) -> str:
-        configuration = configuration_xml("tptz:PTZConfiguration")
+        configuration = self.configuration_xml("tptz:PTZConfiguration")
         return f"<tptz:GetConfigurationsResponse>{configuration}</tptz:GetConfigurationsResponse>"
 
     def _get_configuration(self, operation: Element) -> str:
         require_token(operation, "PTZConfigurationToken", CONFIGURATION, "NoConfig")
-        configuration = configuration_xml("tptz:PTZConfiguration")
+        configuration = self.configuration_xml("tptz:PTZConfiguration")
         return f"<tptz:GetConfigurationResponse>{configuration}</tptz:GetConfigurationResponse>"
 
     def _get_compatible_configurations(self, operation: Element) -> str:
         self._profile(operation)
-        configuration = configuration_xml("tptz:PTZConfiguration")
+        configuration = self.configuration_xml("tptz:PTZConfiguration")
         return f"<tptz:GetCompatibleConfigurationsResponse>{configuration}</tptz:GetCompatibleConfigurationsResponse>"
 
     def _get_configuration_options(self, operation: Element) -> str:
@@ -268,14 +330,21 @@ class PTZService:
         _, pose, moving = self.head.now()
         pan_tilt, zoom = ("MOVING" if axes else "IDLE" for axes in (moving[0] or moving[1], moving[2]))
         utc = datetime.now(UTC).isoformat(timespec="milliseconds").replace("+00:00", "Z")
+        position = _position_xml("tt:Position", self.spaces.normalised(pose)) if self.positions else ""
         return (
-            f"<tptz:GetStatusResponse><tptz:PTZStatus>{_position_xml('tt:Position', self.spaces.normalised(pose))}"
+            f"<tptz:GetStatusResponse><tptz:PTZStatus>{position}"
             f"<tt:MoveStatus><tt:PanTilt>{pan_tilt}</tt:PanTilt><tt:Zoom>{zoom}</tt:Zoom></tt:MoveStatus>"
             f"<tt:UtcTime>{utc}</tt:UtcTime></tptz:PTZStatus></tptz:GetStatusResponse>"
         )
 
     def _absolute_move(self, operation: Element) -> str:
         self._profile(operation)
+        if not self.absolute_moves:
+            raise Fault(
+                "Receiver",
+                ["ter:ActionNotSupported", "ter:OptionalActionNotSupported"],
+                "AbsoluteMove is not supported: the PTZ node has no absolute position space",
+            )
         pan_tilt, zoom = self._vector(operation, "Position", [PAN_TILT_POSITION], ZOOM_POSITION)
         position = [*(pan_tilt[:2] if pan_tilt else (None, None)), zoom]
         lowest, highest = (-1.0, -1.0, 0.0), (1.0, 1.0, 1.0)
@@ -313,7 +382,10 @@ class PTZService:
         velocity = [*(pan_tilt[:2] if pan_tilt else (None, None)), zoom]
         if not all(-1.0 <= value <= 1.0 for value in velocity if value is not None):
             raise invalid("InvalidVelocity", f"Velocity {velocity} is not in [-1, 1]")
-        self.head.run(velocity, self._timeout_s(operation))
+        model = [
+            None if value is None else value * sign for value, sign in zip(velocity, self._directions, strict=True)
+        ]
+        self.head.run(model, self._timeout_s(operation))
         return "<tptz:ContinuousMoveResponse/>"
 
     def _timeout_s(self, operation: Element) -> float:
@@ -341,7 +413,22 @@ class PTZService:
         self.head.move_to(list(self.home_pose), self._speed(operation))
         return "<tptz:GotoHomePositionResponse/>"
 
-    # Presets, in memory.
+    # Presets, in memory and in the presets file.
+
+    def _keep(self, presets: dict[str, tuple[str, np.ndarray]]) -> None:
+        """Write ``presets`` into the presets file (if any) and make them the presets; the presets lock held."""
+        if self.presets_path is not None:
+            document = {
+                "presets": [
+                    {"token": token, "name": name, "pose": [float(value) for value in pose]}
+                    for token, (name, pose) in presets.items()
+                ]
+            }
+            try:
+                write_atomically(self.presets_path, (json.dumps(document, indent=1) + "\n").encode())
+            except OSError as error:
+                raise Fault("Receiver", ["ter:Action"], f"the presets could not be kept: {error.strerror}") from None
+        self._presets = presets
 
     def _set_preset(self, operation: Element) -> str:
         self._profile(operation)
@@ -354,7 +441,7 @@ class PTZService:
                 if len(self._presets) >= _MAX_PRESETS:
                     raise Fault("Receiver", ["ter:Action", "ter:TooManyPresets"], f"at most {_MAX_PRESETS} presets")
                 token, self._next_preset = str(self._next_preset), self._next_preset + 1
-            self._presets[token] = (name or token, pose)
+            self._keep({**self._presets, token: (name or token, pose)})
         return f"<tptz:SetPresetResponse><tptz:PresetToken>{escape(token)}</tptz:PresetToken></tptz:SetPresetResponse>"
 
     def _get_presets(self, operation: Element) -> str:
@@ -365,7 +452,8 @@ class PTZService:
             "<tptz:GetPresetsResponse>"
             + "".join(
                 f"<tptz:Preset token={quoteattr(token)}><tt:Name>{escape(name)}</tt:Name>"
-                f"{_position_xml('tt:PTZPosition', self.spaces.normalised(pose))}</tptz:Preset>"
+                f"{_position_xml('tt:PTZPosition', self.spaces.normalised(pose)) if self.positions else ''}"
+                "</tptz:Preset>"
                 for token, (name, pose) in presets
             )
             + "</tptz:GetPresetsResponse>"
@@ -387,7 +475,8 @@ class PTZService:
     def _remove_preset(self, operation: Element) -> str:
         self._profile(operation)
         with self._presets_lock:
-            del self._presets[self._preset(operation)]
+            token = self._preset(operation)
+            self._keep({key: preset for key, preset in self._presets.items() if key != token})
         return "<tptz:RemovePresetResponse/>"
 
 

@@ -6,9 +6,10 @@ WS-Security UsernameToken; :mod:`~ptztrack.virtual_onvif.soap`, :mod:`~ptztrack.
 :mod:`~ptztrack.virtual_onvif.http`), and streams H.264 over RTSP, RTP over TCP or UDP, when ffmpeg is
 on the PATH (:mod:`~ptztrack.virtual_onvif.rtsp`). Its images come from a ``render(pose, elapsed_s)``
 callable, rendered at a fixed rate with the pose of that instant. The head moves like a real one
-(:mod:`~ptztrack.virtual_onvif.head`): each axis travels towards its target at its speed, so a move
-takes time and GetStatus reports it MOVING until it arrives. The pose of every rendered image is kept
-(:meth:`VirtualONVIFCamera.truth`), to compare with what a client believes.
+(:mod:`~ptztrack.virtual_onvif.head`): a move starts a latency after its command and each axis travels
+towards its target at its speed, so a move takes time and GetStatus reports it MOVING until it
+arrives. The pose of every rendered image is kept (:meth:`VirtualONVIFCamera.truth`), to compare with
+what a client believes.
 
 The transport is ipycam 1.3.0's HTTP handler (snapshot, MJPEG), MJPEG streamer and ffmpeg-backed RTSP
 server; its ``IPCamera`` and its SOAP service are not used. Its defects, and what is done about them
@@ -31,7 +32,8 @@ server; its ``IPCamera`` and its SOAP service are not used. Its defects, and wha
   routed by the qualified name of the Body's child.
 * Moves are instant and out-of-range positions clipped without a fault (ptz.py:361-380);
   ContinuousMove's Timeout is ignored (onvif.py:432-440); presets go to ./ptz_presets.json
-  (ptz.py:469-489): the PTZ service is this package's, in the model's units, presets in memory.
+  (ptz.py:469-489): the PTZ service is this package's, in the model's units, presets in memory or in
+  the file the camera is given.
 * ``IPCameraHTTPHandler.camera`` is a class attribute (camera.py:130): each camera gets its own handler
   class, which also shuts the web UI and REST API (they write ./camera_config.json and take uploads,
   http.py:98-148); its HTTP authentication is Basic only (http.py:34-70): Digest is added.
@@ -57,11 +59,12 @@ import shutil
 import threading
 import time
 from collections.abc import Callable
+from pathlib import Path
 
 import numpy as np
 
 from ptztrack.camera.onvif_spaces import AxisSpeeds, CameraSpaces
-from ptztrack.virtual_onvif.head import Head, head_axes
+from ptztrack.virtual_onvif.head import MOVE_LATENCY_S, Head, head_axes
 from ptztrack.virtual_onvif.http import SNAPSHOT_PATH, HTTPAuth, HTTPServer, Served, make_server
 from ptztrack.virtual_onvif.media import DeviceMediaService, MediaSettings
 from ptztrack.virtual_onvif.ptz import PTZService
@@ -93,6 +96,12 @@ class VirtualONVIFCamera:
     frame_rate_hz : how often an image is rendered; rtsp : stream H.264 over RTSP if ffmpeg is on the PATH.
     f_min_px : the focal length in pixels at zoom 1 of the model that renders the images; with it the
         PTZ node offers RelativeMove in the FOV translation space (:mod:`~ptztrack.virtual_onvif.ptz`).
+    move_latency_s : how long after its command a move starts (:mod:`~ptztrack.virtual_onvif.head`).
+    positions : GetStatus and GetPresets give positions; absolute_moves : the node has absolute position
+        spaces and AbsoluteMove; presets_path : the JSON file that keeps the presets across restarts
+        (read now, written on every change), None for presets in memory only
+        (:class:`~ptztrack.virtual_onvif.ptz.PTZService`; a file that is not one raises an InputError
+        naming it).
 
     After start(), ``onvif_port`` and ``rtsp_port`` (None without RTSP) are the ports in use.
     """
@@ -110,6 +119,10 @@ class VirtualONVIFCamera:
         frame_rate_hz: float = 10.0,
         rtsp: bool = True,
         f_min_px: float | None = None,
+        move_latency_s: float = MOVE_LATENCY_S,
+        positions: bool = True,
+        absolute_moves: bool = True,
+        presets_path: Path | None = None,
     ):
         width_px, height_px = (int(size) for size in image_size_px)
         limits, rates_per_s = head_axes(spaces, speeds)
@@ -126,7 +139,10 @@ class VirtualONVIFCamera:
         self.image_size_px, self.f_min_px = (width_px, height_px), f_min_px
         self.frame_rate_hz, self.rtsp = frame_rate_hz, rtsp
         self._port, self._credentials = port, (username, password)
-        self._head = Head(start_pose, limits, rates_per_s)
+        self._head = Head(start_pose, limits, rates_per_s, move_latency_s)
+        self._ptz = PTZService(
+            self._head, spaces, start_pose, self.image_size_px, f_min_px, positions, absolute_moves, presets_path
+        )
         self.onvif_port: int | None = None
         self.rtsp_port: int | None = None
         self._served: Served | None = None
@@ -161,9 +177,9 @@ class VirtualONVIFCamera:
                 snapshot_uri=f"http://{HOST}:{port}{SNAPSHOT_PATH}",
                 stream_uri=stream_uri,
             )
-            ptz = PTZService(self._head, self.spaces, self.start_pose, self.image_size_px, self.f_min_px)
             tokens = UsernameTokens(username, password) if username else None
-            served.soap = SOAPService(DeviceMediaService(settings).operations() | ptz.operations(), tokens, _PRE_AUTH)
+            operations = DeviceMediaService(settings, self._ptz).operations() | self._ptz.operations()
+            served.soap = SOAPService(operations, tokens, _PRE_AUTH)
             served.mjpeg_streamer.start()
             self._start_s = time.monotonic()
             self._render_one()  # the first image before any request, and a failing render() fails here
