@@ -28,6 +28,7 @@ from ptztrack.camera.onvif_spaces import AxisSpeeds, CameraSpaces, MoveTimes
 from ptztrack.camera.pose_timeline import PoseTimeline
 from ptztrack.camera.recorded import RecordedPTZ
 from ptztrack.camera.stream import thumbnail
+from ptztrack.camera.virtual import VirtualPTZ
 from ptztrack.config import (
     VIRTUAL_CAMERA_CALIBRATION,
     CameraCalibrationFile,
@@ -57,6 +58,13 @@ def camera_spaces(calibration: CameraCalibrationFile) -> CameraSpaces:
     )
 
 
+# The virtual camera renders its pictures this many times finer in both directions and averages them down,
+# as a camera's lens and sensor average the light over each pixel: its 160 x 120 view point-sampled from a
+# 768 x 576 recording would alias, which moves the same scene's features between views (docs: decisions).
+# Its maps are computed every SUPERSAMPLED_MAP_GRID_PX-th pixel (VirtualPTZ.map_grid_px).
+VIRTUAL_SUPERSAMPLE, SUPERSAMPLED_MAP_GRID_PX = 4, 8
+
+
 @dataclass
 class RecordingFeed:
     """The pictures of the virtual ONVIF camera: ``world``'s view of its recording at a pose, the
@@ -68,7 +76,8 @@ class RecordingFeed:
 
     Several cameras over one recording (:func:`virtual_onvif_cameras`) have a feed each, with the same
     ``started_s`` (so they show the same step at the same moment) and the same ``render_lock`` (their
-    world's video is read by one camera at a time)."""
+    world's video is read by one camera at a time). Its pictures are rendered ``supersample`` times
+    finer than the world's camera and area-averaged down to its size."""
 
     world: World
     step_s: float
@@ -77,7 +86,9 @@ class RecordingFeed:
     thumbnails: list[np.ndarray] | None = None
     started_s: float | None = None
     render_lock: threading.Lock = field(default_factory=threading.Lock, repr=False)
+    supersample: int = VIRTUAL_SUPERSAMPLE
     _lock: threading.Lock = field(default_factory=threading.Lock, repr=False)
+    _fine: RecordedPTZ | None = field(default=None, init=False, repr=False)
 
     def render(self, pose, elapsed_s: float) -> np.ndarray:
         """The picture at ``pose``; ``elapsed_s`` (the camera's own clock) is not used: the feed's is."""
@@ -86,15 +97,35 @@ class RecordingFeed:
         steps = self.world.truth.positions_m.shape[0]
         step = int((now_s - self.started_s) * self.time_scale / self.step_s) % steps
         with self.render_lock:
-            image = self.world.backend.image(step, np.asarray(pose, dtype=float))
+            image = self._fine_backend().image(step, np.asarray(pose, dtype=float))
         if image is None:
             raise RuntimeError("the virtual ONVIF camera needs a recording with a video")
+        if self.supersample > 1:
+            camera = self.world.camera
+            image = cv2.resize(image, (camera.image_width_px, camera.image_height_px), interpolation=cv2.INTER_AREA)
         small = None if self.thumbnails is None else thumbnail(image)
         with self._lock:
             self.log.append((now_s, step, *(float(value) for value in pose)))
             if small is not None and self.thumbnails is not None:
                 self.thumbnails.append(small)
         return image
+
+    def _fine_backend(self):
+        """The world's recording seen by a camera ``supersample`` times finer (the world's own at 1)."""
+        backend = self.world.backend
+        if self.supersample == 1 or not isinstance(backend, RecordedPTZ):
+            return backend
+        if self._fine is None:
+            virtual, scale = backend.virtual, self.supersample
+            camera = replace(
+                virtual.camera,
+                image_width_px=virtual.camera.image_width_px * scale,
+                image_height_px=virtual.camera.image_height_px * scale,
+                f_min_px=virtual.camera.f_min_px * scale,
+            )
+            fine = VirtualPTZ(camera, virtual.recording, virtual.recorded_size_px, SUPERSAMPLED_MAP_GRID_PX)
+            self._fine = replace(backend, virtual=fine)
+        return self._fine
 
     @property
     def duration_s(self) -> float:

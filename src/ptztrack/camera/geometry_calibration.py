@@ -25,8 +25,8 @@ import numpy as np
 from ptztrack.camera.onvif_client import CameraError, ONVIFClient
 from ptztrack.camera.stream import LatestFrame
 from ptztrack.geometry.self_calibration import (
-    RotationFit,
-    focal_from_rotations,
+    HeadFit,
+    fit_head,
     focals_from_ratios,
     matched_points,
     zoom_ratio,
@@ -39,8 +39,6 @@ PROBE_TURN, TURN_FRACTION, MIN_TURN, MAX_TURN = 0.02, 0.4, 0.002, 0.5
 # The zoom's steps each magnify by about this much (SIFT matches a 160 x 120 view to one 1.35 times
 # larger at times only), none less than MIN_ZOOM_STEP of the normalised range.
 TARGET_ZOOM_RATIO, MIN_ZOOM_STEP = 1.2, 0.004
-# A turn that comes out shorter than this fraction of its opposite stopped at a limit of the head.
-CLIPPED_TURN = 0.8
 # How long a camera may take to begin moving before GetStatus is trusted to say it has (seconds), and to
 # stand still at most.
 MOVE_START_S, STILL_TIMEOUT_S = 0.3, 30.0
@@ -48,6 +46,9 @@ MOVE_START_S, STILL_TIMEOUT_S = 0.3, 30.0
 # stood still, whatever the calibration's image_delay_s: an RTSP stream holds pictures back by 0.2-1 s, and
 # a picture of the move would spoil the measurement, where waiting costs a second a picture.
 SETTLED_AFTER_S = 1.0
+# Still pictures averaged into one: the stream's compression noise, which moves features by a fraction of
+# a pixel from picture to picture, averages out (a picture takes 40 ms at 25 fps).
+AVERAGED_PICTURES = 5
 
 
 class GeometryError(CameraError):
@@ -59,17 +60,14 @@ class GeometryMeasurement:
     """What the camera's pictures tell of its geometry.
 
     ground_image : (h, w, 3) the ground view at the widest zoom; ground_position : (3,) its normalised
-    position (NaN where the camera reports none); rotations : the widest focal length's fit;
-    pan_deg_per_unit, tilt_deg_per_unit : the model's pan and tilt (depression) degrees per unit of the
-    normalised translation (signed); zoom_normalised : (K,) the zoom steps from 0 to 1; focal_px,
-    focal_sd_px : (K,) the focal length at each and its standard deviation.
+    position (NaN where the camera reports none); head : the widest focal length and the pan's and
+    tilt's degrees per normalised unit, from the turns; zoom_normalised : (K,) the zoom steps from 0 to
+    1; focal_px, focal_sd_px : (K,) the focal length at each and its standard deviation.
     """
 
     ground_image: np.ndarray
     ground_position: np.ndarray
-    rotations: RotationFit
-    pan_deg_per_unit: float
-    tilt_deg_per_unit: float
+    head: HeadFit
     zoom_normalised: np.ndarray
     focal_px: np.ndarray
     focal_sd_px: np.ndarray
@@ -94,18 +92,20 @@ def stood_still(client: ONVIFClient) -> None:
 
 
 def settled_picture(client: ONVIFClient, latest: LatestFrame, image_delay_s: float, translation) -> np.ndarray:
-    """RelativeMove by ``translation`` (3,), then the first picture that arrived ``image_delay_s`` after the
-    camera stood still."""
+    """RelativeMove by ``translation`` (3,), then the mean of the first ``AVERAGED_PICTURES`` pictures that
+    arrived ``image_delay_s`` (at least ``SETTLED_AFTER_S``) after the camera stood still."""
     moved(client, translation)
     still_s = time.time()
     deadline_s = time.monotonic() + STILL_TIMEOUT_S
-    number = 0
+    number, taken = 0, []
     while time.monotonic() < deadline_s:
         frame = latest.newer(number, 1.0)
         if frame is None:
             continue
         if frame.time_s >= still_s + max(image_delay_s, SETTLED_AFTER_S):
-            return frame.image
+            taken.append(frame.image.astype(np.float32))
+            if len(taken) == AVERAGED_PICTURES:
+                return np.rint(np.mean(taken, axis=0)).astype(np.uint8)
         number = frame.number
     raise CameraError(f"{client.address}: no picture from its stream for {STILL_TIMEOUT_S:g} s")
 
@@ -126,47 +126,23 @@ def take_ground_snapshot(client: ONVIFClient, latest: LatestFrame, image_delay_s
     return image
 
 
-def _turn(
-    client: ONVIFClient,
-    latest: LatestFrame,
-    image_delay_s: float,
-    ground: np.ndarray,
-    translation,
-    name: str,
-    report: Callable[[str], None],
-) -> tuple[np.ndarray, np.ndarray]:
-    """Turn by ``translation`` (3,), picture, match with the ground view, turn back; the matches."""
+def _turn(client: ONVIFClient, latest: LatestFrame, image_delay_s: float, translation) -> np.ndarray:
+    """Turn by ``translation`` (3,), take the picture there and turn back; the picture."""
     image = settled_picture(client, latest, image_delay_s, translation)
     moved(client, -np.asarray(translation, dtype=float))
-    points = matched_points(ground, image)
-    if len(points[0]) == 0:
-        raise GeometryError(f"the {name} did not register against the ground view: too few features match")
-    report(f"{name}: {len(points[0])} matches")
-    return points
+    return image
 
 
-def _turn_size(client, latest, image_delay_s: float, ground: np.ndarray, axis: int, report) -> float:
-    """The normalised turn on ``axis`` (0 pan, 1 tilt) that moves the picture by TURN_FRACTION of its size."""
+def _probe(client, latest, image_delay_s: float, ground: np.ndarray, axis: int, report) -> float:
+    """The picture's shift (px) on ``axis`` (0 pan: u, 1 tilt: v) for a turn of PROBE_TURN on that axis."""
     probe = np.zeros(3)
     probe[axis] = PROBE_TURN
     name = ("pan", "tilt")[axis]
-    points_a, points_b = _turn(client, latest, image_delay_s, ground, probe, f"{name} probe of {PROBE_TURN:g}", report)
-    shift_px = abs(float(np.median(points_b[:, axis] - points_a[:, axis])))
-    size_px = ground.shape[1 - axis]
-    return float(np.clip(PROBE_TURN * TURN_FRACTION * size_px / max(shift_px, 1e-3), MIN_TURN, MAX_TURN))
-
-
-def _degrees_per_unit(fit: RotationFit, turns: np.ndarray, axis: int) -> float:
-    """The model's degrees per normalised unit on ``axis`` from the turns both ways (the first two of the
-    fit on pan, the next two on tilt): their angles over their sizes, a turn stopped by a limit left out.
-    A positive pan (tilt) moves the picture's content left (up): the sign follows the centre's shift."""
-    pair = slice(2 * axis, 2 * axis + 2)
-    angles, sizes = fit.angles_deg[pair], np.abs(turns[pair])
-    per_unit = angles / sizes
-    kept = per_unit >= CLIPPED_TURN * per_unit.max()
-    shift = fit.centre_shift_px[pair][:, axis] * np.sign(turns[pair])
-    sign = -np.sign(np.sum(shift[kept]))
-    return float(sign * np.mean(per_unit[kept]))
+    image = _turn(client, latest, image_delay_s, probe)
+    points_a, points_b = matched_points(ground, image)
+    if len(points_a) == 0:
+        raise GeometryError(f"the {name} probe did not register against the ground view: too few features match")
+    return float(np.median(points_b[:, axis] - points_a[:, axis]))
 
 
 def _zoom_ladder(
@@ -191,7 +167,7 @@ def _zoom_ladder(
         where = f"zoom step {step} (normalised zoom {zooms[-1] + step_size:.3f})"
         found = []
         for before in range(step - 1, max(step - 3, -1), -1):
-            points_a, points_b = matched_points(pictures[before], picture, refine=False)
+            points_a, points_b = matched_points(pictures[before], picture)
             if len(points_a):
                 found.append((before, step, *zoom_ratio(points_a, points_b, widest.shape[1::-1])))
         if not found or found[0][0] != step - 1 or found[0][2] <= 1.0:
@@ -234,34 +210,50 @@ def measure_geometry(
     ground = settled_picture(client, latest, image_delay_s, (0.0, 0.0, -1.0))
     ground_position = client.status().position
     report(f"ground view: {ground.shape[1]}x{ground.shape[0]} px")
-    pan_turn = _turn_size(client, latest, image_delay_s, ground, 0, report)
-    tilt_turn = _turn_size(client, latest, image_delay_s, ground, 1, report)
-    turns = np.array([pan_turn, -pan_turn, tilt_turn, -tilt_turn])
+    size_px = (ground.shape[1], ground.shape[0])
+    shifts_px = np.array([_probe(client, latest, image_delay_s, ground, axis, report) for axis in (0, 1)])
+    turn = np.clip(
+        PROBE_TURN * TURN_FRACTION * np.array(size_px) / np.maximum(np.abs(shifts_px), 1e-3), MIN_TURN, MAX_TURN
+    )
+    # A pan (depression) that grows moves the picture's content left (up): f dtheta = -shift, f ~ the width.
+    initial_deg_per_unit = np.rad2deg(-shifts_px / size_px[0]) / PROBE_TURN
     # Each axis both ways, then the four diagonals: a pan's axis, vertical, is tilted in a tilted view, so
     # the diagonals turn the picture as well as shift it, which pins the focal length further.
     signs = [(1, 0), (-1, 0), (0, 1), (0, -1), (1, 1), (-1, -1), (1, -1), (-1, 1)]
-    matches = []
+    steps = [np.zeros(2)]
+    pictures = [ground]
     for pan_sign, tilt_sign in signs:
-        translation = np.array([pan_sign * pan_turn, tilt_sign * tilt_turn, 0.0])
-        name = f"turn of {translation[0]:+.3f} pan, {translation[1]:+.3f} tilt"
-        matches.append(_turn(client, latest, image_delay_s, ground, translation, name, report))
-    size_px = (ground.shape[1], ground.shape[0])
-    rotations = focal_from_rotations(matches, size_px, float(size_px[0]))
+        translation = np.array([pan_sign * turn[0], tilt_sign * turn[1], 0.0])
+        steps.append(translation[:2])
+        pictures.append(_turn(client, latest, image_delay_s, translation))
+    # Every pair of views that registers, the turned ones with each other too: more pairs, and wider ones.
+    matches, registered = [], set()
+    for first in range(len(pictures)):
+        for second in range(first + 1, len(pictures)):
+            points_a, points_b = matched_points(pictures[first], pictures[second])
+            if len(points_a):
+                matches.append((steps[first], steps[second], points_a, points_b))
+                registered |= {first, second}
+    for index in range(1, len(steps)):
+        step = steps[index]
+        state = "registered" if index in registered else "did not register with any view, left out"
+        report(f"turn of {step[0]:+.3f} pan, {step[1]:+.3f} tilt: {state}")
+    for axis, name in enumerate(("pan", "tilt")):
+        if not any(steps[index][axis] != 0 for index in registered):
+            raise GeometryError(f"no turn with a {name} registered against the other views")
+    head = fit_head(matches, size_px, tuple(initial_deg_per_unit), float(size_px[0]))
     report(
-        f"widest focal length {rotations.focal_px:.1f} +- {rotations.focal_sd_px:.1f} px "
-        f"(rms {rotations.rms_px:.2f} px over {len(matches)} turns)"
+        f"widest focal length {head.focal_px:.1f} +- {head.focal_sd_px:.1f} px, pan {head.pan_deg_per_unit:+.3f} "
+        f"and tilt {head.tilt_deg_per_unit:+.3f} deg per normalised unit (rms {head.rms_px:.2f} px over "
+        f"{len(matches)} turns)"
     )
     zoom_normalised, ratios = _zoom_ladder(client, latest, image_delay_s, ground, 1.0 / zoom_steps, report)
     client.goto_preset(token)
-    focal_px, focal_sd_px = focals_from_ratios(
-        rotations.focal_px, rotations.focal_sd_px, len(zoom_normalised) - 1, ratios
-    )
+    focal_px, focal_sd_px = focals_from_ratios(head.focal_px, head.focal_sd_px, len(zoom_normalised) - 1, ratios)
     return GeometryMeasurement(
         ground_image=ground,
         ground_position=np.asarray(ground_position, dtype=float),
-        rotations=rotations,
-        pan_deg_per_unit=_degrees_per_unit(rotations, turns, 0),
-        tilt_deg_per_unit=_degrees_per_unit(rotations, turns, 1),
+        head=head,
         zoom_normalised=zoom_normalised,
         focal_px=focal_px,
         focal_sd_px=focal_sd_px,

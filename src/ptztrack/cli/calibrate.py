@@ -73,7 +73,7 @@ def calibrate_geometry_command(args: argparse.Namespace, credentials: dict | Non
             stream.stop()
         client.close()
     assert token is not None
-    ground = ground_pose(points.pixels_px, points.ground_m, measured.rotations.focal_px, measured.image_size_px)
+    ground = ground_pose(points.pixels_px, points.ground_m, measured.head.focal_px, measured.image_size_px)
     calibration = calibration_of(measured, ground, token, existing)
     write_camera_calibration(args.calibration, calibration)
     _print_geometry(measured, ground, calibration)
@@ -113,9 +113,9 @@ def calibration_of(
     positions = bool(np.all(np.isfinite(position)))
     at = position if positions else np.zeros(3)
     ends = np.array([-1.0, 1.0])
-    pan_deg = ground.pan_deg + measured.pan_deg_per_unit * (ends - at[0])
+    pan_deg = ground.pan_deg + measured.head.pan_deg_per_unit * (ends - at[0])
     pan_deg -= 360.0 * np.round(pan_deg.mean() / 360.0)
-    tilt_deg = ground.tilt_deg + measured.tilt_deg_per_unit * (ends - at[1])
+    tilt_deg = ground.tilt_deg + measured.head.tilt_deg_per_unit * (ends - at[1])
     widest_px = float(measured.focal_px[0])
     fields = {
         "pan_deg": tuple(round(float(value), 4) for value in pan_deg),
@@ -148,8 +148,8 @@ def _print_geometry(measured: GeometryMeasurement, ground: GroundPose, calibrati
         f"{ground.rms_px:.2f} px rms (largest {ground.residuals_px.max():.2f} px)"
     )
     print(
-        f"pan {measured.pan_deg_per_unit:+.3f} deg and tilt {measured.tilt_deg_per_unit:+.3f} deg per normalised "
-        f"unit ({'from its positions' if calibration.positions else 'from the ground preset; no positions reported'})"
+        f"pan {measured.head.pan_deg_per_unit:+.3f} deg and tilt {measured.head.tilt_deg_per_unit:+.3f} deg per "
+        f"normalised unit ({'from its positions' if calibration.positions else 'from the ground preset: no positions'})"
     )
     print(
         f"focal length {measured.focal_px[0]:.1f} +- {measured.focal_sd_px[0]:.1f} px at the widest to "

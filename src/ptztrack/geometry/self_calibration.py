@@ -3,12 +3,12 @@ calibration and high-resolution mosaic generation", CVIU 2006).
 
 * **The widest focal length, from rotations.** A camera turning about its optical centre maps the
   pixels of one view onto another by ``H = K R K^-1`` with ``K = [[f, 0, c_x], [0, f, c_y], [0, 0, 1]]``
-  (the principal point at the image centre). Over the matched points ``(p_a, p_b)`` of a few small
-  pans and tilts, ``f`` and each turn's rotation ``R_j`` (a rotation vector) minimise
-  ``sum |p_b - pi(K R_j K^-1 p_a)|^2`` (soft L1, 1 px). Only the perspective part of ``H`` tells
-  ``f`` from the turn's angle (a point at ``x`` from the centre moves by ``f tan(atan(x / f) + theta) - x``,
-  ``theta (f + x^2 / f)`` to second order), so the turns are made a good fraction of the view wide.
-  Its standard deviation is the Gauss-Newton one, ``sigma^2 (J^T J)^-1`` at the optimum.
+  (the principal point at the image centre). A PTZ head's turns by normalised steps are rotations of
+  four numbers (:func:`fit_head`): ``f``, the pan's and the tilt's degrees per step, and the view's
+  depression. Only the perspective part of ``H`` tells ``f`` from a turn's angle (a point at ``x``
+  from the centre moves by ``f tan(atan(x / f) + theta) - x``, ``theta (f + x^2 / f)`` to second
+  order), so the turns are made a good fraction of the view wide. The standard deviations are the
+  Gauss-Newton ones, ``sigma^2 (J^T J)^-1`` at the optimum.
 * **The focal length at every zoom, from homologies.** At a fixed pan and tilt a zoom maps view ``a``
   onto view ``b`` by ``p_b - c = s (p_a - c) + t`` (``s = f_b / f_a``; ``t`` the lens's axis drifting
   with the zoom), fitted by least squares on RANSAC's inliers; from the widest view's, the focal
@@ -26,12 +26,12 @@ Pixels are in the model's convention: the picture's top left corner at (0, 0), p
 centre at (col + 0.5, row + 0.5).
 """
 
+import itertools
 from dataclasses import dataclass
 
 import cv2
 import numpy as np
 from scipy.optimize import least_squares
-from scipy.spatial.transform import Rotation
 
 from ptztrack.geometry.ptz import rotation_world_to_camera
 from ptztrack.geometry.registration import (
@@ -44,30 +44,9 @@ from ptztrack.geometry.registration import (
 
 # Features per picture for matching two views of the calibration.
 CALIBRATION_FEATURES = 2000
-# ECC's alignment: at most this many iterations, until the warp changes by less than ECC_EPSILON, on
-# pictures smoothed by a Gaussian this wide (px, odd); the correspondences then come from a grid of
-# MATCH_GRID (columns, rows) points.
-ECC_ITERATIONS, ECC_EPSILON, ECC_BLUR_PX = 100, 1e-6, 5
-MATCH_GRID = (16, 12)
 # Ground points whose spread across their second direction is below this fraction of the first lie on
 # one line: the ground's pose is then not pinned.
 COLLINEAR_RATIO = 0.05
-
-
-@dataclass(frozen=True)
-class RotationFit:
-    """The widest focal length from pure rotations.
-
-    focal_px, focal_sd_px : the focal length and its standard deviation; angles_deg : (J,) each turn's
-    angle; centre_shift_px : (J, 2) where view a's centre lands in view b, less the centre; rms_px : the
-    residuals' root mean square.
-    """
-
-    focal_px: float
-    focal_sd_px: float
-    angles_deg: np.ndarray
-    centre_shift_px: np.ndarray
-    rms_px: float
 
 
 @dataclass(frozen=True)
@@ -87,13 +66,9 @@ class GroundPose:
         return float(np.sqrt(np.mean(self.residuals_px**2)))
 
 
-def matched_points(image_a: np.ndarray, image_b: np.ndarray, refine: bool = True) -> tuple[np.ndarray, np.ndarray]:
+def matched_points(image_a: np.ndarray, image_b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Correspondences (M, 2) and (M, 2) of two views: SIFT, Lowe's ratio test and a RANSAC homography's
-    inliers (within ``RANSAC_THRESHOLD_PX``). With ``refine`` the homography is refined on every pixel by
-    OpenCV's ECC (enhanced correlation coefficient) alignment, and the correspondences are the points of a
-    ``MATCH_GRID`` grid of view a that it carries into view b (where ECC does not converge, the inliers):
-    sharp views of a turn gain from it, the blurred views of a lens zoomed past the scene's detail do not.
-    Empty (0, 2) arrays when fewer than ``MIN_INLIERS`` features agree."""
+    inliers (within ``RANSAC_THRESHOLD_PX``); empty (0, 2) arrays when fewer than ``MIN_INLIERS`` agree."""
     keypoints_a, descriptors_a = sift_features(image_a, CALIBRATION_FEATURES)
     keypoints_b, descriptors_b = sift_features(image_b, CALIBRATION_FEATURES)
     pairs = ratio_matches(descriptors_a, descriptors_b)
@@ -101,78 +76,86 @@ def matched_points(image_a: np.ndarray, image_b: np.ndarray, refine: bool = True
     if len(pairs) < MIN_INLIERS:
         return empty
     points_a, points_b = keypoints_a[pairs[:, 0]], keypoints_b[pairs[:, 1]]
-    H, inliers = cv2.findHomography(points_a, points_b, cv2.RANSAC, RANSAC_THRESHOLD_PX)
-    if H is None or inliers is None or inliers.sum() < MIN_INLIERS:
+    _, inliers = cv2.findHomography(points_a, points_b, cv2.RANSAC, RANSAC_THRESHOLD_PX)
+    if inliers is None or inliers.sum() < MIN_INLIERS:
         return empty
     keep = inliers.ravel().astype(bool)
-    refined = _aligned(image_a, image_b, H) if refine else None
-    if refined is None:
-        return points_a[keep], points_b[keep]
-    height_px, width_px = image_a.shape[:2]
-    u, v = np.meshgrid(np.linspace(0, width_px, MATCH_GRID[0]), np.linspace(0, height_px, MATCH_GRID[1]))
-    grid = np.c_[u.ravel(), v.ravel()]
-    mapped = cv2.perspectiveTransform(grid.reshape(-1, 1, 2), refined)[:, 0, :]
-    inside = (mapped[:, 0] >= 0) & (mapped[:, 0] <= width_px) & (mapped[:, 1] >= 0) & (mapped[:, 1] <= height_px)
-    return grid[inside], mapped[inside]
+    return points_a[keep], points_b[keep]
 
 
-def _aligned(image_a: np.ndarray, image_b: np.ndarray, H_a_to_b: np.ndarray) -> np.ndarray | None:
-    """The homography (3, 3) of view a's pixels to view b's (the model's pixel convention) that ECC refines
-    from ``H_a_to_b``; None where it does not converge. OpenCV's pixel centres are at whole coordinates."""
-    to_opencv = np.array([[1.0, 0.0, -0.5], [0.0, 1.0, -0.5], [0.0, 0.0, 1.0]])
-    warp = (to_opencv @ H_a_to_b @ np.linalg.inv(to_opencv)).astype(np.float32)
-    grey_a, grey_b = (cv2.cvtColor(image, cv2.COLOR_BGR2GRAY).astype(np.float32) for image in (image_a, image_b))
-    # Where the recording (or the lens) shows nothing, there is nothing to align.
-    mask = (grey_a > 0).astype(np.uint8)
-    criteria = (cv2.TERM_CRITERIA_EPS | cv2.TERM_CRITERIA_COUNT, ECC_ITERATIONS, ECC_EPSILON)
-    try:
-        _, warp = cv2.findTransformECC(grey_a, grey_b, warp, cv2.MOTION_HOMOGRAPHY, criteria, mask, ECC_BLUR_PX)
-    except cv2.error:
-        return None
-    return np.linalg.inv(to_opencv) @ warp.astype(float) @ to_opencv
+@dataclass(frozen=True)
+class HeadFit:
+    """The widest focal length and the head's mapping, from turns by known normalised steps.
 
-
-def _rotated_px(focal_px: float, rotation_vector, centred_a: np.ndarray) -> np.ndarray:
-    """Centred pixels (M, 2) of view a carried into view b by ``K R K^-1`` (pixels centred on the principal point)."""
-    rays = np.c_[centred_a / focal_px, np.ones(len(centred_a))] @ Rotation.from_rotvec(rotation_vector).as_matrix().T
-    return focal_px * rays[:, :2] / rays[:, 2:]
-
-
-def focal_from_rotations(
-    matches: list[tuple[np.ndarray, np.ndarray]], image_size_px: tuple[int, int], focal_guess_px: float
-) -> RotationFit:
-    """The focal length shared by views related by pure rotations (the module's first part).
-
-    matches : (points_a (M, 2), points_b (M, 2)) per turn; image_size_px : (width, height), the principal
-    point at its centre; focal_guess_px : where the search starts (the image's width is a fair one).
+    focal_px, focal_sd_px : the focal length and its standard deviation; pan_deg_per_unit,
+    tilt_deg_per_unit : the model's pan and tilt (depression) degrees per unit of the normalised
+    translation (signed); tilt_deg : the view's depression; rms_px : the residuals' root mean square.
     """
+
+    focal_px: float
+    focal_sd_px: float
+    pan_deg_per_unit: float
+    tilt_deg_per_unit: float
+    tilt_deg: float
+    rms_px: float
+
+
+def fit_head(
+    matches: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]],
+    image_size_px: tuple[int, int],
+    initial_deg_per_unit: tuple[float, float],
+    focal_guess_px: float,
+) -> HeadFit:
+    """The focal length and the head's mapping that carry every match best: ``matches`` of
+    (step_a (2,), step_b (2,), points_a (M, 2), points_b (M, 2)) between views at the normalised steps
+    step_a and step_b (pan, tilt) from one view.
+
+    A PTZ head pans about the vertical and tilts about the camera's horizontal axis, each by degrees
+    proportional to the normalised step (``pan = a dx``, ``tilt = b dy``). The view at step (dx, dy) is
+    the model's rotation ``R(a dx, t + b dy)`` (:func:`ptztrack.geometry.ptz.rotation_world_to_camera`;
+    the first view's pan taken as 0, its depression ``t``), and views a and b map pixels by
+    ``K R_b R_a^T K^-1``. So four numbers, ``f``, ``a``, ``b`` and ``t``, explain every match (soft L1 of
+    the reprojection error, 1 px; the search starts from depressions of -30, 0, 30 and 60 deg and focal
+    lengths of 0.7 to 2 times the guess, the best kept), where a free rotation per pair would need three
+    more each: the focal length, which shows only in the turns' perspective, is pinned several times
+    better.
+    """
+    steps_a = np.array([match[0] for match in matches], dtype=float).reshape(-1, 2)
+    steps_b = np.array([match[1] for match in matches], dtype=float).reshape(-1, 2)
     centre = np.array(image_size_px, dtype=float) / 2.0
-    centred = [(a - centre, b - centre) for a, b in matches]
-    shifts = np.array([np.median(b - a, axis=0) for a, b in centred])
-    # A small turn about the camera's y axis moves the image by +f omega in u, about x by -f omega in v.
-    initial_rotations = np.c_[-shifts[:, 1], shifts[:, 0], np.zeros(len(shifts))] / focal_guess_px
+    centred = [(match[2] - centre, match[3] - centre) for match in matches]
 
     def residuals(parameters: np.ndarray) -> np.ndarray:
-        focal_px = float(np.exp(parameters[0]))
-        rotations = parameters[1:].reshape(-1, 3)
-        return np.concatenate(
-            [(_rotated_px(focal_px, r, a) - b).ravel() for r, (a, b) in zip(rotations, centred, strict=True)]
+        focal_px, pan_per_unit, tilt_per_unit, tilt_deg = np.exp(parameters[0]), *parameters[1:]
+        views_a, views_b = (
+            rotation_world_to_camera(pan_per_unit * steps[:, 0], tilt_deg + tilt_per_unit * steps[:, 1])
+            for steps in (steps_a, steps_b)
         )
+        parts = []
+        for rotation, (a, b) in zip(views_b @ np.swapaxes(views_a, -1, -2), centred, strict=True):
+            rays = np.c_[a / focal_px, np.ones(len(a))] @ rotation.T
+            parts.append((focal_px * rays[:, :2] / rays[:, 2:] - b).ravel())
+        return np.concatenate(parts)
 
-    start = np.r_[np.log(focal_guess_px), initial_rotations.ravel()]
-    result = least_squares(residuals, start, loss="soft_l1", f_scale=1.0, x_scale="jac")
-    focal_px = float(np.exp(result.x[0]))
-    rotations = result.x[1:].reshape(-1, 3)
-    dof = max(len(result.fun) - len(result.x), 1)
-    sigma2 = float(np.sum(result.fun**2) / dof)
-    covariance = sigma2 * np.linalg.pinv(result.jac.T @ result.jac)
-    centre_shift = np.array([_rotated_px(focal_px, r, np.zeros((1, 2)))[0] for r in rotations])
-    return RotationFit(
+    best = None
+    for tilt_deg, focal_scale in itertools.product((-30.0, 0.0, 30.0, 60.0), (0.7, 1.0, 1.4, 2.0)):
+        # A focal length and turns' angles that trade against each other: the guess's angles scaled to match.
+        per_unit = np.asarray(initial_deg_per_unit) / focal_scale
+        start = np.r_[np.log(focal_scale * focal_guess_px), per_unit, tilt_deg]
+        result = least_squares(residuals, start, loss="soft_l1", f_scale=1.0, x_scale=[0.1, 1.0, 1.0, 1.0])
+        if best is None or result.cost < best.cost:
+            best = result
+    assert best is not None
+    dof = max(len(best.fun) - len(best.x), 1)
+    covariance = float(np.sum(best.fun**2) / dof) * np.linalg.pinv(best.jac.T @ best.jac)
+    focal_px = float(np.exp(best.x[0]))
+    return HeadFit(
         focal_px=focal_px,
         focal_sd_px=focal_px * float(np.sqrt(max(covariance[0, 0], 0.0))),
-        angles_deg=np.rad2deg(np.linalg.norm(rotations, axis=1)),
-        centre_shift_px=centre_shift,
-        rms_px=float(np.sqrt(np.mean(residuals(result.x) ** 2))),
+        pan_deg_per_unit=float(best.x[1]),
+        tilt_deg_per_unit=float(best.x[2]),
+        tilt_deg=float(best.x[3]),
+        rms_px=float(np.sqrt(np.mean(best.fun**2))),
     )
 
 
@@ -253,7 +236,7 @@ def ground_pose(pixels_px, ground_m, focal_px: float, image_size_px: tuple[int, 
     K = np.array([[focal_px, 0, image_size_px[0] / 2.0], [0, focal_px, image_size_px[1] / 2.0], [0, 0, 1.0]])
     object_points = np.c_[ground_m, np.zeros(len(ground_m))]
     # K's principal point is in the model's pixel convention, as are the points: OpenCV's is not needed.
-    image_points = pixels_px.reshape(-1, 1, 2)
+    image_points = np.ascontiguousarray(pixels_px).reshape(-1, 1, 2)
     count, rotations, translations, _ = cv2.solvePnPGeneric(
         object_points, image_points, K, None, flags=cv2.SOLVEPNP_IPPE
     )
