@@ -26,7 +26,7 @@ def test_the_head_of_noisy_turns_is_found_within_one_percent():
     """Eight turns of a 236 px camera looking 17 deg down, by normalised steps of +-0.15 pan and +-0.2
     tilt (both ways and the diagonals) at 90 and -50 deg per unit, 100 points each with 0.3 px noise: the
     focal length within 1 % and its standard deviation honest (the error within three), the degrees per
-    unit within 1 %, the depression within 1 deg."""
+    unit within 1 %, the depression within 1 deg; a wrongly matched pair is left out."""
     rng = np.random.default_rng(3)
     focal_px, pan_per_unit, tilt_per_unit, tilt_deg = 236.0, 90.0, -50.0, 17.0
     camera = PTZCamera((0.0, 0.0, 5.0), SIZE_PX[0], SIZE_PX[1], focal_px)
@@ -44,7 +44,11 @@ def test_the_head_of_noisy_turns_is_found_within_one_percent():
         if inside.sum() >= 12:
             noisy = moved[inside] + rng.normal(0, 0.3, (int(inside.sum()), 2))
             matches.append((np.zeros(2), step, points[inside], noisy))
+    # A pair RANSAC matched wrongly (a shift no turn of the head makes) is left out.
+    wrong = rng.uniform([0, 0], SIZE_PX, (60, 2))
+    matches.append((np.zeros(2), np.array([0.15, 0.0]), wrong, wrong + [-20.0, 35.0]))
     fit = fit_head(matches, SIZE_PX, (100.0, -45.0), 160.0)
+    assert fit.pairs == len(matches) - 1
     assert abs(fit.focal_px / focal_px - 1) < 0.01
     assert abs(fit.focal_px - focal_px) < 3 * fit.focal_sd_px
     assert fit.pan_deg_per_unit == pytest.approx(pan_per_unit, rel=0.01)

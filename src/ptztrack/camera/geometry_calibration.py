@@ -245,7 +245,7 @@ def measure_geometry(
     report(
         f"widest focal length {head.focal_px:.1f} +- {head.focal_sd_px:.1f} px, pan {head.pan_deg_per_unit:+.3f} "
         f"and tilt {head.tilt_deg_per_unit:+.3f} deg per normalised unit (rms {head.rms_px:.2f} px over "
-        f"{len(matches)} turns)"
+        f"{head.pairs} of {len(matches)} pairs of views)"
     )
     zoom_normalised, ratios = _zoom_ladder(client, latest, image_delay_s, ground, 1.0 / zoom_steps, report)
     client.goto_preset(token)

@@ -44,6 +44,9 @@ from ptztrack.geometry.registration import (
 
 # Features per picture for matching two views of the calibration.
 CALIBRATION_FEATURES = 2000
+# A pair of views whose matches the fitted head carries no nearer than this (median, px) was matched
+# wrongly: it is left out of the fit.
+OUTLYING_PAIR_PX = 2.0
 # Ground points whose spread across their second direction is below this fraction of the first lie on
 # one line: the ground's pose is then not pinned.
 COLLINEAR_RATIO = 0.05
@@ -89,7 +92,8 @@ class HeadFit:
 
     focal_px, focal_sd_px : the focal length and its standard deviation; pan_deg_per_unit,
     tilt_deg_per_unit : the model's pan and tilt (depression) degrees per unit of the normalised
-    translation (signed); tilt_deg : the view's depression; rms_px : the residuals' root mean square.
+    translation (signed); tilt_deg : the view's depression; rms_px : the residuals' root mean square;
+    pairs : the pairs of views fitted (those left out as outlying not counted).
     """
 
     focal_px: float
@@ -98,6 +102,7 @@ class HeadFit:
     tilt_deg_per_unit: float
     tilt_deg: float
     rms_px: float
+    pairs: int
 
 
 def fit_head(
@@ -146,6 +151,13 @@ def fit_head(
         if best is None or result.cost < best.cost:
             best = result
     assert best is not None
+    # A pair whose views RANSAC matched wrongly (repeated texture, a crowd) fits no head: left out, refitted.
+    sizes = [len(match[2]) for match in matches]
+    errors_px = np.linalg.norm(best.fun.reshape(-1, 2), axis=1)
+    pair_errors_px = np.array([np.median(part) for part in np.split(errors_px, np.cumsum(sizes)[:-1])])
+    if np.any(pair_errors_px > OUTLYING_PAIR_PX) and np.any(pair_errors_px <= OUTLYING_PAIR_PX):
+        kept = [match for match, error in zip(matches, pair_errors_px, strict=True) if error <= OUTLYING_PAIR_PX]
+        return fit_head(kept, image_size_px, initial_deg_per_unit, focal_guess_px)
     dof = max(len(best.fun) - len(best.x), 1)
     covariance = float(np.sum(best.fun**2) / dof) * np.linalg.pinv(best.jac.T @ best.jac)
     focal_px = float(np.exp(best.x[0]))
@@ -156,6 +168,7 @@ def fit_head(
         tilt_deg_per_unit=float(best.x[2]),
         tilt_deg=float(best.x[3]),
         rms_px=float(np.sqrt(np.mean(best.fun**2))),
+        pairs=len(matches),
     )
 
 
