@@ -23,20 +23,11 @@ from pathlib import Path
 
 import numpy as np
 
+from ptztrack.builders.camera_calibration import camera_spaces, pose_timeline
 from ptztrack.builders.episode import episode_world, make_policy, make_tracker, run_episode
-from ptztrack.builders.live import (
-    VIRTUAL_FRAME_RATE_HZ,
-    VIRTUAL_SPEEDS,
-    RecordingFeed,
-    camera_spaces,
-    live_as_episode,
-    live_world,
-    offline_counterpart,
-    plan_ahead_of,
-    pose_timeline,
-    virtual_calibration,
-)
+from ptztrack.builders.live import live_as_episode, live_world, offline_counterpart, plan_ahead_of
 from ptztrack.builders.recording import pets_scenario
+from ptztrack.builders.virtual_camera import VIRTUAL_FRAME_RATE_HZ, VIRTUAL_SPEEDS, RecordingFeed, virtual_calibration
 from ptztrack.camera.live_camera import POLL_S
 from ptztrack.camera.stream import LatestFrame
 from ptztrack.evaluate.metrics import episode_metrics

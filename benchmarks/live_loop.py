@@ -34,19 +34,11 @@ from pathlib import Path
 import cv2
 import numpy as np
 
+from ptztrack.builders.camera_calibration import camera_spaces
 from ptztrack.builders.episode import episode_world, make_tracker, run_episode
-from ptztrack.builders.live import (
-    RecordingFeed,
-    camera_spaces,
-    live_as_episode,
-    live_world,
-    offline_counterpart,
-    run_live_episode,
-    shown_steps,
-    virtual_calibration,
-    virtual_onvif_camera,
-)
+from ptztrack.builders.live import live_as_episode, live_world, offline_counterpart, run_live_episode, shown_steps
 from ptztrack.builders.recording import pets_scenario
+from ptztrack.builders.virtual_camera import RecordingFeed, virtual_calibration, virtual_onvif_camera
 from ptztrack.camera.move_timing import measure_image_delay
 from ptztrack.camera.onvif_client import CameraAddress, ONVIFClient
 from ptztrack.camera.onvif_spaces import MoveTimes

@@ -24,8 +24,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ptztrack.builders.live import virtual_onvif_camera
 from ptztrack.builders.recording import pets_scenario
+from ptztrack.builders.virtual_camera import virtual_onvif_camera
 from ptztrack.files import write_json
 
 USER, PASSWORD = "bench", "bench-pass"

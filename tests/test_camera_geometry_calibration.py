@@ -16,8 +16,9 @@ import yaml
 pytest.importorskip("ipycam", reason="the virtual ONVIF camera needs ipycam (pip install --no-deps ipycam==1.3.0)")
 pytest.importorskip("onvif", reason="the ONVIF client is onvif-zeep-async (pip install onvif-zeep-async)")
 
-from ptztrack.builders.live import VIRTUAL_SPEEDS, camera_spaces, virtual_calibration, virtual_onvif_camera  # noqa: E402
+from ptztrack.builders.camera_calibration import camera_spaces
 from ptztrack.builders.recording import pets_scenario  # noqa: E402
+from ptztrack.builders.virtual_camera import VIRTUAL_SPEEDS, virtual_calibration, virtual_onvif_camera
 from ptztrack.cli import main  # noqa: E402
 from ptztrack.virtual_onvif.server import VirtualONVIFCamera  # noqa: E402
 

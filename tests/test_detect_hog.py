@@ -5,7 +5,8 @@ import cv2
 import numpy as np
 import pytest
 
-from ptztrack.builders.live import live_world, offline_counterpart, virtual_calibration
+from ptztrack.builders.live import live_world, offline_counterpart
+from ptztrack.builders.virtual_camera import virtual_calibration
 from ptztrack.builders.world import build_world
 from ptztrack.camera.virtual import virtual_ptz
 from ptztrack.detect.hog import (

@@ -21,8 +21,8 @@ from bad_dataset_inputs import _dataset
 from bad_input_files import video_bytes
 from bad_inputs import write_case
 from ptztrack.builders.budget import refuse_if_too_large
+from ptztrack.builders.camera_calibration import camera_spaces, pose_timeline
 from ptztrack.builders.episode import run_episode
-from ptztrack.builders.live import camera_spaces, pose_timeline
 from ptztrack.cli import main
 from ptztrack.config import (
     MultiViewDataset,

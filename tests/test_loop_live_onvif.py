@@ -17,16 +17,11 @@ import numpy as np
 import psutil
 import pytest
 
+from ptztrack.builders.camera_calibration import camera_spaces
 from ptztrack.builders.episode import run_episode
-from ptztrack.builders.live import (
-    camera_spaces,
-    live_as_episode,
-    offline_counterpart,
-    run_live_episode,
-    virtual_calibration,
-    virtual_onvif_camera,
-)
+from ptztrack.builders.live import live_as_episode, offline_counterpart, run_live_episode
 from ptztrack.builders.recording import pets_scenario
+from ptztrack.builders.virtual_camera import virtual_calibration, virtual_onvif_camera
 from ptztrack.camera.onvif_client import CameraAddress, CameraError, ONVIFClient
 from ptztrack.camera.stream import open_rtsp
 from ptztrack.cli import main

@@ -104,8 +104,8 @@ def test_run_with_view_prints_the_address_starts_when_a_page_connects_and_sends_
 @pytest.mark.slow
 def test_live_with_view_sends_the_cameras_frames(tmp_path):
     pytest.importorskip("ipycam", reason="the virtual ONVIF camera needs ipycam (pip install --no-deps ipycam==1.3.0)")
-    from ptztrack.builders.live import virtual_onvif_camera
     from ptztrack.builders.recording import pets_scenario
+    from ptztrack.builders.virtual_camera import virtual_onvif_camera
 
     camera, _ = virtual_onvif_camera(pets_scenario("hog"), 0.5, 0)
     with camera:

@@ -14,9 +14,10 @@ import numpy as np
 import pytest
 
 from onvif_camera import ERRORS, HEIGHT_PX, START_POSE, USER, WIDTH_PX, call, camera, render
+from ptztrack.builders.camera_calibration import camera_spaces
 from ptztrack.builders.episode import episode_world
-from ptztrack.builders.live import GeometryPriors, camera_spaces, virtual_calibration, virtual_geometry
 from ptztrack.builders.recording import pets_scenario
+from ptztrack.builders.virtual_camera import GeometryPriors, virtual_calibration, virtual_geometry
 from ptztrack.camera.onvif_spaces import AxisSpeeds
 from ptztrack.config import ScenarioError, write_camera_calibration
 from ptztrack.files import InputError
@@ -26,7 +27,7 @@ pytest.importorskip("onvif", reason="the ONVIF client is onvif-zeep-async (pip i
 
 import zeep.exceptions  # noqa: E402  (onvif-zeep-async's SOAP library)
 
-from ptztrack.builders.live import virtual_onvif_camera  # noqa: E402
+from ptztrack.builders.virtual_camera import virtual_onvif_camera
 from ptztrack.virtual_onvif.ptz import PAN_TILT_FOV  # noqa: E402
 from ptztrack.virtual_onvif.server import VirtualONVIFCamera  # noqa: E402
 

@@ -161,7 +161,10 @@ def _zoom_ladder(
     ratios: list[tuple[int, int, float, float]] = []
     step_size = first_step
     while zooms[-1] < 1.0 - 1e-9:
-        step_size = min(step_size, 1.0 - zooms[-1])
+        # The last step takes the rest of the range when less than half a step would be left after it: a
+        # sliver of a step magnifies too little to measure.
+        remaining = 1.0 - zooms[-1]
+        step_size = remaining if remaining < 1.5 * step_size else step_size
         picture = settled_picture(client, latest, image_delay_s, (0.0, 0.0, step_size))
         step = len(pictures)
         where = f"zoom step {step} (normalised zoom {zooms[-1] + step_size:.3f})"

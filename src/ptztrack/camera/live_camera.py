@@ -14,19 +14,43 @@ converted with the camera's calibration
 logs one line and tries to reconnect after 0.5 s, then 1, 2, 4 and at most
 8 s, logging one line when the camera is back; meanwhile the timeline has
 no new samples and the stream no new pictures.
+
+Given a ``sweep`` (a camera that reports no positions, or whose positions
+are not trusted: ``ptztrack live --pose registered``), it first builds a
+reference index from a sweep of its own pictures
+(:func:`~ptztrack.camera.reference_sweep.sweep_index`); then its control
+thread, instead of asking GetStatus, registers each picture whose pose is
+asked for (the newest one when none has been for ``REGISTER_IDLE_S``) and
+puts its pose into the timeline (a
+:class:`~ptztrack.camera.registered_timeline.RegisteredTimeline`) at the
+picture's capture time, and sends a target once the last move could have
+landed, as a move from the newest registered pose
+(:class:`~ptztrack.camera.reference_sweep.Mover`). A picture that does not
+register gives no sample, and at most one log line a second.
 """
 
 import logging
 import threading
 import time
 from collections.abc import Callable
+from dataclasses import dataclass
 
 import numpy as np
 
 from ptztrack.camera.onvif_client import CameraError, ONVIFClient
 from ptztrack.camera.onvif_spaces import CameraSpaces
 from ptztrack.camera.pose_timeline import PoseTimeline
-from ptztrack.camera.stream import FrameStream, rtsp_pictures
+from ptztrack.camera.reference_sweep import (
+    KnownView,
+    Mover,
+    PictureRegistration,
+    registered_sd,
+    stop_at,
+    sweep_index,
+)
+from ptztrack.camera.registered_timeline import RegisteredTimeline
+from ptztrack.camera.stream import Frame, FrameStream, rtsp_pictures
+from ptztrack.geometry.ptz import PTZCamera
 
 log = logging.getLogger("ptztrack.loop.live")
 
@@ -36,6 +60,22 @@ LONGEST_RETRY_S = 8.0
 POLL_S = 0.04
 # A camera without a stream is asked for its snapshot at most this often.
 SNAPSHOT_INTERVAL_S = 0.1
+# Pictures that do not register are logged at most once in this many seconds.
+UNREGISTERED_LOG_S = 1.0
+# A camera placed by its pictures registers the pictures whose poses are asked for, and, when none is
+# asked for this long, its newest one: a priori, five a second keep a camera's pose current between
+# decisions at a fraction of the cost of every picture.
+REGISTER_IDLE_S = 0.2
+
+
+@dataclass(frozen=True)
+class Sweep:
+    """What a camera placed by its pictures sweeps at the start: from the ``known`` view over a grid
+    covering ``grid_poses`` (G, 3), its views bundle-adjusted through ``model`` (the world's camera)."""
+
+    known: KnownView
+    grid_poses: np.ndarray
+    model: PTZCamera
 
 
 class LiveONVIFCamera:
@@ -44,7 +84,10 @@ class LiveONVIFCamera:
 
     spaces : the calibration's spaces; timeline : where GetStatus samples and targets go;
     image_delay_s : how much older than its arrival a picture is; transport : RTSP over 'tcp' or 'udp'.
-    ``frames.latest`` holds the newest picture; ``failures`` counts the calls that failed.
+    sweep : place the camera by its pictures (module docstring; ``timeline`` a RegisteredTimeline and
+    ``spaces`` in world degrees), None to ask GetStatus.
+    ``frames.latest`` holds the newest picture; ``failures`` counts the calls that failed;
+    ``registration`` is the pictures' registration once swept.
     """
 
     def __init__(
@@ -56,8 +99,17 @@ class LiveONVIFCamera:
         transport: str = "tcp",
         poll_s: float = POLL_S,
         clock: Callable[[], float] = time.monotonic,
+        sweep: Sweep | None = None,
     ):
+        if sweep is not None and not isinstance(timeline, RegisteredTimeline):
+            raise TypeError("a camera placed by its pictures keeps them in a RegisteredTimeline")
         self._connect, self.spaces, self.timeline = connect, spaces, timeline
+        self.sweep = sweep
+        self.registration: PictureRegistration | None = None
+        self._mover: Mover | None = None
+        self._stop_s: float | None = None
+        self._registered_number = 0
+        self._unregistered, self._unregistered_logged_s = 0, -np.inf
         self.transport, self.poll_s, self._clock = transport, poll_s, clock
         self.client: ONVIFClient | None = connect()
         self.frames = FrameStream(self._open_pictures, image_delay_s)
@@ -68,10 +120,37 @@ class LiveONVIFCamera:
         self._last_target: np.ndarray | None = None
         self._retry_s, self._retry_at, self._lost_at = FIRST_RETRY_S, 0.0, 0.0
         self._control = threading.Thread(target=self._run, name="camera-control", daemon=True)
+        if isinstance(timeline, RegisteredTimeline):
+            timeline.asked = self._wake.set  # a picture's pose asked for: register it at once
 
     def start(self) -> None:
-        self._control.start()
+        """Start the stream and the control thread; with a ``sweep``, sweep first (a CameraError of one line
+        if the camera cannot be placed by its pictures)."""
+        if self.sweep is None:
+            self._control.start()
+            self.frames.start()
+            return
         self.frames.start()
+        self._swept()
+        self._control.start()
+
+    def _swept(self) -> None:
+        """Choose the moves the camera's node offers and build the reference index from the sweep."""
+        client = self.client
+        assert client is not None and self.sweep is not None and self.timeline.move_times is not None
+        moves = client.moves()
+        if not (moves.relative or moves.continuous):
+            raise CameraError(f"{client.address}: the camera offers neither RelativeMove nor ContinuousMove")
+        if self.sweep.known.preset is None and not moves.absolute:
+            raise CameraError(
+                f"{client.address}: the camera has no AbsoluteMove to reach a known view: give its calibration "
+                "a ground_view (camera calibrate --geometry)"
+            )
+        self._mover = Mover(self.spaces, self.timeline.move_times, relative=moves.relative)
+        sweep = self.sweep
+        self.registration = sweep_index(
+            client, self.frames.latest, sweep.model, self._mover, sweep.known, sweep.grid_poses
+        )
 
     def send(self, pose) -> bool:
         """Have the camera go to ``pose`` (3,) as soon as the control thread can; whether it is a new target."""
@@ -107,6 +186,9 @@ class LiveONVIFCamera:
             self._wake.clear()
 
     def _step(self, client: ONVIFClient) -> None:
+        if self.registration is not None:
+            self._registered_step(client)
+            return
         with self._lock:
             target, self._pending = self._pending, None
         if target is not None:
@@ -117,6 +199,54 @@ class LiveONVIFCamera:
         status = client.status()
         answered_s = time.time()
         self.timeline.sample((asked_s + answered_s) / 2, self.spaces.pose(status.position), status.moving)
+
+    def _registered_step(self, client: ONVIFClient) -> None:
+        """Stop a ContinuousMove that is due, register the picture whose pose is asked for (or, after
+        REGISTER_IDLE_S without one, the newest), and send the pending target once the timeline is ready
+        for a move."""
+        assert isinstance(self.timeline, RegisteredTimeline) and self._mover is not None
+        if self._stop_s is not None and time.time() >= self._stop_s:
+            stop_at(client, self._stop_s)
+            self._stop_s = None
+        wanted_s, latest = self.timeline.wanted(), self.frames.latest
+        frame = latest.newer(self._registered_number, 0.0)
+        if wanted_s is not None:
+            frame = latest.captured_at(wanted_s) or frame
+        elif time.time() < self.timeline.newest_s() + self.frames.delay_s + REGISTER_IDLE_S:
+            frame = None
+        if frame is not None and frame.time_s > self.timeline.newest_s():  # the samples stay in time order
+            self._registered_number = max(self._registered_number, frame.number)
+            self._register(frame)
+        with self._lock:
+            target = self._pending
+        if target is None or not self.timeline.ready(time.time()):
+            return
+        current = self.timeline.current()
+        with self._lock:
+            if self._pending is target:
+                self._pending = None
+        sent_s = time.time()
+        self._stop_s = self._mover.move(client, current, target)
+        self.timeline.sent(sent_s, target)
+
+    def _register(self, frame: Frame) -> None:
+        """Put the pose of ``frame`` into the timeline; where it does not register, place it by dead
+        reckoning if the timeline does so by then, and log it (at most one line a second)."""
+        assert isinstance(self.timeline, RegisteredTimeline) and self.registration is not None
+        pose = self.registration.pose(frame.image)
+        if pose is not None:
+            self.timeline.registered(frame.time_s, pose, registered_sd(pose))
+            return
+        self._unregistered += 1
+        placed = self.timeline.dead_reckoned(frame.time_s)
+        now_s = self._clock()
+        if now_s >= self._unregistered_logged_s + UNREGISTERED_LOG_S:
+            what = "placed where the camera's moves took it" if placed else "not used"
+            log.warning(
+                "picture %d did not register against the reference views (%d since the last such line): %s",
+                frame.number, self._unregistered, what,
+            )  # fmt: skip
+            self._unregistered, self._unregistered_logged_s = 0, now_s
 
     def _open_pictures(self):
         """The stream's ``read`` and ``close`` (:class:`FrameStream`), the snapshots' where it has no stream."""

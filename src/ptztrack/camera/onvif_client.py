@@ -89,6 +89,21 @@ class CameraStatus:
     moving: bool
 
 
+# ONVIF's generic relative pan/tilt space, in which :meth:`ONVIFClient.relative_move` translates.
+GENERIC_TRANSLATION_SPACE = "http://www.onvif.org/ver10/tptz/PanTiltSpaces/TranslationGenericSpace"
+
+
+@dataclass(frozen=True)
+class PTZMoves:
+    """The moves a camera's PTZ node offers (GetNodes' SupportedPTZSpaces): AbsoluteMove (an absolute
+    pan/tilt position space), RelativeMove in the generic translation space, ContinuousMove (a pan/tilt
+    velocity space)."""
+
+    absolute: bool
+    relative: bool
+    continuous: bool
+
+
 class ONVIFClient:
     """One ONVIF PTZ camera: its first media profile's PTZ and snapshot, each call within ``timeout_s``,
     the connection within ``connect_timeout_s``."""
@@ -171,6 +186,19 @@ class ONVIFClient:
 
     def goto_preset(self, token: str) -> None:
         self._call(self._ptz.GotoPreset({"ProfileToken": self._profile, "PresetToken": token}))
+
+    def moves(self) -> PTZMoves:
+        """Which of AbsoluteMove, RelativeMove (generic space) and ContinuousMove the first PTZ node offers."""
+        spaces = self._call(self._ptz.GetNodes())[0].SupportedPTZSpaces
+
+        def uris(name: str) -> list[str]:
+            return [str(space.URI) for space in getattr(spaces, name, None) or []]
+
+        return PTZMoves(
+            absolute=bool(uris("AbsolutePanTiltPositionSpace")),
+            relative=GENERIC_TRANSLATION_SPACE in uris("RelativePanTiltTranslationSpace"),
+            continuous=bool(uris("ContinuousPanTiltVelocitySpace")),
+        )
 
     def position_limits(self) -> np.ndarray:
         """(3, 2) [low, high] of pan, tilt and zoom in the node's absolute position spaces."""

@@ -33,6 +33,8 @@ _OPEN_LOCK = threading.Lock()
 
 
 THUMBNAIL_SIZE_PX = (64, 48)
+# A LatestFrame keeps this many of the newest pictures, to be found by their capture time.
+RECENT_PICTURES = 8
 # The frame clock is fitted to a stream's last this many pictures (2 s at 25 fps).
 FRAME_CLOCK_PICTURES = 50
 
@@ -55,18 +57,26 @@ class Frame:
 
 
 class LatestFrame:
-    """The newest picture of a source, handed from the thread that receives to the one that uses them."""
+    """The newest picture of a source, handed from the thread that receives to the one that uses them (and
+    the RECENT_PICTURES newest, to find one by its capture time)."""
 
     def __init__(self) -> None:
         self._condition = threading.Condition()
         self._frame: Frame | None = None
+        self._recent: deque[Frame] = deque(maxlen=RECENT_PICTURES)
         self.received = 0
 
     def put(self, image: np.ndarray, time_s: float) -> None:
         with self._condition:
             self.received += 1
             self._frame = Frame(image, time_s, self.received)
+            self._recent.append(self._frame)
             self._condition.notify_all()
+
+    def captured_at(self, time_s: float) -> Frame | None:
+        """The picture of capture time ``time_s`` among the RECENT_PICTURES newest; None if gone or never."""
+        with self._condition:
+            return next((frame for frame in self._recent if frame.time_s == time_s), None)
 
     def newer(self, number: int, timeout_s: float) -> Frame | None:
         """The newest picture after picture ``number``, waiting at most ``timeout_s``; None if none came."""

@@ -33,6 +33,8 @@ from ptztrack.config.ground_points import GroundPoints, load_ground_points
 from ptztrack.files import check_output_file, write_atomically
 from ptztrack.geometry.self_calibration import GroundPose, ground_points_problem, ground_pose
 
+# How well a user places a ground point in the picture (px): a priori, a click on a pixel.
+POINT_SD_PX = 1.0
 # The first picture of the stream is awaited this long (an RTSP stream takes seconds to open).
 FIRST_PICTURE_S = 20.0
 
@@ -73,7 +75,10 @@ def calibrate_geometry_command(args: argparse.Namespace, credentials: dict | Non
             stream.stop()
         client.close()
     assert token is not None
-    ground = ground_pose(points.pixels_px, points.ground_m, measured.head.focal_px, measured.image_size_px)
+    head = measured.head
+    ground = ground_pose(
+        points.pixels_px, points.ground_m, head.focal_px, measured.image_size_px, head.focal_sd_px, POINT_SD_PX
+    )
     calibration = calibration_of(measured, ground, token, existing)
     write_camera_calibration(args.calibration, calibration)
     _print_geometry(measured, ground, calibration)
@@ -109,13 +114,16 @@ def calibration_of(
     ground view's pose (from its reported position, or from the preset, which then stands at 0), the zoom
     curve as zoom factors of the widest focal length with their standard deviations, the position on the
     ground and the ground view; move times and the stream's delay kept from ``existing``."""
+    # The points refine the widest focal length; the turns' angles trade against it (a shift is f theta).
+    refined = ground.focal_px / measured.head.focal_px
+    pan_per_unit, tilt_per_unit = measured.head.pan_deg_per_unit / refined, measured.head.tilt_deg_per_unit / refined
     position = measured.ground_position
     positions = bool(np.all(np.isfinite(position)))
     at = position if positions else np.zeros(3)
     ends = np.array([-1.0, 1.0])
-    pan_deg = ground.pan_deg + measured.head.pan_deg_per_unit * (ends - at[0])
+    pan_deg = ground.pan_deg + pan_per_unit * (ends - at[0])
     pan_deg -= 360.0 * np.round(pan_deg.mean() / 360.0)
-    tilt_deg = ground.tilt_deg + measured.head.tilt_deg_per_unit * (ends - at[1])
+    tilt_deg = ground.tilt_deg + tilt_per_unit * (ends - at[1])
     widest_px = float(measured.focal_px[0])
     fields = {
         "pan_deg": tuple(round(float(value), 4) for value in pan_deg),
@@ -126,7 +134,7 @@ def calibration_of(
         ],
         "zoom_curve_sd": [round(float(sd / widest_px), 6) for sd in measured.focal_sd_px],
         "position_m": tuple(round(float(value), 4) for value in ground.position_m),
-        "f_min_px": round(widest_px, 3),
+        "f_min_px": round(widest_px * refined, 3),
         "positions": positions,
         "ground_view": GroundViewSection(
             preset=preset,
@@ -147,12 +155,12 @@ def _print_geometry(measured: GeometryMeasurement, ground: GroundPose, calibrati
         f"tilt {ground.tilt_deg:.2f} deg, roll {ground.roll_deg:.2f} deg; ground points' reprojection error "
         f"{ground.rms_px:.2f} px rms (largest {ground.residuals_px.max():.2f} px)"
     )
+    pan_per_unit, tilt_per_unit = (np.diff(ends)[0] / 2 for ends in (calibration.pan_deg, calibration.tilt_deg))
+    counted = "from its positions" if calibration.positions else "from the ground preset: no positions"
+    print(f"pan {pan_per_unit:+.3f} deg and tilt {tilt_per_unit:+.3f} deg per normalised unit ({counted})")
+    scale = ground.focal_px / measured.focal_px[0]
     print(
-        f"pan {measured.head.pan_deg_per_unit:+.3f} deg and tilt {measured.head.tilt_deg_per_unit:+.3f} deg per "
-        f"normalised unit ({'from its positions' if calibration.positions else 'from the ground preset: no positions'})"
-    )
-    print(
-        f"focal length {measured.focal_px[0]:.1f} +- {measured.focal_sd_px[0]:.1f} px at the widest to "
-        f"{measured.focal_px[-1]:.1f} +- {measured.focal_sd_px[-1]:.1f} px at normalised zoom 1 "
-        f"({len(measured.focal_px)} steps)"
+        f"focal length {ground.focal_px:.1f} +- {scale * measured.focal_sd_px[0]:.1f} px at the widest (the turns "
+        f"gave {measured.focal_px[0]:.1f}, the ground points refined it) to {scale * measured.focal_px[-1]:.1f} px "
+        f"at normalised zoom 1 ({len(measured.focal_px)} steps)"
     )

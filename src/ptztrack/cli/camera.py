@@ -10,13 +10,12 @@ from pathlib import Path
 
 import numpy as np
 
-from ptztrack.builders.live import (
+from ptztrack.builders.camera_calibration import camera_spaces
+from ptztrack.builders.live import live_as_episode, live_pictures, run_live_episode
+from ptztrack.builders.live_registered import check_pose_source
+from ptztrack.builders.virtual_camera import (
     TRUTH_LOG_HEADER,
     camera_presets_path,
-    camera_spaces,
-    live_as_episode,
-    live_pictures,
-    run_live_episode,
     virtual_calibration,
     virtual_geometry,
     virtual_onvif_cameras,
@@ -59,6 +58,7 @@ def live_command(args: argparse.Namespace) -> int:
         args.scenario, args.detector, detector_model=args.detector_model, dataset=args.dataset, view=args.dataset_view
     )
     calibrations = _calibrations(args)
+    check_pose_source(calibrations, args.pose)
     addresses = [camera_address(url, _credentials(args)) for url in args.camera]
     truth_log = None if args.truth is None else read_truth_log(args.truth)
     steps = args.steps or scenario.frames
@@ -70,8 +70,10 @@ def live_command(args: argparse.Namespace) -> int:
         (world,), (live,) = run_live_episode(
             scenario, calibrations, addresses, args.policy, steps, args.time_scale, args.seed,
             timeout_s=args.timeout_s, transport=args.transport, keep_images=args.out is not None,
-            observe=watch.observe,
+            observe=watch.observe, pose_source=args.pose,
         )  # fmt: skip
+    if args.truth is not None:  # read again: the camera logged the run's pictures since the start
+        truth_log = read_truth_log(args.truth)
     episode = live_as_episode(world, live, truth_log)
     _print_rates(live)
     metrics = episode_metrics(episode)
@@ -121,8 +123,11 @@ def _live_network(args, scenario, calibrations, addresses, truth_log, steps: int
         worlds, lives = run_live_episode(
             scenario, calibrations, addresses, args.policy, steps, args.time_scale, args.seed, args.coordination,
             args.timeout_s, args.transport, keep_images=args.out is not None, observe=watch.observe,
+            pose_source=args.pose,
         )  # fmt: skip
     # The cameras share the recording's clock: a virtual camera's truth log places every camera's pictures.
+    if args.truth is not None:  # read again: the camera logged the run's pictures since the start
+        truth_log = read_truth_log(args.truth)
     episodes = [live_as_episode(world, live, truth_log) for world, live in zip(worlds, lives, strict=True)]
     with contextlib.ExitStack() as stack:
         folder = None if args.out is None else stack.enter_context(run_folder(args.out, args.overwrite))

@@ -52,6 +52,13 @@ def add_camera_commands(commands, policies: list[str]) -> None:
         "--time-scale", type=positive_float, default=1.0, help="the scenario's seconds per second (serve-camera's)"
     )
     live.add_argument("--transport", choices=("tcp", "udp"), default="tcp", help="RTSP's transport (default tcp)")
+    live.add_argument(
+        "--pose",
+        choices=("status", "registered"),
+        default="status",
+        help="the camera's pose: GetStatus's position (default), or registered from its pictures against "
+        "reference views it sweeps at the start (moves by RelativeMove; for cameras without positions)",
+    )
     live.add_argument("--timeout-s", type=positive_float, default=5.0, help="the longest wait for any camera call")
     live.add_argument(
         "--truth", type=Path, help="score against a virtual camera's truth log (serve-camera --truth-log)"

@@ -62,8 +62,9 @@ class CameraCalibrationFile(_Strict):
     ``ptztrack camera calibrate`` measures it: the spread of its delays).
     zoom_curve_sd : the standard deviation of each zoom_curve point's zoom factor (as measured by
     ``camera calibrate --geometry``; null: not measured); positions : whether the camera reports its
-    position (false: pan_deg and tilt_deg are the degrees at normalised -1 and +1 from the ground view's
-    preset, which stands at 0, and the camera is moved by relative moves); ground_view : see
+    position (false: its ground view's preset stands at normalised 0, pan_deg and tilt_deg are the world
+    degrees that relative moves of -1 and +1 from there reach, and the camera is moved by relative moves);
+    ground_view : see
     :class:`GroundViewSection` (null: not measured).
     """
 

@@ -56,13 +56,15 @@ COLLINEAR_RATIO = 0.05
 class GroundPose:
     """The camera's pose on the ground: position_m (3,) its optical centre (x, y, height), pan_deg,
     tilt_deg (the model's, on a level mount), roll_deg (the roll about the optical axis that the points
-    show when it is let free), residuals_px (N,) each ground point's reprojection error on the level mount."""
+    show when it is let free), residuals_px (N,) each ground point's reprojection error on the level mount,
+    focal_px the focal length of the fit (the one given, or refined by the points)."""
 
     position_m: np.ndarray
     pan_deg: float
     tilt_deg: float
     roll_deg: float
     residuals_px: np.ndarray
+    focal_px: float
 
     @property
     def rms_px(self) -> float:
@@ -240,11 +242,21 @@ def ground_points_problem(pixels_px, ground_m, image_size_px: tuple[int, int] | 
     return None
 
 
-def ground_pose(pixels_px, ground_m, focal_px: float, image_size_px: tuple[int, int]) -> GroundPose:
+def ground_pose(
+    pixels_px,
+    ground_m,
+    focal_px: float,
+    image_size_px: tuple[int, int],
+    focal_sd_px: float = 0.0,
+    pixel_sd_px: float = 1.0,
+) -> GroundPose:
     """The camera's pose from ground points (the module's third part): pixels (N, 2) of ground points
     (N, 2) m (on z = 0) in a view of focal length ``focal_px``, the principal point at the centre of an
-    ``image_size_px`` (width, height) picture. Raises ValueError when no solution puts the camera above
-    the ground with the points in front of it."""
+    ``image_size_px`` (width, height) picture. With ``focal_sd_px`` the level fit frees the focal length
+    too, under its measurement as a prior: residuals ``(p - pi(X)) / pixel_sd_px`` and
+    ``(log f - log focal_px) / (focal_sd_px / focal_px)``, so that the points' perspective, which also
+    tells the focal length, refines it. Raises ValueError when no solution puts the camera above the
+    ground with the points in front of it."""
     pixels_px, ground_m = np.asarray(pixels_px, dtype=float), np.asarray(ground_m, dtype=float)
     K = np.array([[focal_px, 0, image_size_px[0] / 2.0], [0, focal_px, image_size_px[1] / 2.0], [0, 0, 1.0]])
     object_points = np.c_[ground_m, np.zeros(len(ground_m))]
@@ -270,11 +282,22 @@ def ground_pose(pixels_px, ground_m, focal_px: float, image_size_px: tuple[int, 
     rolled = R @ rotation_world_to_camera(pan_deg, tilt_deg).T
     roll_deg = float(np.rad2deg(np.arctan2(rolled[1, 0], rolled[0, 0])))
 
-    def level_residuals(level: np.ndarray) -> np.ndarray:
+    def reprojected(level: np.ndarray) -> np.ndarray:
         camera_points = (object_points - level[:3]) @ rotation_world_to_camera(level[3], level[4]).T
-        projected = camera_points[:, :2] / camera_points[:, 2:] @ K[:2, :2].T + K[:2, 2]
+        projected = np.exp(level[5]) * camera_points[:, :2] / camera_points[:, 2:] + K[:2, 2]
         return (projected - image_points[:, 0, :]).ravel()
 
-    level = least_squares(level_residuals, np.r_[centre_m, pan_deg, tilt_deg], xtol=1e-12, ftol=1e-12, gtol=1e-12).x
-    errors = np.linalg.norm(level_residuals(level).reshape(-1, 2), axis=1)
-    return GroundPose(level[:3], float(level[3]), float(level[4]), roll_deg, errors)
+    def level_residuals(level: np.ndarray) -> np.ndarray:
+        prior = (level[5] - np.log(focal_px)) * focal_px / focal_sd_px if focal_sd_px > 0 else 0.0
+        return np.r_[reprojected(level) / pixel_sd_px, prior]
+
+    start = np.r_[centre_m, pan_deg, tilt_deg, np.log(focal_px)]
+    if focal_sd_px > 0:
+        level = least_squares(level_residuals, start, xtol=1e-12, ftol=1e-12, gtol=1e-12).x
+    else:
+        fixed = least_squares(
+            lambda free: reprojected(np.r_[free, start[5]]), start[:5], xtol=1e-12, ftol=1e-12, gtol=1e-12
+        )
+        level = np.r_[fixed.x, start[5]]
+    errors = np.linalg.norm(reprojected(level).reshape(-1, 2), axis=1)
+    return GroundPose(level[:3], float(level[3]), float(level[4]), roll_deg, errors, float(np.exp(level[5])))
