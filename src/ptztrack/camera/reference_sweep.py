@@ -279,6 +279,12 @@ def sweep_index(
         landed_s = sent_s + float(move_times.seconds(here, pose))
         images.append(settled_picture(latest, landed_s, landed_s + SETTLE_TIMEOUT_S, thumbnail(images[-1])).image)
         here = pose
+    # Back to the known view: the loop starts where the ground is seen, not at the sweep's last corner,
+    # which may look beyond anything that registers.
+    sent_s = time.time()
+    stop_at(client, mover.move(client, here, known.pose))
+    landed_s = sent_s + float(move_times.seconds(here, known.pose))
+    settled_picture(latest, landed_s, landed_s + SETTLE_TIMEOUT_S, thumbnail(images[-1]))
     log.warning("registered pose: %d views swept in %.1f s", len(images), time.time() - phase_s)
     phase_s = time.time()
     poses = np.vstack([known.pose, planned])
