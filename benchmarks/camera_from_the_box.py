@@ -40,7 +40,7 @@ import yaml
 from ptztrack.builders.camera_calibration import camera_spaces
 from ptztrack.builders.episode import episode_world
 from ptztrack.builders.live import live_as_episode, run_live_episode
-from ptztrack.builders.virtual_camera import virtual_geometry
+from ptztrack.builders.virtual_camera import VIRTUAL_SUPERSAMPLE, virtual_geometry
 from ptztrack.camera.onvif_client import camera_address
 from ptztrack.cli import main
 from ptztrack.cli.camera import read_truth_log
@@ -116,7 +116,8 @@ def served(seed: int, blind: bool, truth_log: Path):
     """``ptztrack serve-camera`` in a process of its own (a camera is a machine of its own) with the
     geometry of ``seed``, without positions and AbsoluteMove where ``blind``; its onvif:// URL."""
     command = [sys.executable, "-m", "ptztrack.cli", "serve-camera", "--port", "0", "--geometry-seed", str(seed)]
-    command += ["--truth-log", str(truth_log), *(["--no-positions", "--relative-only"] if blind else [])]
+    command += ["--truth-log", str(truth_log), "--supersample", str(VIRTUAL_SUPERSAMPLE)]
+    command += ["--no-positions", "--relative-only"] if blind else []
     server = subprocess.Popen(command, stdout=subprocess.PIPE, text=True)
     try:
         line = server.stdout.readline() if server.stdout is not None else ""

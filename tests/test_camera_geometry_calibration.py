@@ -18,7 +18,12 @@ pytest.importorskip("onvif", reason="the ONVIF client is onvif-zeep-async (pip i
 
 from ptztrack.builders.camera_calibration import camera_spaces
 from ptztrack.builders.recording import pets_scenario  # noqa: E402
-from ptztrack.builders.virtual_camera import VIRTUAL_SPEEDS, virtual_calibration, virtual_onvif_camera
+from ptztrack.builders.virtual_camera import (
+    VIRTUAL_SPEEDS,
+    VIRTUAL_SUPERSAMPLE,
+    virtual_calibration,
+    virtual_onvif_camera,
+)
 from ptztrack.cli import main  # noqa: E402
 from ptztrack.virtual_onvif.server import VirtualONVIFCamera  # noqa: E402
 
@@ -67,7 +72,7 @@ def test_a_zoom_that_shows_a_blank_wall_ends_the_sweep_naming_its_step_and_keeps
     register, the zoom step that shows the wall does not (halved to the smallest step): exit 2 with one
     line naming that zoom step, the old file as it was."""
     scenario = pets_scenario()
-    _, feed = virtual_onvif_camera(scenario, 1.0, 0)
+    _, feed = virtual_onvif_camera(scenario, 1.0, 0, supersample=VIRTUAL_SUPERSAMPLE)
     world = feed.world
 
     def render(pose, elapsed_s: float) -> np.ndarray:
@@ -103,7 +108,16 @@ def test_a_zoom_that_shows_a_blank_wall_ends_the_sweep_naming_its_step_and_keeps
 def test_ctrl_c_during_the_sweep_leaves_the_old_file_intact(tmp_path):
     """`camera calibrate --geometry` in a process of its own against `serve-camera` in another, Ctrl-C a few
     seconds into the sweep: exit 130, the old file as it was and nothing beside it."""
-    serve = [sys.executable, "-m", "ptztrack.cli", "serve-camera", "--port", "0"]
+    serve = [
+        sys.executable,
+        "-m",
+        "ptztrack.cli",
+        "serve-camera",
+        "--port",
+        "0",
+        "--supersample",
+        str(VIRTUAL_SUPERSAMPLE),
+    ]
     default_sigint = {"preexec_fn": lambda: signal.signal(signal.SIGINT, signal.SIG_DFL)}
     server = subprocess.Popen(serve, stdout=subprocess.PIPE, text=True, **default_sigint)  # type: ignore[call-overload]
     calibration = tmp_path / "camera.yaml"

@@ -38,10 +38,12 @@ if TYPE_CHECKING:
     from ptztrack.virtual_onvif.server import VirtualONVIFCamera
 
 
-# The virtual camera renders its pictures this many times finer in both directions and averages them down,
-# as a camera's lens and sensor average the light over each pixel: its 160 x 120 view point-sampled from a
-# 768 x 576 recording would alias, which moves the same scene's features between views (docs: decisions).
-# Its maps are computed every SUPERSAMPLED_MAP_GRID_PX-th pixel (VirtualPTZ.map_grid_px).
+# With ``serve-camera --supersample N`` the virtual camera renders its pictures N times finer in both
+# directions and averages them down, as a camera's lens and sensor average the light over each pixel: its
+# 160 x 120 view point-sampled from a 768 x 576 recording aliases, which moves the same scene's features
+# between views (docs: decisions). The geometry's calibration is measured at VIRTUAL_SUPERSAMPLE; the
+# live runs compared with offline ones keep 1, the offline tables' own rendering. The finer maps are
+# computed every SUPERSAMPLED_MAP_GRID_PX-th pixel (VirtualPTZ.map_grid_px).
 VIRTUAL_SUPERSAMPLE, SUPERSAMPLED_MAP_GRID_PX = 4, 8
 
 
@@ -66,7 +68,7 @@ class RecordingFeed:
     thumbnails: list[np.ndarray] | None = None
     started_s: float | None = None
     render_lock: threading.Lock = field(default_factory=threading.Lock, repr=False)
-    supersample: int = VIRTUAL_SUPERSAMPLE
+    supersample: int = 1
     _lock: threading.Lock = field(default_factory=threading.Lock, repr=False)
     _fine: RecordedPTZ | None = field(default=None, init=False, repr=False)
 
@@ -263,6 +265,7 @@ def virtual_onvif_camera(
     absolute_moves: bool = True,
     presets_path: Path | None = None,
     move_latency_s: float = MOVE_LATENCY_S,
+    supersample: int = 1,
 ) -> tuple["VirtualONVIFCamera", RecordingFeed]:
     """The virtual ONVIF camera over ``scenario``'s recording (not started) and the feed that logs its
     truth (``feed``, to go on with one).
@@ -270,7 +273,7 @@ def virtual_onvif_camera(
     geometry : the camera's true spaces (:func:`virtual_geometry`; None: :func:`virtual_calibration`'s);
     positions, absolute_moves, presets_path, move_latency_s : as
     :class:`~ptztrack.virtual_onvif.server.VirtualONVIFCamera` takes them (a presets file that is not one
-    raises an InputError naming it).
+    raises an InputError naming it); supersample : a new feed's (:class:`RecordingFeed`).
     """
     try:  # the server is ipycam's, installed apart (it must not bring opencv-python): only here is it needed
         from ptztrack.virtual_onvif.server import VirtualONVIFCamera
@@ -279,7 +282,9 @@ def virtual_onvif_camera(
             "the virtual ONVIF camera needs ipycam: pip install --no-deps ipycam==1.3.0 (docs: Real cameras)"
         ) from None
     if feed is None:
-        feed = RecordingFeed(episode_world(scenario, 0), 1.0 / scenario.frame_rate_hz, time_scale)
+        feed = RecordingFeed(
+            episode_world(scenario, 0), 1.0 / scenario.frame_rate_hz, time_scale, supersample=supersample
+        )
     world = feed.world
     spaces = camera_spaces(virtual_calibration() if geometry is None else geometry)
     camera = VirtualONVIFCamera(
@@ -318,6 +323,7 @@ def virtual_onvif_cameras(
     positions: bool = True,
     absolute_moves: bool = True,
     presets_path: Path | None = None,
+    supersample: int = 1,
 ) -> list[tuple["VirtualONVIFCamera", RecordingFeed]]:
     """Virtual ONVIF cameras over one play of ``scenario``'s recording (not started), one on each of
     ``ports`` (0: any free port), each with the feed that logs its truth: they show the same recording
@@ -328,7 +334,17 @@ def virtual_onvif_cameras(
     def camera(number: int, port: int, feed: RecordingFeed | None) -> tuple["VirtualONVIFCamera", RecordingFeed]:
         presets = None if presets_path is None else camera_presets_path(presets_path, number)
         return virtual_onvif_camera(
-            scenario, time_scale, port, username, password, feed, geometry, positions, absolute_moves, presets
+            scenario,
+            time_scale,
+            port,
+            username,
+            password,
+            feed,
+            geometry,
+            positions,
+            absolute_moves,
+            presets,
+            supersample=supersample,
         )
 
     first_camera, first_feed = camera(1, ports[0], None)
@@ -338,7 +354,7 @@ def virtual_onvif_cameras(
     for number, port in enumerate(ports[1:], start=2):
         feed = RecordingFeed(
             first_feed.world, first_feed.step_s, time_scale, started_s=first_feed.started_s,
-            render_lock=first_feed.render_lock,
+            render_lock=first_feed.render_lock, supersample=supersample,
         )  # fmt: skip
         cameras.append(camera(number, port, feed))
     return cameras

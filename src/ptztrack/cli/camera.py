@@ -247,7 +247,7 @@ def serve_camera_command(args: argparse.Namespace) -> int:
             check_output_file(camera_presets_path(args.presets, number), "--presets")
     cameras = virtual_onvif_cameras(
         scenario, args.time_scale, ports, username, password, geometry, not args.no_positions,
-        not args.relative_only, args.presets,
+        not args.relative_only, args.presets, args.supersample,
     )  # fmt: skip
     # The cameras share the recording's clock, so the first camera's log gives every camera's steps.
     feed = cameras[0][1]

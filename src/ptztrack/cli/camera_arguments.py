@@ -119,6 +119,13 @@ def add_camera_commands(commands, policies: list[str]) -> None:
         "with --cameras, camera k >= 2 in FILE with -k before its suffix",
     )
     serve.add_argument(
+        "--supersample",
+        type=positive_int,
+        default=1,
+        help="render each picture N times finer and average it down, as a lens and sensor do (default 1: "
+        "point-sampled, as the offline tables render)",
+    )
+    serve.add_argument(
         "--no-positions", action="store_true", help="a camera that does not report its position (GetStatus, presets)"
     )
     serve.add_argument(
