@@ -29,6 +29,7 @@ from ptztrack.geometry.self_calibration import (
     fit_head,
     focals_from_ratios,
     matched_points,
+    view_features,
     zoom_ratio,
 )
 
@@ -133,13 +134,14 @@ def _turn(client: ONVIFClient, latest: LatestFrame, image_delay_s: float, transl
     return image
 
 
-def _probe(client, latest, image_delay_s: float, ground: np.ndarray, axis: int, report) -> float:
-    """The picture's shift (px) on ``axis`` (0 pan: u, 1 tilt: v) for a turn of PROBE_TURN on that axis."""
+def _probe(client, latest, image_delay_s: float, ground, axis: int, report) -> float:
+    """The picture's shift (px) on ``axis`` (0 pan: u, 1 tilt: v) for a turn of PROBE_TURN on that axis;
+    ``ground`` the ground view's :func:`view_features`."""
     probe = np.zeros(3)
     probe[axis] = PROBE_TURN
     name = ("pan", "tilt")[axis]
     image = _turn(client, latest, image_delay_s, probe)
-    points_a, points_b = matched_points(ground, image)
+    points_a, points_b = matched_points(ground, view_features(image))
     if len(points_a) == 0:
         raise GeometryError(f"the {name} probe did not register against the ground view: too few features match")
     return float(np.median(points_b[:, axis] - points_a[:, axis]))
@@ -157,7 +159,7 @@ def _zoom_ladder(
     about ``TARGET_ZOOM_RATIO`` (the first ``first_step``; a step that does not register is halved, down to
     ``MIN_ZOOM_STEP``), each picture matched to the one and the two before. The steps' normalised zooms
     (K + 1,) and the scales (i, j, s_ij, sd_ij) between them."""
-    pictures, zooms = [widest], [0.0]
+    features, zooms = [view_features(widest)], [0.0]
     ratios: list[tuple[int, int, float, float]] = []
     step_size = first_step
     while zooms[-1] < 1.0 - 1e-9:
@@ -166,11 +168,12 @@ def _zoom_ladder(
         remaining = 1.0 - zooms[-1]
         step_size = remaining if remaining < 1.5 * step_size else step_size
         picture = settled_picture(client, latest, image_delay_s, (0.0, 0.0, step_size))
-        step = len(pictures)
+        step = len(features)
+        picture_features = view_features(picture)
         where = f"zoom step {step} (normalised zoom {zooms[-1] + step_size:.3f})"
         found = []
         for before in range(step - 1, max(step - 3, -1), -1):
-            points_a, points_b = matched_points(pictures[before], picture)
+            points_a, points_b = matched_points(features[before], picture_features)
             if len(points_a):
                 found.append((before, step, *zoom_ratio(points_a, points_b, widest.shape[1::-1])))
         if not found or found[0][0] != step - 1 or found[0][2] <= 1.0:
@@ -182,7 +185,7 @@ def _zoom_ladder(
             continue
         ratio = found[0][2]
         report(f"{where}: x{ratio:.4f} +- {found[0][3]:.4f} on the step before")
-        pictures.append(picture)
+        features.append(picture_features)
         zooms.append(zooms[-1] + step_size)
         ratios.extend(found)
         step_size *= np.log(TARGET_ZOOM_RATIO) / np.log(ratio)
@@ -214,7 +217,8 @@ def measure_geometry(
     ground_position = client.status().position
     report(f"ground view: {ground.shape[1]}x{ground.shape[0]} px")
     size_px = (ground.shape[1], ground.shape[0])
-    shifts_px = np.array([_probe(client, latest, image_delay_s, ground, axis, report) for axis in (0, 1)])
+    ground_features = view_features(ground)
+    shifts_px = np.array([_probe(client, latest, image_delay_s, ground_features, axis, report) for axis in (0, 1)])
     turn = np.clip(
         PROBE_TURN * TURN_FRACTION * np.array(size_px) / np.maximum(np.abs(shifts_px), 1e-3), MIN_TURN, MAX_TURN
     )
@@ -224,16 +228,16 @@ def measure_geometry(
     # the diagonals turn the picture as well as shift it, which pins the focal length further.
     signs = [(1, 0), (-1, 0), (0, 1), (0, -1), (1, 1), (-1, -1), (1, -1), (-1, 1)]
     steps = [np.zeros(2)]
-    pictures = [ground]
+    features = [ground_features]
     for pan_sign, tilt_sign in signs:
         translation = np.array([pan_sign * turn[0], tilt_sign * turn[1], 0.0])
         steps.append(translation[:2])
-        pictures.append(_turn(client, latest, image_delay_s, translation))
+        features.append(view_features(_turn(client, latest, image_delay_s, translation)))
     # Every pair of views that registers, the turned ones with each other too: more pairs, and wider ones.
     matches, registered = [], set()
-    for first in range(len(pictures)):
-        for second in range(first + 1, len(pictures)):
-            points_a, points_b = matched_points(pictures[first], pictures[second])
+    for first in range(len(features)):
+        for second in range(first + 1, len(features)):
+            points_a, points_b = matched_points(features[first], features[second])
             if len(points_a):
                 matches.append((steps[first], steps[second], points_a, points_b))
                 registered |= {first, second}

@@ -71,11 +71,16 @@ class GroundPose:
         return float(np.sqrt(np.mean(self.residuals_px**2)))
 
 
-def matched_points(image_a: np.ndarray, image_b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Correspondences (M, 2) and (M, 2) of two views: SIFT, Lowe's ratio test and a RANSAC homography's
-    inliers (within ``RANSAC_THRESHOLD_PX``); empty (0, 2) arrays when fewer than ``MIN_INLIERS`` agree."""
-    keypoints_a, descriptors_a = sift_features(image_a, CALIBRATION_FEATURES)
-    keypoints_b, descriptors_b = sift_features(image_b, CALIBRATION_FEATURES)
+def view_features(image_bgr: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """A calibration view's SIFT keypoints (K, 2) px and descriptors (K, 128), extracted once per view."""
+    return sift_features(image_bgr, CALIBRATION_FEATURES)
+
+
+def matched_points(features_a, features_b) -> tuple[np.ndarray, np.ndarray]:
+    """Correspondences (M, 2) and (M, 2) of two views given their :func:`view_features`: Lowe's ratio test
+    and a RANSAC homography's inliers (within ``RANSAC_THRESHOLD_PX``); empty (0, 2) arrays when fewer than
+    ``MIN_INLIERS`` agree."""
+    (keypoints_a, descriptors_a), (keypoints_b, descriptors_b) = features_a, features_b
     pairs = ratio_matches(descriptors_a, descriptors_b)
     empty = np.zeros((0, 2)), np.zeros((0, 2))
     if len(pairs) < MIN_INLIERS:
