@@ -21,13 +21,12 @@ def _still_at(pose, times_s, timeline=None) -> RegisteredTimeline:
     return timeline
 
 
-def test_a_picture_is_placed_only_near_a_registered_sample_with_the_registrations_sd_added():
+def test_a_picture_is_placed_only_by_its_own_registration_with_the_registrations_sd_added():
     timeline = _still_at(HERE, [10.0, 10.04])
-    at = timeline.at(10.02)
+    at = timeline.at(10.04)
     np.testing.assert_allclose(at.pose, HERE)
     np.testing.assert_allclose(at.sd, SD)  # standing still: the registration's sd alone
-    assert timeline.at(10.04 + 0.05) is not None  # within two frame intervals
-    assert timeline.at(10.04 + 0.2) is None and timeline.at(9.5) is None  # too far from any sample
+    assert timeline.at(10.02) is None and timeline.at(10.08) is None  # pictures that did not register
 
 
 def test_a_registered_pose_that_jumps_is_moving_and_a_picture_at_rest_after_the_landing_is_settled():
@@ -64,18 +63,21 @@ def test_a_move_starts_from_its_target_when_no_picture_registered_after_it():
     np.testing.assert_allclose(timeline.current(), THERE)
 
 
-def test_pictures_that_do_not_register_are_placed_by_dead_reckoning_after_a_blind_second():
+def test_pictures_that_do_not_register_are_never_placed_but_after_a_blind_second_the_moves_go_on():
     timeline = _still_at(HERE, [10.0])
     timeline.sent(10.05, THERE)  # lands at 10.35
     assert not timeline.dead_reckoned(11.0) and timeline.at(11.0) is None  # skipped
     assert timeline.dead_reckoned(11.4)
-    at = timeline.at(11.4)
-    np.testing.assert_allclose(at.pose, THERE)
-    # Uncertain by the registration's sd and 5 % of the move since the last registered pose, and by the
-    # turn from that pose over the capture time's uncertainty.
-    turn_sd = 9.0 / (11.4 - 10.0) * 0.02
-    np.testing.assert_allclose(at.sd, [np.hypot(0.1 + 0.05 * 9.0, turn_sd), 0.1, 0.02])
-    assert timeline.settled(11.4) and timeline.ready(11.45)
+    assert timeline.at(11.4) is None and not timeline.settled(11.4)  # the picture is not used
+    np.testing.assert_allclose(timeline.current(), THERE)  # but the next move starts where this one went
+    assert timeline.ready(11.45)
+    # Its sd, the registration's and 5 % of the 9 deg pan since, is what the next picture is compared with:
+    # a pan 1.5 deg off is within 3 such sds (0.56 deg each) and at rest, 2 deg off is moving.
+    for pan_off_deg, moving in ((1.5, False), (2.0, True)):
+        timeline = _still_at(HERE, [10.0])
+        timeline.sent(10.05, THERE)
+        assert timeline.dead_reckoned(11.4)
+        assert timeline.registered(11.5, np.add(THERE, [pan_off_deg, 0.0, 0.0]), SD) == moving
 
 
 def test_a_relative_move_is_the_difference_of_the_normalised_poses_and_a_continuous_one_ends_all_axes_together():

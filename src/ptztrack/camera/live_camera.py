@@ -230,8 +230,9 @@ class LiveONVIFCamera:
         self.timeline.sent(sent_s, target)
 
     def _register(self, frame: Frame) -> None:
-        """Put the pose of ``frame`` into the timeline; where it does not register, place it by dead
-        reckoning if the timeline does so by then, and log it (at most one line a second)."""
+        """Put the pose of ``frame`` into the timeline; where it does not register, the picture is not
+        used (the timeline may dead-reckon the camera's moves from it) and a line is logged (at most one
+        a second)."""
         assert isinstance(self.timeline, RegisteredTimeline) and self.registration is not None
         pose = self.registration.pose(frame.image)
         if pose is not None:
@@ -241,7 +242,7 @@ class LiveONVIFCamera:
         placed = self.timeline.dead_reckoned(frame.time_s)
         now_s = self._clock()
         if now_s >= self._unregistered_logged_s + UNREGISTERED_LOG_S:
-            what = "placed where the camera's moves took it" if placed else "not used"
+            what = "not used; the moves go on from where the last ones took it" if placed else "not used"
             log.warning(
                 "picture %d did not register against the reference views (%d since the last such line): %s",
                 frame.number, self._unregistered, what,

@@ -2,11 +2,11 @@
 pictures (:mod:`ptztrack.geometry.registration`), each at its picture's capture time.
 
 A :class:`RegisteredTimeline` is a :class:`~ptztrack.camera.pose_timeline.PoseTimeline` whose samples
-are registered poses, each with its standard deviation ``sd`` (3,). A picture is placed only from a
-sample at most ``max_gap_s`` from its capture time (between two samples as the timeline interpolates
-them, past the last one by its move-time model), its standard deviation
-``sqrt(sd_timeline^2 + sd_registered^2)`` per axis, the registered ``sd`` interpolated like the pose;
-further from every sample it is not placed (None), and the live loop's detector skips it.
+are registered poses, each with its standard deviation ``sd`` (3,). A picture is placed only by its
+own registration, at the pose registered from it, its standard deviation
+``sqrt(sd_timeline^2 + sd_registered^2)`` per axis (``sd_timeline``, the turn over the capture time's
+uncertainty, as the timeline gives it); a picture that did not register is not placed (None), and the
+live loop's detector skips it.
 
 A sample is *moving* when its pose differs from the one before by more than ``MOVED_SDS`` times the
 two samples' combined standard deviation on any axis, when it was captured before the last move sent
@@ -15,9 +15,11 @@ where the move started (a stream later than its calibrated delay shows the camer
 moves; a move that shows nothing by ``MOVE_SEEN_S`` after its landing is not waited for longer).
 The camera stands still where it was last registered until it
 is sent elsewhere, so a picture that does not register, ``blind_s`` after the last sample and the last
-landing, is placed by dead reckoning (:meth:`RegisteredTimeline.dead_reckoned`): where the last
+landing, gives a dead-reckoned sample (:meth:`RegisteredTimeline.dead_reckoned`): where the last
 registered sample showed the camera, or where the last move sent after it took it, uncertain by the
-sample's ``sd`` and ``DEAD_RECKONING_FRACTION`` of the moves' length since.
+sample's ``sd`` and ``DEAD_RECKONING_FRACTION`` of the moves' length since. Such a sample only lets the
+next move start (:meth:`~RegisteredTimeline.current`, :meth:`~RegisteredTimeline.ready`), so a camera
+that stands where nothing registers can be sent back; no picture is placed by it.
 """
 
 from collections import deque
@@ -32,13 +34,14 @@ from ptztrack.camera.pose_timeline import KEEP_S, PoseAt, PoseTimeline
 # combined standard deviations on an axis: registration noise alone exceeds it on one of three axes once
 # in about 120 samples.
 MOVED_SDS = 3.0
-# A picture is placed from a registered sample at most this far from its capture time: two frame
-# intervals at 25 fps, a priori.
-MAX_GAP_S = 0.08
+# A sample is a picture's own when their capture times are this close: they are the same number, and
+# pictures are tens of milliseconds apart.
+SAME_PICTURE_S = 1e-6
 # A move that no registered pose has shown by this long after its landing is taken as done: a priori.
 MOVE_SEEN_S = 1.0
-# Pictures that do not register are skipped for this long after the last sample and the last landing,
-# then placed by dead reckoning: a priori, a second of a camera that may stand where nothing registers.
+# Pictures that do not register are skipped, and after this long since the last sample and the last
+# landing the moves go on by dead reckoning: a priori, a second of a camera that may stand where nothing
+# registers.
 BLIND_S = 1.0
 # A relative move lands within this fraction of its length per axis: a priori, a calibration's degrees
 # per unit of the normalised space off by 5 %.
@@ -48,22 +51,21 @@ DEAD_RECKONING_FRACTION = 0.05
 class RegisteredTimeline(PoseTimeline):
     """Registered poses and the moves sent, shared between threads (module docstring).
 
-    move_times, capture_time_sd_s : as :class:`PoseTimeline` takes them; max_gap_s : how far from a
-    registered sample a picture may be placed; blind_s : how long pictures that do not register are
-    skipped before they are placed by dead reckoning. ``asked`` is called whenever a thread waits for
-    the pose of a picture (:meth:`wait_past`), which :meth:`wanted` then gives.
+    move_times, capture_time_sd_s : as :class:`PoseTimeline` takes them; blind_s : how long after the
+    last sample pictures that do not register give dead-reckoned samples. ``asked`` is called whenever
+    a thread waits for the pose of a picture (:meth:`wait_past`), which :meth:`wanted` then gives.
     """
 
     def __init__(
         self,
         move_times: MoveTimes | None = None,
         capture_time_sd_s: float = 0.02,
-        max_gap_s: float = MAX_GAP_S,
         blind_s: float = BLIND_S,
     ):
         super().__init__(move_times, capture_time_sd_s)
-        self.max_gap_s, self.blind_s = max_gap_s, blind_s
+        self.blind_s = blind_s
         self._sds: deque[np.ndarray] = deque()  # each sample's sd (3,), in step with the samples
+        self._reckoned: deque[bool] = deque()  # whether each sample is dead-reckoned, in step with them
         self._moved_from: np.ndarray | None = None  # where the last move was sent from
         self._seen = True  # whether a sample has shown the last move
         self._wanted_s: float | None = None  # the capture time a thread waits for, not yet handed out
@@ -82,12 +84,12 @@ class RegisteredTimeline(PoseTimeline):
                 if not self._seen and self._target is not None and self._moved_from is not None:
                     self._seen = time_s >= self._target[0] and bool(np.any(np.abs(pose - self._moved_from) > limit))
                     moving = moving or (not self._seen and time_s < self._lands_s + MOVE_SEEN_S)
-            self._append(time_s, pose, moving, sd)
+            self._append(time_s, pose, moving, sd, reckoned=False)
         return moving
 
     def dead_reckoned(self, time_s: float) -> bool:
-        """Place the picture captured at ``time_s``, which did not register, by dead reckoning once
-        ``blind_s`` has passed since the last sample and the last landing; whether it was placed."""
+        """Add a dead-reckoned sample for the picture captured at ``time_s``, which did not register, once
+        ``blind_s`` has passed since the last sample and the last landing; whether it was added."""
         with self._condition:
             if not self._samples:
                 return False
@@ -98,7 +100,7 @@ class RegisteredTimeline(PoseTimeline):
             if self._target is not None and self._target[0] >= last_s and self._moved_from is not None:
                 sd = sd + DEAD_RECKONING_FRACTION * np.abs(self._target[1] - self._moved_from)
                 pose = self._target[1]
-            self._append(time_s, pose, False, sd)
+            self._append(time_s, pose, False, sd, reckoned=True)
         return True
 
     def wait_past(self, time_s: float, timeout_s: float) -> bool:
@@ -157,17 +159,18 @@ class RegisteredTimeline(PoseTimeline):
             self._seen = here is None or not np.any(np.abs(target - here) > noise)
 
     def at(self, time_s: float) -> PoseAt | None:
-        """The pose at ``time_s`` from a sample at most ``max_gap_s`` away; None where there is none."""
+        """The pose of the picture captured at ``time_s`` from its own registration; None where it did
+        not register."""
         with self._condition:
-            times = np.array([sample[0] for sample in self._samples])
-            sds = np.array(self._sds).reshape(-1, 3)
-        if not len(times) or np.min(np.abs(times - time_s)) > self.max_gap_s:
-            return None
-        placed = super().at(time_s)
+            own = [
+                sd
+                for (sample_s, _, _), sd, reckoned in zip(self._samples, self._sds, self._reckoned, strict=True)
+                if abs(sample_s - time_s) <= SAME_PICTURE_S and not reckoned
+            ]
+        placed = super().at(time_s) if own else None
         if placed is None:
             return None
-        registered_sd = np.array([np.interp(time_s, times, sds[:, axis]) for axis in range(3)])
-        return PoseAt(placed.pose, np.sqrt(placed.sd**2 + registered_sd**2))
+        return PoseAt(placed.pose, np.sqrt(placed.sd**2 + own[-1] ** 2))
 
     def settled(self, time_s: float) -> bool:
         """Whether a picture captured at ``time_s`` shows the camera at rest where its last move took it:
@@ -181,11 +184,13 @@ class RegisteredTimeline(PoseTimeline):
         around = samples[max(after - 1, 0) : after + 1]  # the sample at or before, and the one after
         return time_s >= lands_s and not any(moving for _, _, moving in around)
 
-    def _append(self, time_s: float, pose: np.ndarray, moving: bool, sd: np.ndarray) -> None:
+    def _append(self, time_s: float, pose: np.ndarray, moving: bool, sd: np.ndarray, reckoned: bool) -> None:
         """Add a sample (the condition held), dropping those older than KEEP_S, and wake the waiting."""
         self._samples.append((time_s, pose, moving))
         self._sds.append(sd)
+        self._reckoned.append(reckoned)
         while self._samples[0][0] < time_s - KEEP_S:
             self._samples.popleft()
             self._sds.popleft()
+            self._reckoned.popleft()
         self._condition.notify_all()
