@@ -8,14 +8,15 @@ picture is taken once the camera stands still (GetStatus's MoveStatus, then a pi
 widest zoom, set where the ground points were picked (:func:`take_ground_snapshot`); the measurement
 starts there and ends there:
 
-1. turns of a few tenths of the view, both ways in pan and in tilt and along the diagonals, each
-   pictured and matched to the ground view (their size from a small probe turn first): the widest focal
-   length and each axis' degrees per unit of the normalised translation space;
+1. a 5 x 5 grid of turns of up to a few tenths of the view, in pan, in tilt and both together, each
+   pictured (their size from a small probe turn first) and every pair matched: the widest focal length
+   and each axis' degrees per unit of the normalised translation space;
 2. the zoom from the widest view to the narrowest in steps that each magnify by about
    ``TARGET_ZOOM_RATIO``, each picture matched to the one and the two before: the focal length at every
-   step.
+   step. It runs at the view of the grid with the most features in its middle, which the zoom keeps.
 """
 
+import itertools
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -25,7 +26,9 @@ import numpy as np
 from ptztrack.camera.onvif_client import CameraError, ONVIFClient
 from ptztrack.camera.stream import LatestFrame
 from ptztrack.geometry.self_calibration import (
+    ECC_RATIO_SD,
     HeadFit,
+    ecc_zoom_ratio,
     fit_head,
     focals_from_ratios,
     matched_points,
@@ -157,11 +160,12 @@ def _zoom_ladder(
 ) -> tuple[np.ndarray, list[tuple[int, int, float, float]]]:
     """Zoom from the widest view (normalised 0) to normalised 1 in steps sized so that each magnifies by
     about ``TARGET_ZOOM_RATIO`` (the first ``first_step``; a step that does not register is halved, down to
-    ``MIN_ZOOM_STEP``), each picture matched to the one and the two before. The steps' normalised zooms
-    (K + 1,) and the scales (i, j, s_ij, sd_ij) between them."""
-    features, zooms = [view_features(widest)], [0.0]
+    ``MIN_ZOOM_STEP``), each picture matched to the one and the two before (SIFT), or where SIFT cannot
+    match it to the one before, registered to that one by its intensities (:func:`ecc_zoom_ratio`). The
+    steps' normalised zooms (K + 1,) and the scales (i, j, s_ij, sd_ij) between them."""
+    features, zooms, previous = [view_features(widest)], [0.0], widest
     ratios: list[tuple[int, int, float, float]] = []
-    step_size = first_step
+    step_size, rate = first_step, np.log(TARGET_ZOOM_RATIO) / first_step  # log scale per normalised unit
     while zooms[-1] < 1.0 - 1e-9:
         # The last step takes the rest of the range when less than half a step would be left after it: a
         # sliver of a step magnifies too little to measure.
@@ -177,6 +181,10 @@ def _zoom_ladder(
             if len(points_a):
                 found.append((before, step, *zoom_ratio(points_a, points_b, widest.shape[1::-1])))
         if not found or found[0][0] != step - 1 or found[0][2] <= 1.0:
+            # Too few features to match (a long zoom's blur, the stream's compression): the intensities.
+            scale = ecc_zoom_ratio(previous, picture, float(np.exp(rate * step_size)))
+            found = [] if scale is None or scale <= 1.0 else [(step - 1, step, scale, ECC_RATIO_SD * scale)]
+        if not found:
             if step_size / 2 < MIN_ZOOM_STEP:
                 raise GeometryError(f"{where} did not register against the step before: too few features match")
             report(f"{where} did not register against the step before: half the step")
@@ -188,8 +196,16 @@ def _zoom_ladder(
         features.append(picture_features)
         zooms.append(zooms[-1] + step_size)
         ratios.extend(found)
+        previous, rate = picture, np.log(ratio) / step_size
         step_size *= np.log(TARGET_ZOOM_RATIO) / np.log(ratio)
     return np.array(zooms), ratios
+
+
+def _middle_features(keypoints_px: list[np.ndarray], size_px: tuple[int, int]) -> np.ndarray:
+    """How many of each view's keypoints (K, 2) px lie in the middle of the picture, the quarter of its
+    width and height around the centre, where a zoom of 4 looks: (views,) counts."""
+    centre, half = np.array(size_px) / 2.0, np.array(size_px) / 8.0
+    return np.array([np.sum(np.all(np.abs(points - centre) <= half, axis=1)) for points in keypoints_px])
 
 
 def measure_geometry(
@@ -224,27 +240,34 @@ def measure_geometry(
     )
     # A pan (depression) that grows moves the picture's content left (up): f dtheta = -shift, f ~ the width.
     initial_deg_per_unit = np.rad2deg(-shifts_px / size_px[0]) / PROBE_TURN
-    # Each axis both ways, then the four diagonals: a pan's axis, vertical, is tilted in a tilted view, so
-    # the diagonals turn the picture as well as shift it, which pins the focal length further.
-    signs = [(1, 0), (-1, 0), (0, 1), (0, -1), (1, 1), (-1, -1), (1, -1), (-1, 1)]
+    # A 5 x 5 grid of turns, half and whole turns each way on each axis and together: a pan's axis,
+    # vertical, is tilted in a tilted view, so the diagonals turn the picture as well as shift it, and
+    # every view is another sampling of the scene, whose texture sets how well the focal length is pinned.
+    fractions = (-1.0, -0.5, 0.0, 0.5, 1.0)
     steps = [np.zeros(2)]
     features = [ground_features]
-    for pan_sign, tilt_sign in signs:
-        translation = np.array([pan_sign * turn[0], tilt_sign * turn[1], 0.0])
+    for pan_fraction, tilt_fraction in itertools.product(fractions, fractions):
+        if pan_fraction == tilt_fraction == 0.0:
+            continue
+        translation = np.array([pan_fraction * turn[0], tilt_fraction * turn[1], 0.0])
         steps.append(translation[:2])
         features.append(view_features(_turn(client, latest, image_delay_s, translation)))
     # Every pair of views that registers, the turned ones with each other too: more pairs, and wider ones.
     matches, registered = [], set()
+    still: list[list[np.ndarray]] = [[] for _ in steps]  # each view's matched keypoints
     for first in range(len(features)):
         for second in range(first + 1, len(features)):
             points_a, points_b = matched_points(features[first], features[second])
             if len(points_a):
                 matches.append((steps[first], steps[second], points_a, points_b))
                 registered |= {first, second}
+                still[first].append(points_a)
+                still[second].append(points_b)
     for index in range(1, len(steps)):
-        step = steps[index]
-        state = "registered" if index in registered else "did not register with any view, left out"
-        report(f"turn of {step[0]:+.3f} pan, {step[1]:+.3f} tilt: {state}")
+        if index not in registered:
+            pan, tilt = steps[index]
+            report(f"turn of {pan:+.3f} pan, {tilt:+.3f} tilt: did not register with any view, left out")
+    report(f"{len(registered - {0})} of {len(steps) - 1} turns registered, {len(matches)} pairs of views")
     for axis, name in enumerate(("pan", "tilt")):
         if not any(steps[index][axis] != 0 for index in registered):
             raise GeometryError(f"no turn with a {name} registered against the other views")
@@ -254,7 +277,18 @@ def measure_geometry(
         f"and tilt {head.tilt_deg_per_unit:+.3f} deg per normalised unit (rms {head.rms_px:.2f} px over "
         f"{head.pairs} of {len(matches)} pairs of views)"
     )
-    zoom_normalised, ratios = _zoom_ladder(client, latest, image_delay_s, ground, 1.0 / zoom_steps, report)
+    # The zoom magnifies the view's middle, so it runs where the middle shows the most still texture (the
+    # features matched between views taken seconds apart): a long zoom into plain ground (or a wall)
+    # leaves too few features to match, and one into a passer-by changes from picture to picture.
+    views = sorted(registered)
+    middles = _middle_features([np.unique(np.concatenate(still[index]), axis=0) for index in views], size_px)
+    ladder = views[int(np.argmax(middles))]
+    report(
+        f"zoom steps at the turn of {steps[ladder][0]:+.3f} pan, {steps[ladder][1]:+.3f} tilt: "
+        f"{middles.max()} still features in the middle of its view"
+    )
+    widest = settled_picture(client, latest, image_delay_s, (*steps[ladder], 0.0))
+    zoom_normalised, ratios = _zoom_ladder(client, latest, image_delay_s, widest, 1.0 / zoom_steps, report)
     client.goto_preset(token)
     focal_px, focal_sd_px = focals_from_ratios(head.focal_px, head.focal_sd_px, len(zoom_normalised) - 1, ratios)
     return GeometryMeasurement(

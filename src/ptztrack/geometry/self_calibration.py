@@ -50,6 +50,10 @@ OUTLYING_PAIR_PX = 2.0
 # Ground points whose spread across their second direction is below this fraction of the first lie on
 # one line: the ground's pose is then not pinned.
 COLLINEAR_RATIO = 0.05
+# ECC's zoom scale: at most this many iterations; kept where the warped views correlate at least this
+# well (a uniform picture does not correlate at all); its standard deviation, a fraction of the scale:
+# about ECC's largest error between views of a still recording at long zooms (docs: decisions).
+ECC_ITERATIONS, ECC_MIN_CORRELATION, ECC_RATIO_SD = 200, 0.9, 0.003
 
 
 @dataclass(frozen=True)
@@ -192,6 +196,27 @@ def zoom_ratio(points_a: np.ndarray, points_b: np.ndarray, image_size_px: tuple[
     sigma2 = float(fitted @ fitted / max(len(fitted) - 3, 1))
     covariance = sigma2 * np.linalg.inv(design.T @ design)
     return float(solution[0]), float(np.sqrt(covariance[0, 0]))
+
+
+def ecc_zoom_ratio(image_a: np.ndarray, image_b: np.ndarray, predicted: float) -> float | None:
+    """The zoom's scale ``s = f_b / f_a`` between two views (h, w, 3) at one pan and tilt from their
+    intensities (``cv2.findTransformECC``, an affine warp from ``b``'s pixels to ``a``'s started at the
+    homology ``p_a - c = (p_b - c) / predicted``): ``1 / sqrt(|det A|)`` of the warp's linear part; None
+    where ECC does not converge or its correlation is below ``ECC_MIN_CORRELATION``. For views whose
+    features SIFT cannot match (a long zoom's blur, a stream's compression)."""
+    gray_a, gray_b = (cv2.cvtColor(image, cv2.COLOR_BGR2GRAY).astype(np.float32) for image in (image_a, image_b))
+    centre = np.array(gray_a.shape[::-1], dtype=float) / 2.0 - 0.5  # OpenCV's pixel centres are integers
+    inverse = 1.0 / predicted
+    warp = np.array([[inverse, 0.0, 0.0], [0.0, inverse, 0.0]], dtype=np.float32)
+    warp[:, 2] = centre * (1.0 - inverse)
+    criteria = (cv2.TERM_CRITERIA_EPS | cv2.TERM_CRITERIA_COUNT, ECC_ITERATIONS, 1e-7)
+    try:
+        correlation, warp = cv2.findTransformECC(gray_b, gray_a, warp, cv2.MOTION_AFFINE, criteria, None, 5)
+    except cv2.error:
+        return None
+    if not correlation >= ECC_MIN_CORRELATION:
+        return None
+    return float(1.0 / np.sqrt(abs(np.linalg.det(warp[:, :2]))))
 
 
 def focals_from_ratios(
