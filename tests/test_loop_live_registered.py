@@ -152,7 +152,8 @@ class _BlankingFeed(RecordingFeed):
 def test_a_live_run_is_placed_by_its_pictures_moved_by_relative_moves_and_skips_a_blank_picture(caplog):
     """A live smpl run with --pose registered: most pictures used are placed within half a degree and 2 %
     of zoom of where the camera stood, the camera is moved by RelativeMoves only (no AbsoluteMove, no
-    GetStatus), and half a second of uniform pictures is not used, with a log line for it."""
+    GetStatus), and half a second of uniform pictures costs steps (decided on the prediction, no picture
+    placed or detected in), with a log line for it."""
     scenario = _narrow_scenario()
     feed = _BlankingFeed(episode_world(scenario, 0), 1.0 / scenario.frame_rate_hz, HALF_PACE)
     served = _started(scenario, feed)
@@ -175,7 +176,9 @@ def test_a_live_run_is_placed_by_its_pictures_moved_by_relative_moves_and_skips_
     finally:
         served.camera.stop()
     assert len(live.capture_time_s) == 40 and blanked
-    truths = [served.true_pose(time_s) for time_s in live.capture_time_s]
+    placed = np.all(np.isfinite(live.poses), axis=1)
+    times_s = live.capture_time_s
+    truths = [served.true_pose(time_s) if here else None for time_s, here in zip(times_s, placed, strict=True)]
     at_rest = np.array([truth is not None for truth in truths])
     errors = np.array(
         [_off(pose[None], truth[None])[0] for pose, truth in zip(live.poses, truths, strict=True) if truth is not None]
@@ -183,8 +186,11 @@ def test_a_live_run_is_placed_by_its_pictures_moved_by_relative_moves_and_skips_
     assert at_rest.sum() >= 20 and np.mean(errors <= 1.0) >= 0.9, errors
     assert served.operations.get("RelativeMove", 0) > 0
     assert "AbsoluteMove" not in served.operations and "GetStatus" not in served.operations
-    used = [cv2.imdecode(np.frombuffer(jpeg, np.uint8), cv2.IMREAD_GRAYSCALE) for jpeg in live.images]
-    assert not any(image.std() < 2.0 for image in used), "a uniform picture was used"
+    pictures = [cv2.imdecode(np.frombuffer(jpeg, np.uint8), cv2.IMREAD_GRAYSCALE) for jpeg in live.images]
+    uniform = np.array([picture.std() < 2.0 for picture in pictures])
+    # A uniform picture costs its step (a decision on the prediction), and is never placed or detected in.
+    assert uniform.any() and not np.any(uniform & placed), "a uniform picture was used"
+    assert all(live.detections[step] is None for step in np.flatnonzero(uniform))
     lines = [record for record in caplog.records if "did not register" in record.getMessage()]
     # The blank pictures' line, or the line less than a second before them that held it back (a line a
     # second at most).

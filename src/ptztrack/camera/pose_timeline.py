@@ -92,6 +92,12 @@ class PoseTimeline:
             last_s, _, moving = self._samples[-1]
             return moving or (self._target is not None and self._target[0] >= last_s)
 
+    def begun(self, time_s: float) -> bool:
+        """Whether a sample was taken by ``time_s``: a picture captured then that :meth:`at` does not place
+        is one that cannot be placed, not one taken before the pose was known."""
+        with self._condition:
+            return bool(self._samples) and self._samples[0][0] <= time_s
+
     def at(self, time_s: float) -> PoseAt | None:
         """The pose at ``time_s``; None before the first sample."""
         with self._condition:

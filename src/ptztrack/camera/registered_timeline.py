@@ -174,12 +174,14 @@ class RegisteredTimeline(PoseTimeline):
 
     def settled(self, time_s: float) -> bool:
         """Whether a picture captured at ``time_s`` shows the camera at rest where its last move took it:
-        placed, the samples either side of it not moving, and no sooner than that move could land."""
-        if self.at(time_s) is None:
-            return False
+        it has a sample of its own (registered, or dead-reckoned: the camera stands where its moves took
+        it, and the next may start), the samples either side of it are not moving, and it was captured
+        no sooner than that move could land."""
         with self._condition:
             samples, lands_s = list(self._samples), self._lands_s
         times = np.array([sample[0] for sample in samples])
+        if not np.any(np.abs(times - time_s) <= SAME_PICTURE_S):
+            return False
         after = int(np.searchsorted(times, time_s, side="right"))
         around = samples[max(after - 1, 0) : after + 1]  # the sample at or before, and the one after
         return time_s >= lands_s and not any(moving for _, _, moving in around)

@@ -11,11 +11,14 @@ with four stages in their own threads:
   sent as soon as they are made;
 * the detector, on the newest picture not yet seen, at the pose of its
   capture time, busy at most half the time (it waits as long as its last
-  detection took before it takes the next picture);
+  detection took before it takes the next picture); a picture the pose
+  source cannot place (one that did not register) is passed on without
+  detections;
 * the tracker and the policy (the calling thread): every detected picture
   updates the tracker, predicted to its capture time (the scenario's time:
   wall time times ``time_scale``) with the pose's uncertainty in the
-  measurement noise; once no newer picture waits, the policy decides on the
+  measurement noise (a picture without a pose only predicts: it costs its
+  step); once no newer picture waits, the policy decides on the
   tracks as the newest picture left them, and the camera is sent there.
   While the camera still moves to its last target it is given that target
   only (the paper's camera is sent no new decision while it moves).
@@ -272,18 +275,21 @@ def run_live_network(
             # Pictures of different cameras may come out of their capture order: the belief never goes back.
             dt_s = None if last_time_s is None else max(frame.time_s - last_time_s, 0.0) * time_scale
             last_time_s = frame.time_s if last_time_s is None else max(last_time_s, frame.time_s)
-            tracker.predict(dt_s)
-            view = _CapturedView(frame.image)
-            image = partial(view.image, used, at.pose)
-            update, measured = track(tracker.updater(index), detections, at.pose, image, at.sd)
+            planned = tracker.predict(dt_s)
+            measured, pose, pose_sd = None, np.full(3, np.nan), np.full(3, np.nan)
+            if at is not None:  # else the picture costs its step: the decision is made on the prediction
+                pose, pose_sd = at.pose, at.sd
+                image = partial(_CapturedView(frame.image).image, used, pose)
+                update, measured = track(tracker.updater(index), detections, pose, image, pose_sd)
+                planned = update.tracks
             settled[index] = cameras[index].timeline.settled(frame.time_s)
             row = {
                 "capture_time_s": frame.time_s,
                 "picked_s": picked_s,
                 "detected_s": detected_s,
                 "tracked_s": time.time(),
-                "poses": at.pose,
-                "pose_sd": at.sd,
+                "poses": pose,
+                "pose_sd": pose_sd,
                 "decided_s": np.nan,
                 "decision_s": np.nan,
                 "sent": False,
@@ -295,7 +301,6 @@ def run_live_network(
                 decided_s = time.time()
                 since_s = None if last_decided_s is None else (decided_s - last_decided_s) * time_scale
                 last_decided_s = decided_s
-                planned = update.tracks
                 if plan_ahead is not None:
                     planned = plan_ahead(planned, max(decided_s - frame.time_s, 0.0) * time_scale)
                 contexts = [
@@ -368,10 +373,12 @@ def _detect_pictures(index: int, world: World, camera: LiveCamera, seeds, detect
             number, picked_s = frame.number, time.time()
             camera.timeline.wait_past(frame.time_s, POSE_WAIT_S)
             at = camera.timeline.at(frame.time_s)
-            if at is None:  # no pose known yet: a picture nobody can place
+            if at is None and not camera.timeline.begun(frame.time_s):  # taken before any pose was known
                 continue
-            rng = np.random.default_rng(seeds.spawn(1)[0])
-            detections = world.detector.detect(_CapturedView(frame.image), number, at.pose, rng)
+            detections = None
+            if at is not None:  # else a picture that cannot be placed (it did not register): no detections
+                rng = np.random.default_rng(seeds.spawn(1)[0])
+                detections = world.detector.detect(_CapturedView(frame.image), number, at.pose, rng)
             detected_s = time.time()
             while not stopping.is_set():
                 try:
