@@ -23,7 +23,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ptztrack.camera.move_timing import fitted_move_time
 from ptztrack.camera.onvif_client import CameraError, ONVIFClient
+from ptztrack.camera.onvif_spaces import MoveTimes
 from ptztrack.camera.stream import LatestFrame
 from ptztrack.geometry.self_calibration import (
     ECC_RATIO_SD,
@@ -66,7 +68,8 @@ class GeometryMeasurement:
     ground_image : (h, w, 3) the ground view at the widest zoom; ground_position : (3,) its normalised
     position (NaN where the camera reports none); head : the widest focal length and the pan's and
     tilt's degrees per normalised unit, from the turns; zoom_normalised : (K,) the zoom steps from 0 to
-    1; focal_px, focal_sd_px : (K,) the focal length at each and its standard deviation.
+    1; focal_px, focal_sd_px : (K,) the focal length at each and its standard deviation; move_times :
+    the moves' times, from the calibration's own moves (:func:`timed_moves`).
     """
 
     ground_image: np.ndarray
@@ -75,17 +78,27 @@ class GeometryMeasurement:
     zoom_normalised: np.ndarray
     focal_px: np.ndarray
     focal_sd_px: np.ndarray
+    move_times: MoveTimes
 
     @property
     def image_size_px(self) -> tuple[int, int]:
         return self.ground_image.shape[1], self.ground_image.shape[0]
 
 
-def moved(client: ONVIFClient, translation) -> None:
+TimedMoves = list[tuple[np.ndarray, float]]
+"""Moves made: each RelativeMove's translation (3,) and the seconds from its command until the camera stood
+still (at least ``MOVE_START_S``)."""
+
+
+def moved(client: ONVIFClient, translation, timed: TimedMoves | None = None) -> None:
     """RelativeMove by ``translation`` (3,) (normalised) and wait until the camera stands still: a relative
-    move counts from where the camera is when it arrives, so the next one must wait."""
+    move counts from where the camera is when it arrives, so the next one must wait. The move and its
+    time go into ``timed`` where given."""
+    started_s = time.monotonic()
     client.relative_move(translation)
     stood_still(client)
+    if timed is not None:
+        timed.append((np.asarray(translation, dtype=float), time.monotonic() - started_s))
 
 
 def stood_still(client: ONVIFClient) -> None:
@@ -95,10 +108,13 @@ def stood_still(client: ONVIFClient) -> None:
         raise CameraError(f"{client.address}: still moving after {STILL_TIMEOUT_S:g} s")
 
 
-def settled_picture(client: ONVIFClient, latest: LatestFrame, image_delay_s: float, translation) -> np.ndarray:
-    """RelativeMove by ``translation`` (3,), then the mean of the first ``AVERAGED_PICTURES`` pictures that
-    arrived ``image_delay_s`` (at least ``SETTLED_AFTER_S``) after the camera stood still."""
-    moved(client, translation)
+def settled_picture(
+    client: ONVIFClient, latest: LatestFrame, image_delay_s: float, translation, timed: TimedMoves | None = None
+) -> np.ndarray:
+    """RelativeMove by ``translation`` (3,) (timed into ``timed`` where given), then the mean of the first
+    ``AVERAGED_PICTURES`` pictures that arrived ``image_delay_s`` (at least ``SETTLED_AFTER_S``) after the
+    camera stood still."""
+    moved(client, translation, timed)
     still_s = time.time()
     deadline_s = time.monotonic() + STILL_TIMEOUT_S
     number, taken = 0, []
@@ -130,10 +146,13 @@ def take_ground_snapshot(client: ONVIFClient, latest: LatestFrame, image_delay_s
     return image
 
 
-def _turn(client: ONVIFClient, latest: LatestFrame, image_delay_s: float, translation) -> np.ndarray:
-    """Turn by ``translation`` (3,), take the picture there and turn back; the picture."""
-    image = settled_picture(client, latest, image_delay_s, translation)
-    moved(client, -np.asarray(translation, dtype=float))
+def _turn(
+    client: ONVIFClient, latest: LatestFrame, image_delay_s: float, translation, timed: TimedMoves | None = None
+) -> np.ndarray:
+    """Turn by ``translation`` (3,), take the picture there and turn back (both moves timed into ``timed``
+    where given); the picture."""
+    image = settled_picture(client, latest, image_delay_s, translation, timed)
+    moved(client, -np.asarray(translation, dtype=float), timed)
     return image
 
 
@@ -157,12 +176,14 @@ def _zoom_ladder(
     widest: np.ndarray,
     first_step: float,
     report: Callable[[str], None],
+    timed: TimedMoves,
 ) -> tuple[np.ndarray, list[tuple[int, int, float, float]]]:
     """Zoom from the widest view (normalised 0) to normalised 1 in steps sized so that each magnifies by
     about ``TARGET_ZOOM_RATIO`` (the first ``first_step``; a step that does not register is halved, down to
     ``MIN_ZOOM_STEP``), each picture matched to the one and the two before (SIFT), or where SIFT cannot
-    match it to the one before, registered to that one by its intensities (:func:`ecc_zoom_ratio`). The
-    steps' normalised zooms (K + 1,) and the scales (i, j, s_ij, sd_ij) between them."""
+    match it to the one before, registered to that one by its intensities (:func:`ecc_zoom_ratio`), every
+    move timed into ``timed``. The steps' normalised zooms (K + 1,) and the scales (i, j, s_ij, sd_ij)
+    between them."""
     features, zooms, previous = [view_features(widest)], [0.0], widest
     ratios: list[tuple[int, int, float, float]] = []
     step_size, rate = first_step, np.log(TARGET_ZOOM_RATIO) / first_step  # log scale per normalised unit
@@ -171,7 +192,7 @@ def _zoom_ladder(
         # sliver of a step magnifies too little to measure.
         remaining = 1.0 - zooms[-1]
         step_size = remaining if remaining < 1.5 * step_size else step_size
-        picture = settled_picture(client, latest, image_delay_s, (0.0, 0.0, step_size))
+        picture = settled_picture(client, latest, image_delay_s, (0.0, 0.0, step_size), timed)
         step = len(features)
         picture_features = view_features(picture)
         where = f"zoom step {step} (normalised zoom {zooms[-1] + step_size:.3f})"
@@ -189,7 +210,7 @@ def _zoom_ladder(
                 raise GeometryError(f"{where} did not register against the step before: too few features match")
             report(f"{where} did not register against the step before: half the step")
             step_size /= 2
-            moved(client, (0.0, 0.0, -step_size))
+            moved(client, (0.0, 0.0, -step_size), timed)
             continue
         ratio = found[0][2]
         report(f"{where}: x{ratio:.4f} +- {found[0][3]:.4f} on the step before")
@@ -246,12 +267,13 @@ def measure_geometry(
     fractions = (-1.0, -0.5, 0.0, 0.5, 1.0)
     steps = [np.zeros(2)]
     features = [ground_features]
+    turned: TimedMoves = []
     for pan_fraction, tilt_fraction in itertools.product(fractions, fractions):
         if pan_fraction == tilt_fraction == 0.0:
             continue
         translation = np.array([pan_fraction * turn[0], tilt_fraction * turn[1], 0.0])
         steps.append(translation[:2])
-        features.append(view_features(_turn(client, latest, image_delay_s, translation)))
+        features.append(view_features(_turn(client, latest, image_delay_s, translation, turned)))
     # Every pair of views that registers, the turned ones with each other too: more pairs, and wider ones.
     matches, registered = [], set()
     still: list[list[np.ndarray]] = [[] for _ in steps]  # each view's matched keypoints
@@ -288,9 +310,16 @@ def measure_geometry(
         f"{middles.max()} still features in the middle of its view"
     )
     widest = settled_picture(client, latest, image_delay_s, (*steps[ladder], 0.0))
-    zoom_normalised, ratios = _zoom_ladder(client, latest, image_delay_s, widest, 1.0 / zoom_steps, report)
+    zoomed: TimedMoves = []
+    zoom_normalised, ratios = _zoom_ladder(client, latest, image_delay_s, widest, 1.0 / zoom_steps, report, zoomed)
     client.goto_preset(token)
     focal_px, focal_sd_px = focals_from_ratios(head.focal_px, head.focal_sd_px, len(zoom_normalised) - 1, ratios)
+    move_times = timed_moves(turned, zoomed, head, zoom_normalised, focal_px / focal_px[0])
+    report(
+        f"moves: {move_times.pan[0]:.2f} s + {move_times.pan[1] * 1e3:.1f} ms/deg pan, {move_times.tilt[0]:.2f} s + "
+        f"{move_times.tilt[1] * 1e3:.1f} ms/deg tilt, {move_times.zoom[0]:.2f} s + {move_times.zoom[1]:.3f} s per "
+        "unit of zoom"
+    )
     return GeometryMeasurement(
         ground_image=ground,
         ground_position=np.asarray(ground_position, dtype=float),
@@ -298,4 +327,19 @@ def measure_geometry(
         zoom_normalised=zoom_normalised,
         focal_px=focal_px,
         focal_sd_px=focal_sd_px,
+        move_times=move_times,
     )
+
+
+def timed_moves(turned: TimedMoves, zoomed: TimedMoves, head: HeadFit, zoom_normalised, zoom_factors) -> MoveTimes:
+    """The camera's move times (:class:`MoveTimes`, Frigate's line per axis) from the calibration's own
+    moves: the turns on one axis alone at the head's degrees per unit, and the zoom ladder's moves (all
+    relative, from normalised zoom 0) at the zoom factors (K,) of its steps' normalised zooms (K,)."""
+    fits = []
+    for axis, per_unit in ((0, head.pan_deg_per_unit), (1, head.tilt_deg_per_unit)):
+        alone = [(abs(move[axis]) * abs(per_unit), s) for move, s in turned if move[axis] != 0 and move[1 - axis] == 0]
+        fits.append(fitted_move_time(*zip(*alone, strict=True)))
+    ends = np.cumsum([0.0] + [move[2] for move, _ in zoomed])
+    factors = np.interp(ends, zoom_normalised, zoom_factors)
+    fits.append(fitted_move_time(np.abs(np.diff(factors)), [s for _, s in zoomed]))
+    return MoveTimes(*fits)

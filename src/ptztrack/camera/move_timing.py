@@ -40,10 +40,16 @@ def measure_move_times(client: ONVIFClient, spaces: CameraSpaces) -> tuple[MoveT
                 start = spaces.pose(client.status().position)
                 seconds.append(timed_move(client, spaces.normalised(there)))
                 distances.append(abs(there[axis] - start[axis]))
-        slope, intercept = np.polyfit(distances, seconds, 1)
-        fits.append((max(float(intercept), 0.0), max(float(slope), 0.0)))
+        fits.append(fitted_move_time(distances, seconds))
         samples[name] = (np.asarray(distances), np.asarray(seconds))
     return MoveTimes(*fits), samples
+
+
+def fitted_move_time(distances, seconds) -> tuple[float, float]:
+    """(intercept_s, slope) of ``seconds = intercept + slope x distance`` by least squares over timed moves
+    (M,) and (M,), neither below 0."""
+    slope, intercept = np.polyfit(np.asarray(distances, dtype=float), np.asarray(seconds, dtype=float), 1)
+    return max(float(intercept), 0.0), max(float(slope), 0.0)
 
 
 # The pictures' sideways shift is measured on grey copies this wide (px), by phase correlation with the

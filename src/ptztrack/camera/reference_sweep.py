@@ -280,11 +280,14 @@ def sweep_index(
         images.append(settled_picture(latest, landed_s, landed_s + SETTLE_TIMEOUT_S, thumbnail(images[-1])).image)
         here = pose
     # Back to the known view: the loop starts where the ground is seen, not at the sweep's last corner,
-    # which may look beyond anything that registers.
-    sent_s = time.time()
-    stop_at(client, mover.move(client, here, known.pose))
-    landed_s = sent_s + float(move_times.seconds(here, known.pose))
-    settled_picture(latest, landed_s, landed_s + SETTLE_TIMEOUT_S, thumbnail(images[-1]))
+    # which may look beyond anything that registers. By its preset or position, not by a relative move: a
+    # relative move sent before the last one ended counts from where the head was, and the sweep's slips
+    # add up.
+    if known.preset is not None:
+        client.goto_preset(known.preset)
+    else:
+        client.move_to(known.position)
+    arrived(anywhere_s)
     log.warning("registered pose: %d views swept in %.1f s", len(images), time.time() - phase_s)
     phase_s = time.time()
     poses = np.vstack([known.pose, planned])

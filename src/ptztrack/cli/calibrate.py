@@ -25,6 +25,7 @@ from ptztrack.camera.stream import FrameStream, LatestFrame, rtsp_pictures
 from ptztrack.config import (
     CameraCalibrationFile,
     GroundViewSection,
+    MoveTimesSection,
     ScenarioError,
     load_camera_calibration,
     write_camera_calibration,
@@ -113,7 +114,8 @@ def calibration_of(
     """The calibration file of a measured geometry: the spaces' degrees at normalised -1 and +1 through the
     ground view's pose (from its reported position, or from the preset, which then stands at 0), the zoom
     curve as zoom factors of the widest focal length with their standard deviations, the position on the
-    ground and the ground view; move times and the stream's delay kept from ``existing``."""
+    ground and the ground view; the stream's delay kept from ``existing``, and its move times where it has
+    measured ones (else the geometry's own moves' times)."""
     # The points refine the widest focal length; the turns' angles trade against it (a shift is f theta).
     refined = ground.focal_px / measured.head.focal_px
     pan_per_unit, tilt_per_unit = measured.head.pan_deg_per_unit / refined, measured.head.tilt_deg_per_unit / refined
@@ -145,6 +147,15 @@ def calibration_of(
         ),
     }
     kept = {} if existing is None else existing.model_dump(include={"move_times", "image_delay_s", "capture_time_sd_s"})
+    # Times that `camera calibrate` measured (AbsoluteMove and GetStatus) are kept; a camera that has not
+    # been timed so gets the times of the geometry's own relative moves.
+    if existing is None or existing.move_times == MoveTimesSection():
+        times = measured.move_times
+        fields["move_times"] = {
+            "pan": tuple(round(value, 6) for value in times.pan),
+            "tilt": tuple(round(value, 6) for value in times.tilt),
+            "zoom": tuple(round(value, 6) for value in times.zoom),
+        }
     return CameraCalibrationFile.model_validate({**kept, **fields})
 
 
