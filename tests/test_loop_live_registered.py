@@ -12,13 +12,14 @@ import numpy as np
 import pytest
 
 from ptztrack.builders.episode import episode_world
-from ptztrack.builders.live import live_world, run_live_episode
+from ptztrack.builders.live import live_as_episode, live_world, run_live_episode
 from ptztrack.builders.live_registered import registered_camera
 from ptztrack.builders.recording import pets_scenario
 from ptztrack.builders.virtual_camera import RecordingFeed, virtual_calibration, virtual_onvif_camera
 from ptztrack.camera.onvif_client import CameraAddress, ONVIFClient, PTZMoves
 from ptztrack.cli import main
 from ptztrack.config import CameraCalibrationFile, write_camera_calibration
+from ptztrack.evaluate.metrics import episode_metrics
 
 pytest.importorskip("ipycam", reason="the virtual ONVIF camera needs ipycam (pip install --no-deps ipycam==1.3.0)")
 pytestmark = pytest.mark.onvif
@@ -190,7 +191,10 @@ def test_a_live_run_is_placed_by_its_pictures_moved_by_relative_moves_and_skips_
     uniform = np.array([picture.std() < 2.0 for picture in pictures])
     # A uniform picture costs its step (a decision on the prediction), and is never placed or detected in.
     assert uniform.any() and not np.any(uniform & placed), "a uniform picture was used"
-    assert all(live.detections[step] is None for step in np.flatnonzero(uniform))
+    assert all(len(live.detections[step]) == 0 for step in np.flatnonzero(uniform))
+    # Such steps are scored as the others: the camera's commanded pose stands in for the unknown one.
+    looked = episode_metrics(live_as_episode(world, live))
+    assert looked["detections"] == sum(len(found) for found in live.detections)
     lines = [record for record in caplog.records if "did not register" in record.getMessage()]
     # The blank pictures' line, or the line less than a second before them that held it back (a line a
     # second at most).

@@ -294,7 +294,7 @@ def run_live_network(
                 "decision_s": np.nan,
                 "sent": False,
                 "tracks": tracker.reported(),
-                "detections": measured,
+                "detections": Detections.empty() if measured is None else measured,
                 "images": _jpeg(frame.image) if keep_images else b"",
             }
             if detected.empty():  # decide on the newest picture only
