@@ -22,11 +22,18 @@ over ``--offline-seeds`` seeds (its policy samples), for the spread of the figur
 held against.
 
     python benchmarks/live_loop.py [--steps 700] [--time-scale 1] [--policy smpl] [--transport tcp]
-                                   [--offline-seeds 5] [--json PATH]
+                                   [--offline-seeds 5] [--busy-cores N] [--json PATH]
+
+``--busy-cores N`` starts N processes that spin on this machine's cores for the live run (a camera's
+small computer running other work); the JSON then holds the run's keys under ``busy``. The machine (its
+CPU model and cores) and the virtual camera's own CPU use (its share of one core: a real camera does not
+share the loop's cores) are reported beside the figures.
 """
 
 import argparse
+import contextlib
 import multiprocessing
+import os
 import time
 from functools import partial
 from pathlib import Path
@@ -90,14 +97,31 @@ def replay(scenario, calibration, steps, poses, times_s) -> dict:
 
 def serve(time_scale: float, ready, stop, results) -> None:
     """The virtual camera in a process of its own (as a camera is a machine of its own): its ONVIF port
-    into ``ready``, then, once ``stop`` is set, its truth log and thumbnails into ``results``."""
+    into ``ready``, then, once ``stop`` is set, its truth log, thumbnails and the CPU seconds it used (its
+    rendering and encoding, which a real camera does on its own processor) into ``results``."""
     scenario = pets_scenario("hog")
     feed = RecordingFeed(episode_world(scenario, 0), 1.0 / scenario.frame_rate_hz, time_scale, thumbnails=[])
     camera, _ = virtual_onvif_camera(scenario, time_scale, 0, "bench", "bench-pass", feed=feed)
     with camera:
         ready.put(camera.onvif_port)
+        started_cpu_s = time.process_time()
         stop.wait()
-    results.put((feed.rows(), np.asarray(feed.thumbnails)))
+        cpu_s = time.process_time() - started_cpu_s
+    results.put((feed.rows(), np.asarray(feed.thumbnails), cpu_s))
+
+
+def spin(stop) -> None:
+    """Keep a core busy until ``stop`` is set: other work on the machine the loop runs on."""
+    while not stop.is_set():
+        sum(range(100_000))
+
+
+def machine() -> dict:
+    """The machine's CPU model (``lscpu``'s model name, from /proc/cpuinfo) and how many cores it has."""
+    model = "unknown"
+    with contextlib.suppress(OSError), open("/proc/cpuinfo") as cpuinfo:
+        model = next((line.split(":", 1)[1].strip() for line in cpuinfo if line.startswith("model name")), model)
+    return {"cpu_model": model, "cores": os.cpu_count()}
 
 
 def calibrated(address: CameraAddress):
@@ -126,8 +150,11 @@ def main() -> None:
     parser.add_argument("--policy", default="smpl")
     parser.add_argument("--transport", choices=("tcp", "udp"), default="tcp")
     parser.add_argument("--offline-seeds", type=int, default=5, help="seeds of the offline run (0 is the one compared)")
+    parser.add_argument("--busy-cores", type=int, default=0, help="processes spinning on this machine during the run")
     parser.add_argument("--json", type=Path)
     args = parser.parse_args()
+    if args.busy_cores < 0:
+        parser.error(f"--busy-cores {args.busy_cores}: expected a whole number >= 0")
     scenario = pets_scenario("hog")
     decisions: list[tuple[float, int, int]] = []
 
@@ -140,9 +167,13 @@ def main() -> None:
     ready, stop, results = processes.Queue(), processes.Event(), processes.Queue()
     server = processes.Process(target=serve, args=(args.time_scale, ready, stop, results), daemon=True)
     server.start()
+    busy_stop = processes.Event()
+    busy = [processes.Process(target=spin, args=(busy_stop,), daemon=True) for _ in range(args.busy_cores)]
     try:
         address = CameraAddress("127.0.0.1", ready.get(timeout=120), "bench", "bench-pass")
         calibration = calibrated(address)
+        for process in busy:
+            process.start()
         started = time.perf_counter()
         (world,), (live,) = run_live_episode(
             scenario, [calibration], [address], args.policy, args.steps, args.time_scale, 0,
@@ -150,8 +181,11 @@ def main() -> None:
         )  # fmt: skip
         wall_s = time.perf_counter() - started
     finally:
+        busy_stop.set()
         stop.set()
-    truth_log, thumbnails = results.get(timeout=60)
+    for process in busy:
+        process.join()
+    truth_log, thumbnails, camera_cpu_s = results.get(timeout=60)
     server.join()
     live_metrics = episode_metrics(live_as_episode(world, live, truth_log))
     offline = offline_counterpart(scenario, world, live, truth_log)
@@ -188,6 +222,9 @@ def main() -> None:
     with_tracks = [seconds for seconds, tracks in choices if tracks > 0]
     rates, run_s = live.rates(), live.ended_s - live.started_s
     row = {
+        **machine(),
+        "busy_cores": args.busy_cores,
+        "camera_cpu_share": camera_cpu_s / wall_s,
         "policy": args.policy,
         "time_scale": args.time_scale,
         "transport": args.transport,
@@ -241,7 +278,8 @@ def main() -> None:
     for stage, seconds in stages_s.items():
         print(f"  {stage:<36} {1e3 * seconds:7.1f}")
     if args.json is not None:
-        write_json(args.json, {**row, "mota_offline_per_seed": offline_seeds, "stages_s": stages_s})
+        document = {**row, "mota_offline_per_seed": offline_seeds, "stages_s": stages_s}
+        write_json(args.json, {"busy": document} if args.busy_cores else document)
 
 
 if __name__ == "__main__":
