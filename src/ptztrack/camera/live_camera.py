@@ -26,7 +26,8 @@ puts its pose into the timeline (a
 picture's capture time, and sends a target once the last move could have
 landed, as a move from the newest registered pose
 (:class:`~ptztrack.camera.reference_sweep.Mover`). A picture that does not
-register gives no sample, and at most one log line a second.
+register is not used, with at most one log line a second; after a second
+without a sample it gives a dead-reckoned one, from which the moves go on.
 """
 
 import logging
@@ -239,10 +240,10 @@ class LiveONVIFCamera:
             self.timeline.registered(frame.time_s, pose, registered_sd(pose))
             return
         self._unregistered += 1
-        placed = self.timeline.dead_reckoned(frame.time_s)
+        reckoned = self.timeline.dead_reckoned(frame.time_s)
         now_s = self._clock()
         if now_s >= self._unregistered_logged_s + UNREGISTERED_LOG_S:
-            what = "not used; the moves go on from where the last ones took it" if placed else "not used"
+            what = "not used; the moves go on from where the last ones took it" if reckoned else "not used"
             log.warning(
                 "picture %d did not register against the reference views (%d since the last such line): %s",
                 frame.number, self._unregistered, what,

@@ -151,11 +151,7 @@ def calibration_of(
     # been timed so gets the times of the geometry's own relative moves.
     if existing is None or existing.move_times == MoveTimesSection():
         times = measured.move_times
-        fields["move_times"] = {
-            "pan": tuple(round(value, 6) for value in times.pan),
-            "tilt": tuple(round(value, 6) for value in times.tilt),
-            "zoom": tuple(round(value, 6) for value in times.zoom),
-        }
+        fields["move_times"] = MoveTimesSection(pan=times.pan, tilt=times.tilt, zoom=times.zoom)
     return CameraCalibrationFile.model_validate({**kept, **fields})
 
 
