@@ -150,6 +150,56 @@ def test_the_policy_plans_on_the_tracks_predicted_from_the_pictures_capture_to_i
         assert next_id == 1001 + k and 0.0 <= seconds <= 0.5 * wall_s
 
 
+class Slow:
+    """A detector that finds nobody, in DETECTION_S."""
+
+    def detect(self, camera, step, pose, rng, believed_pose=None) -> Detections:
+        time.sleep(DETECTION_S)
+        return Detections.empty()
+
+
+DETECTION_S = 0.06
+
+
+def test_the_detector_rests_as_long_as_it_detected_but_takes_the_first_picture_at_rest_after_a_move(world):
+    """With a detection three pictures long, a camera at rest has its detector take about one picture in
+    four (it rests as long as it detected; the pictures of its rest are dropped, and each it takes is the
+    newest), each followed by a decision; the first picture at rest after a move is taken at once."""
+    scenario, built = world
+    slow = replace(built, detector=Slow())
+    with PictureCamera(slow) as camera:
+        policy, tracker = make_policy("random", scenario, slow), make_tracker(None, scenario, slow)
+        live = run_live(slow, policy, tracker, camera, 12, 1.0, 0)
+    assert live.detected.all() and np.all(np.isfinite(live.decided_s))
+    taken_apart_s = np.diff(live.picked_s)
+    assert np.all(taken_apart_s >= 2 * DETECTION_S - PICTURE_S) and np.median(taken_apart_s) < 2 * DETECTION_S + 0.04
+    assert live.frames_received > 2.5 * len(live.capture_time_s)
+    with PictureCamera(slow, moving=True) as camera:
+        lands = LandsAtThirdDetection(camera)
+        policy, tracker = make_policy("random", scenario, slow), make_tracker(None, scenario, slow)
+        live = run_live(replace(slow, detector=lands), policy, tracker, camera, 30, 1.0, 0)
+    # It would rest for LANDING_DETECTION_S after its third detection: the first picture at rest is taken at once.
+    first_at_rest = np.flatnonzero(live.detected & (live.capture_time_s > lands.landed_s))[0]
+    assert live.picked_s[first_at_rest] - lands.landed_s < 0.5 * LANDING_DETECTION_S
+
+
+LANDING_DETECTION_S = 0.1
+
+
+class LandsAtThirdDetection:
+    """A detector that finds nobody, in LANDING_DETECTION_S, and stops ``camera`` as its third detection ends."""
+
+    def __init__(self, camera: PictureCamera):
+        self.camera, self.detections, self.landed_s = camera, 0, np.inf
+
+    def detect(self, camera, step, pose, rng, believed_pose=None) -> Detections:
+        time.sleep(LANDING_DETECTION_S)
+        self.detections += 1
+        if self.detections == 3:
+            self.camera.moving, self.landed_s = False, time.time()
+        return Detections.empty()
+
+
 def _keep_reachable(seen: list, step, context, record) -> None:
     seen.append(context.reachable)
 

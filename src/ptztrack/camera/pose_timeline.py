@@ -73,11 +73,15 @@ class PoseTimeline:
 
     def settled(self, time_s: float) -> bool:
         """Whether a picture captured at ``time_s`` shows the camera at rest where its last move took it:
-        standing still then (no spread), and no sooner than that move could land."""
+        standing still then (no spread), the samples either side of it not moving (a camera says it moves
+        from a command on, before its pose changes), and no sooner than that move could land."""
         at = self.at(time_s)
         with self._condition:
-            lands_s = self._lands_s
-        return at is not None and not np.any(at.sd > 0) and time_s >= lands_s
+            samples, lands_s = list(self._samples), self._lands_s
+        if at is None or np.any(at.sd > 0) or time_s < lands_s:
+            return False
+        after = int(np.searchsorted([sample[0] for sample in samples], time_s, side="right"))
+        return not any(moving for _, _, moving in samples[max(after - 1, 0) : after + 1])
 
     def wait_past(self, time_s: float, timeout_s: float) -> bool:
         """Wait at most ``timeout_s`` for a sample at ``time_s`` or later; whether there is one."""

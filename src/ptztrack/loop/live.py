@@ -10,21 +10,28 @@ with four stages in their own threads:
   uncertainty (:mod:`ptztrack.camera.pose_timeline`), and its commands,
   sent as soon as they are made;
 * the detector, on the newest picture not yet seen, at the pose of its
-  capture time, busy at most half the time (it waits as long as its last
-  detection took before it takes the next picture); a picture the pose
-  source cannot place (one that did not register) is passed on without
-  detections;
-* the tracker and the policy (the calling thread): every detected picture
-  updates the tracker, predicted to its capture time (the scenario's time:
-  wall time times ``time_scale``) with the pose's uncertainty in the
-  measurement noise (a picture without a pose only predicts: it costs its
-  step); once no newer picture waits, the policy decides on the
-  tracks as the newest picture left them, and the camera is sent there.
-  While the camera still moves to its last target it is given that target
-  only (the paper's camera is sent no new decision while it moves).
+  capture time, within a budget it measures as it runs: after each
+  detection it rests as long as that detection took (busy at most half the
+  time: the rest of the machine is the stream's decoder's, the pose
+  samples' and the tracker's, whose timing places the pictures), and the
+  pictures that come meanwhile are dropped, except for the first picture
+  taken at rest where the camera was sent after a move, the one worth the
+  most, which it takes at once. A picture the pose source cannot place
+  (one that did not register) is passed on without detections;
+* the tracker and the policy (the calling thread): every picture predicts
+  the tracker to its capture time (the scenario's time: wall time times
+  ``time_scale``), and a detected one updates it, with the pose's
+  uncertainty in the measurement noise; once no newer picture waits, the
+  policy decides on the tracks as the newest picture left them, and the
+  camera is sent there. While the camera still moves to its last target,
+  and until a detected picture taken at rest there is in the belief, it is
+  given that target only (the paper's camera is sent no new decision while
+  it moves), and so it is when no picture was detected since the last
+  decision (no new evidence to choose on).
 
-So the pictures the detector takes are used, moving or not, and a decision
-follows each picture the tracker takes. Before the first picture
+So a busy machine drops pictures rather than falling behind: a decision
+follows each picture the tracker takes and is never made on a picture older
+than the newest. Before the first picture
 the stages are run once on copies (:func:`warm_up`), so that compiling and
 caching are done and the first decision is as fast as the others. Ctrl-C
 (or ``steps`` pictures used) ends the run with what was recorded.
@@ -61,7 +68,7 @@ from ptztrack.types import DecisionContext, Detections, PeopleInView, Tracks
 POSE_WAIT_S = 0.1
 IDLE_WAIT_S = 0.5
 # The detector takes the next picture no sooner than this many times its last detection's time after it took
-# the last one.
+# the last one (but the first at rest after a move).
 DETECTOR_DUTY_INVERSE = 2.0
 
 
@@ -92,7 +99,9 @@ class LiveEpisode:
     """What a live run recorded, one row per picture used (T pictures).
 
     capture_time_s : (T,) epoch seconds each picture was taken; picked_s, detected_s, tracked_s : (T,) epoch
-    seconds the detector took it, its detections were ready, and the tracker was done with it; poses :
+    seconds the detector took it, its detections were ready (when it was passed on, for a picture not
+    detected), and the tracker was done with it; detected : (T,) whether the detector ran on it (not on
+    a picture the pose source could not place); poses :
     (T, 3) the pose at its capture and pose_sd : (T, 3) its standard deviation;
     decided_s : (T,) epoch seconds of the decision that followed the picture, NaN where a newer picture
     was already waiting and none was made; decision_s : (T,) the policy's time (NaN likewise);
@@ -106,6 +115,7 @@ class LiveEpisode:
     picked_s: np.ndarray
     detected_s: np.ndarray
     tracked_s: np.ndarray
+    detected: np.ndarray
     poses: np.ndarray
     pose_sd: np.ndarray
     decided_s: np.ndarray
@@ -120,12 +130,13 @@ class LiveEpisode:
     ended_s: float
 
     def rates(self) -> dict[str, float]:
-        """Pictures used and decisions per second over the run (intervals over the time they span),
-        and each decision's age: seconds from its picture's capture to the decision."""
+        """Pictures used, pictures detected and decisions per second over the run (intervals over the time
+        they span), and each decision's age: seconds from its picture's capture to the decision."""
         decided = np.isfinite(self.decided_s)
         age_s = (self.decided_s - self.capture_time_s)[decided]
         return {
             "frames_used_per_s": _rate(self.capture_time_s),
+            "frames_detected_per_s": _rate(self.capture_time_s[self.detected]),
             "decisions_per_s": _rate(self.decided_s[decided]),
             "frames_received_per_s": self.frames_received / max(self.ended_s - self.started_s, 1e-9),
             "frame_age_s_p95": float(np.percentile(age_s, 95)) if len(age_s) else float("nan"),
@@ -257,6 +268,8 @@ def run_live_network(
     # Whether each camera's newest picture used shows it at rest where it was last sent: only then has the
     # belief seen what its last move was for, and may it choose the next.
     settled = [False for _ in cameras]
+    # Whether a picture was detected since the last decision.
+    evidence = False
     used = 0
     started_s = time.time()
     for detector in detectors:
@@ -277,17 +290,21 @@ def run_live_network(
             last_time_s = frame.time_s if last_time_s is None else max(last_time_s, frame.time_s)
             planned = tracker.predict(dt_s)
             measured, pose, pose_sd = None, np.full(3, np.nan), np.full(3, np.nan)
-            if at is not None:  # else the picture costs its step: the decision is made on the prediction
+            if at is not None:
                 pose, pose_sd = at.pose, at.sd
+            if at is not None and detections is not None:  # else the decision is made on the prediction
                 image = partial(_CapturedView(frame.image).image, used, pose)
                 update, measured = track(tracker.updater(index), detections, pose, image, pose_sd)
-                planned = update.tracks
-            settled[index] = cameras[index].timeline.settled(frame.time_s)
+                planned, evidence = update.tracks, True
+            # A picture at rest that was not detected leaves the belief as it was: it settles nothing.
+            at_rest = cameras[index].timeline.settled(frame.time_s)
+            settled[index] = at_rest and (detections is not None or settled[index])
             row = {
                 "capture_time_s": frame.time_s,
                 "picked_s": picked_s,
                 "detected_s": detected_s,
                 "tracked_s": time.time(),
+                "detected": detections is not None,
                 "poses": pose,
                 "pose_sd": pose_sd,
                 "decided_s": np.nan,
@@ -303,10 +320,15 @@ def run_live_network(
                 last_decided_s = decided_s
                 if plan_ahead is not None:
                     planned = plan_ahead(planned, max(decided_s - frame.time_s, 0.0) * time_scale)
+                # Without a picture detected since the last decision there is no new evidence to choose on:
+                # every camera keeps its target.
                 contexts = [
-                    _context(camera, grid, sent_to, used, planned, policy_rng, decided_s, since_s, at_rest)
-                    for camera, grid, sent_to, at_rest in zip(cameras, grids, commanded, settled, strict=True)
+                    _context(camera, grid, sent_to, used, planned, policy_rng, decided_s, since_s, free)
+                    for camera, grid, sent_to, free in zip(
+                        cameras, grids, commanded, np.logical_and(settled, evidence), strict=True
+                    )
                 ]
+                evidence = False
                 choices, row["decision_s"] = timed(policy.choose, contexts)
                 sent = []
                 for k, (camera, grid, choice) in enumerate(zip(cameras, grids, choices, strict=True)):
@@ -347,8 +369,9 @@ def _context(
 ) -> DecisionContext:
     """The decision context of ``camera`` at epoch ``decided_s``: where it is (the pose it was sent to,
     ``commanded`` (3,), where no pose is known yet), the nearest grid action to that, and what it may reach:
-    while it moves, and until a picture taken at rest where it went is in the belief (``settled``), only
-    the action nearest to its target (the paper's camera is sent no new decision while it moves)."""
+    while it moves, and unless a detected picture taken at rest where it went is in the belief and a
+    picture was detected since the last decision (``settled``), only the action nearest to its target (the
+    paper's camera is sent no new decision while it moves)."""
     now = camera.timeline.at(decided_s)
     here = commanded if now is None else now.pose
     if camera.timeline.moving() or not settled:
@@ -362,15 +385,19 @@ def _context(
 
 def _detect_pictures(index: int, world: World, camera: LiveCamera, seeds, detected: queue.Queue, stopping) -> None:
     """Camera ``index``'s detector stage: each newest picture not yet seen, at the pose of its capture, into
-    ``detected`` as (index, frame, pose, detections, when it was picked, when detected); an exception goes
-    there too, for the tracker's stage to raise."""
+    ``detected`` as (index, frame, pose, detections, when it was picked, when detected), detections None
+    for a picture that cannot be placed; an exception goes there too, for the tracker's stage to raise."""
     try:
         number = 0
+        rest_until_s, last_settled = -np.inf, True
         while not stopping.is_set():
             frame = camera.frames.latest.newer(number, IDLE_WAIT_S)
             if frame is None:
                 continue
             number, picked_s = frame.number, time.time()
+            # The first picture at rest where the camera went is worth the most: it is taken at once.
+            if picked_s < rest_until_s and (last_settled or not camera.timeline.settled(frame.time_s)):
+                continue  # the machine's share for detection is spent: the picture is dropped
             camera.timeline.wait_past(frame.time_s, POSE_WAIT_S)
             at = camera.timeline.at(frame.time_s)
             if at is None and not camera.timeline.begun(frame.time_s):  # taken before any pose was known
@@ -380,16 +407,24 @@ def _detect_pictures(index: int, world: World, camera: LiveCamera, seeds, detect
                 rng = np.random.default_rng(seeds.spawn(1)[0])
                 detections = world.detector.detect(_CapturedView(frame.image), number, at.pose, rng)
             detected_s = time.time()
-            while not stopping.is_set():
-                try:
-                    detected.put((index, frame, at, detections, picked_s, detected_s), timeout=IDLE_WAIT_S)
-                    break
-                except queue.Full:
-                    continue
-            # Busy at most half the time: the other half of its core is the stream's decoder's and the tracker's.
-            stopping.wait(max(0.0, picked_s + DETECTOR_DUTY_INVERSE * (detected_s - picked_s) - time.time()))
+            if not _hand_over(detected, stopping, (index, frame, at, detections, picked_s, detected_s)):
+                return
+            if detections is not None:
+                rest_until_s = picked_s + DETECTOR_DUTY_INVERSE * (detected_s - picked_s)
+                last_settled = camera.timeline.settled(frame.time_s)
     except BaseException as error:  # noqa: BLE001 - handed to the tracker's stage, which raises it
         detected.put(error)
+
+
+def _hand_over(detected: queue.Queue, stopping, item) -> bool:
+    """Put ``item`` into ``detected`` once there is room; False if the run stopped first."""
+    while not stopping.is_set():
+        try:
+            detected.put(item, timeout=IDLE_WAIT_S)
+            return True
+        except queue.Full:
+            continue
+    return False
 
 
 def _jpeg(image: np.ndarray) -> bytes:
@@ -407,6 +442,7 @@ def _episode(rows: list[dict], received: int, started_s: float, ended_s: float) 
         picked_s=column("picked_s"),
         detected_s=column("detected_s"),
         tracked_s=column("tracked_s"),
+        detected=np.array([row["detected"] for row in rows], dtype=bool),
         poses=column("poses", 3),
         pose_sd=column("pose_sd", 3),
         decided_s=column("decided_s"),
