@@ -123,7 +123,8 @@ class InformationGainPolicy:
         return RewardTerms(actions, tracks.ids, track_nats, patrol_nats)
 
     def choose(self, context: DecisionContext) -> int:
-        action = self.best_action(context)
+        # One reachable action (a live camera given its target while it moves) leaves nothing to weigh.
+        action = int(context.reachable[0]) if len(context.reachable) == 1 else self.best_action(context)
         self.advance_exploration(action, context.dt_s)
         return action
 
