@@ -4,20 +4,22 @@ run of the same recording steps, and where the two differ.
 ``ptztrack live``'s loop (:func:`ptztrack.builders.live.run_live_episode`) drives the virtual camera
 of ``ptztrack serve-camera`` (PETS S2.L1 played at ``--time-scale``, 25 fps over RTSP, moving at 90
 deg/s and 3 zoom per second), served by a process of its own on this machine's cores, with
-``--policy`` and the HOG detector, for ``--steps`` pictures. It prints the rates (decisions and
-pictures used per second, the age of the picture each decision was made on, the choices and the new
-targets sent per second), the policy's time (the first decision with tracks and the median, both
+``--policy`` and the HOG detector, for ``--steps`` pictures used. It prints the rates (decisions,
+pictures used and pictures detected per second, the age of the picture each decision was made on, the choices and the
+new targets sent per second), the policy's time (the first decision with tracks and the median, both
 among the decisions with a choice: a camera that moves, or has not yet taken a picture at rest where
 it went, is given its target alone), and the MOTA of the live run scored against the recording's
 truth beside the offline virtual-PTZ run of the same recording steps. Each picture used is then
 found among the pictures the camera rendered (by its thumbnail), which gives what the live run paid:
 the stream's true delay, the pose error at capture (the pose the tracker used against the pose
 rendered, still and moving), the recording step it took the picture for against the one shown, and
-the detections per picture against the offline run's. The gap is then taken apart by replays through
+the detections per picture against the offline run's; and the stages a decision's picture went
+through (medians), with the detection's cost by the picture's zoom. The gap is then taken apart by replays through
 a fresh tracker, each changing one thing: the live run's pictures rendered exactly (the recording's
-view at the step and pose each showed, at its render time: no stream, no pose error), then one such
-picture per recording step (the offline run's rate, at the live camera's poses). What is left
-between the last and the offline run is where the camera looked. The offline run is also repeated
+view at the step and pose each showed, at its render time: no stream, no pose error; detected where
+the live run could place them), then one detected picture per recording step (the offline run's rate, at
+the live camera's poses). What is left between the last and the offline run is where the camera
+looked. The offline run is also repeated
 over ``--offline-seeds`` seeds (its policy samples), for the spread of the figure the live run is
 held against.
 
@@ -58,6 +60,8 @@ from ptztrack.loop.steps import track
 MATCH_WINDOW_S = (1.0, 0.5)
 # Thumbnails within this mean grey level of the best match are indistinguishable from it.
 SAME_GREY = 0.5
+# The zoom bands the detection's cost is reported in.
+ZOOM_BANDS = ((1.0, 1.5), (1.5, 3.0), (3.0, np.inf))
 
 
 def identify(live, log: np.ndarray, thumbnails: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -78,10 +82,11 @@ def identify(live, log: np.ndarray, thumbnails: np.ndarray) -> tuple[np.ndarray,
     return rows, only
 
 
-def replay(scenario, calibration, steps, poses, times_s) -> dict:
+def replay(scenario, calibration, steps, poses, times_s, detected) -> dict:
     """The CLEAR figures of a fresh tracker (the live run's) fed pictures rendered exactly: for each
-    picture (T,), the recording's view at ``steps`` (T,) and ``poses`` (T, 3), detected as the live run
-    detects, predicted to ``times_s`` (T,) (wall seconds at time scale 1), scored against ``steps``."""
+    picture (T,), the recording's view at ``steps`` (T,) and ``poses`` (T, 3), predicted to ``times_s`` (T,)
+    (wall seconds at time scale 1) and, where ``detected`` (T,) (where the live run's detector ran on it),
+    detected as the live run detects; scored against ``steps``."""
     world = live_world(scenario, calibration, 0)
     view = world.backend
     tracker = make_tracker(None, scenario, world)
@@ -89,8 +94,9 @@ def replay(scenario, calibration, steps, poses, times_s) -> dict:
     reported = []
     for index, (step, pose) in enumerate(zip(steps, poses, strict=True)):
         tracker.predict(None if index == 0 else max(float(times_s[index] - times_s[index - 1]), 0.0))
-        detections = world.detector.detect(view, int(step), pose, rng)
-        track(tracker, detections, pose, partial(view.image, int(step), pose))
+        if detected[index]:
+            detections = world.detector.detect(view, int(step), pose, rng)
+            track(tracker, detections, pose, partial(view.image, int(step), pose))
         reported.append(tracker.reported())
     return clear_metrics(world.truth.positions_m[steps], [t.ids for t in reported], [t.mean[:, :2] for t in reported])
 
@@ -202,21 +208,37 @@ def main() -> None:
     moving = np.any(live.pose_sd[found] > 0, axis=1)
     arrival_s = live.capture_time_s + calibration.image_delay_s
     decided = np.isfinite(live.decided_s)
+    detected = decided & live.detected
     stages_s = {
         "stream (true delay)": float(np.median(arrival_s[timed] - truth_log[rendered[timed], 0])),
         "waiting for the detector": float(np.median((live.picked_s - arrival_s)[decided])),
-        "pose sample and detection": float(np.median((live.detected_s - live.picked_s)[decided])),
+        "pose sample and detection": float(np.median((live.detected_s - live.picked_s)[detected])),
         "waiting for the tracker, tracking": float(np.median((live.tracked_s - live.detected_s)[decided])),
         "decision and command": float(np.median((live.decided_s - live.tracked_s)[decided])),
+    }
+    detection_s = live.detected_s - live.picked_s
+    cost_by_zoom_ms = {
+        f"zoom {low:g}-{high:g}": float(1e3 * np.median(detection_s[band])) if band.any() else float("nan")
+        for low, high in ZOOM_BANDS
+        for band in [live.detected & (live.poses[:, 2] >= low) & (live.poses[:, 2] < high)]
     }
     # Each picture as rendered (unidentified ones: the step shown at its capture, the pose estimated).
     steps = np.where(found, truth_log[np.maximum(rendered, 0), 1], shown_steps(truth_log, live.capture_time_s))
     steps = np.clip(steps, 0, world.truth.positions_m.shape[0] - 1).astype(int)
     poses = np.where(found[:, None], truth_log[np.maximum(rendered, 0), 2:], live.poses)
     times_s = np.where(found, truth_log[np.maximum(rendered, 0), 0], live.capture_time_s)
-    rendered_exactly = replay(scenario, calibration, steps, poses, times_s)
-    last_of_step = np.r_[steps[1:] != steps[:-1], True]
-    per_step = replay(scenario, calibration, steps[last_of_step], poses[last_of_step], times_s[last_of_step])
+    rendered_exactly = replay(scenario, calibration, steps, poses, times_s, live.detected)
+    # The last detected picture of each recording step.
+    detected_steps = steps[live.detected]
+    last_of_step = np.flatnonzero(live.detected)[np.r_[detected_steps[1:] != detected_steps[:-1], True]]
+    per_step = replay(
+        scenario,
+        calibration,
+        steps[last_of_step],
+        poses[last_of_step],
+        times_s[last_of_step],
+        np.ones(len(last_of_step), bool),
+    )
     # A camera moving or not yet at rest where it went is given its target alone: no choice to time.
     choices = [(seconds, tracks) for seconds, tracks, reachable in decisions if reachable > 1]
     with_tracks = [seconds for seconds, tracks in choices if tracks > 0]
@@ -235,6 +257,7 @@ def main() -> None:
         "wall_s": wall_s,
         "decisions_per_s": rates["decisions_per_s"],
         "frames_used_per_s": rates["frames_used_per_s"],
+        "frames_detected_per_s": rates["frames_detected_per_s"],
         "frames_received_per_s": rates["frames_received_per_s"],
         "frame_age_s_p95": rates["frame_age_s_p95"],
         "first_decision_s": with_tracks[0] if with_tracks else float("nan"),
@@ -277,8 +300,16 @@ def main() -> None:
     print("\nwhere a decision's picture ages (medians over the decisions), ms:")
     for stage, seconds in stages_s.items():
         print(f"  {stage:<36} {1e3 * seconds:7.1f}")
+    print("the detection's cost by the picture's zoom (median), ms:")
+    for band, milliseconds in cost_by_zoom_ms.items():
+        print(f"  {band:<36} {milliseconds:7.1f}")
     if args.json is not None:
-        document = {**row, "mota_offline_per_seed": offline_seeds, "stages_s": stages_s}
+        document = {
+            **row,
+            "mota_offline_per_seed": offline_seeds,
+            "stages_s": stages_s,
+            "detection_ms_by_zoom": cost_by_zoom_ms,
+        }
         write_json(args.json, {"busy": document} if args.busy_cores else document)
 
 
