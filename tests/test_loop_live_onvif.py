@@ -31,7 +31,9 @@ from ptztrack.evaluate.metrics import episode_metrics
 from ptztrack.virtual_onvif.head import MOVE_LATENCY_S
 
 pytest.importorskip("ipycam", reason="the virtual ONVIF camera needs ipycam (pip install --no-deps ipycam==1.3.0)")
-pytestmark = pytest.mark.onvif
+# The live runs go one at a time (one xdist worker): two live loops at once would each be a machine busier
+# than the one their bounds are for (the other worker's tests are the other load they share the cores with).
+pytestmark = [pytest.mark.onvif, pytest.mark.xdist_group("live-loop")]
 
 USER, PASSWORD = "operator", "s3cret-pass"
 # A pose of the virtual camera far from where a PETS run starts (pan 57 deg, tilt 17 deg, zoom 1).

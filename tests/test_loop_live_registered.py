@@ -22,7 +22,9 @@ from ptztrack.config import CameraCalibrationFile, write_camera_calibration
 from ptztrack.evaluate.metrics import episode_metrics
 
 pytest.importorskip("ipycam", reason="the virtual ONVIF camera needs ipycam (pip install --no-deps ipycam==1.3.0)")
-pytestmark = pytest.mark.onvif
+# The live runs go one at a time (one xdist worker): two live loops at once would each be a machine busier
+# than the one their bounds are for (the other worker's tests are the other load they share the cores with).
+pytestmark = [pytest.mark.onvif, pytest.mark.xdist_group("live-loop")]
 
 HALF_PACE = 0.5
 # Within this of the truth: a registered pose (degrees, and a fraction of the zoom).
