@@ -164,11 +164,12 @@ DETECTION_S = 0.06
 def test_the_detector_rests_as_long_as_it_detected_but_takes_the_first_picture_at_rest_after_a_move(world):
     """With a detection three pictures long, a camera at rest has its detector take about one picture in
     four (it rests as long as it detected; the pictures of its rest are dropped, and each it takes is the
-    newest), each followed by a decision; the first picture at rest after a move is taken at once."""
+    newest), each followed by a decision, while the camera stays where it is; the first picture at rest
+    after a move is taken at once."""
     scenario, built = world
     slow = replace(built, detector=Slow())
     with PictureCamera(slow) as camera:
-        policy, tracker = make_policy("random", scenario, slow), make_tracker(None, scenario, slow)
+        policy, tracker = make_policy("fix", scenario, slow), make_tracker(None, scenario, slow)
         live = run_live(slow, policy, tracker, camera, 12, 1.0, 0)
     assert live.detected.all() and np.all(np.isfinite(live.decided_s))
     taken_apart_s = np.diff(live.picked_s)
