@@ -14,7 +14,8 @@ found among the pictures the camera rendered (by its thumbnail), which gives wha
 the stream's true delay, the pose error at capture (the pose the tracker used against the pose
 rendered, still and moving), the recording step it took the picture for against the one shown, and
 the detections per picture against the offline run's; and the stages a decision's picture went
-through (medians), with the detection's cost by the picture's zoom. The gap is then taken apart by replays through
+through (medians), with the detection's cost by the picture's zoom beside the people it found there and
+the detector model's recall at their height. The gap is then taken apart by replays through
 a fresh tracker, each changing one thing: the live run's pictures rendered exactly (the recording's
 view at the step and pose each showed, at its render time: no stream, no pose error; detected where
 the live run could place them), then one detected picture per recording step (the offline run's rate, at
@@ -60,7 +61,7 @@ from ptztrack.loop.steps import track
 MATCH_WINDOW_S = (1.0, 0.5)
 # Thumbnails within this mean grey level of the best match are indistinguishable from it.
 SAME_GREY = 0.5
-# The zoom bands the detection's cost is reported in.
+# The zoom bands the detection's cost and recall are reported in.
 ZOOM_BANDS = ((1.0, 1.5), (1.5, 3.0), (3.0, np.inf))
 
 
@@ -99,6 +100,25 @@ def replay(scenario, calibration, steps, poses, times_s, detected) -> dict:
             track(tracker, detections, pose, partial(view.image, int(step), pose))
         reported.append(tracker.reported())
     return clear_metrics(world.truth.positions_m[steps], [t.ids for t in reported], [t.mean[:, :2] for t in reported])
+
+
+def detection_by_zoom(live, recall) -> dict:
+    """For each of ZOOM_BANDS, over the pictures of ``live`` the detector ran on at a zoom in it: the median
+    detection time (``ms``), the median height of the people it found (``people_height_px``), and
+    ``recall``, the detector model's recall at that height (``recall(height_px)``, the run's online
+    model as it ended; NaN without one, or without people found)."""
+    detection_ms = 1e3 * (live.detected_s - live.picked_s)
+    figures = {}
+    for low, high in ZOOM_BANDS:
+        band = np.flatnonzero(live.detected & (live.poses[:, 2] >= low) & (live.poses[:, 2] < high))
+        heights_px = np.concatenate([np.zeros(0), *(live.detections[k].height_px for k in band)])
+        height_px = float(np.median(heights_px)) if len(heights_px) else float("nan")
+        figures[f"zoom {low:g}-{high:g}"] = {
+            "ms": float(np.median(detection_ms[band])) if len(band) else float("nan"),
+            "people_height_px": height_px,
+            "recall": float(recall(height_px)) if recall is not None and np.isfinite(height_px) else float("nan"),
+        }
+    return figures
 
 
 def serve(time_scale: float, ready, stop, results) -> None:
@@ -216,12 +236,7 @@ def main() -> None:
         "waiting for the tracker, tracking": float(np.median((live.tracked_s - live.detected_s)[decided])),
         "decision and command": float(np.median((live.decided_s - live.tracked_s)[decided])),
     }
-    detection_s = live.detected_s - live.picked_s
-    cost_by_zoom_ms = {
-        f"zoom {low:g}-{high:g}": float(1e3 * np.median(detection_s[band])) if band.any() else float("nan")
-        for low, high in ZOOM_BANDS
-        for band in [live.detected & (live.poses[:, 2] >= low) & (live.poses[:, 2] < high)]
-    }
+    by_zoom = detection_by_zoom(live, world.detector_model)
     # Each picture as rendered (unidentified ones: the step shown at its capture, the pose estimated).
     steps = np.where(found, truth_log[np.maximum(rendered, 0), 1], shown_steps(truth_log, live.capture_time_s))
     steps = np.clip(steps, 0, world.truth.positions_m.shape[0] - 1).astype(int)
@@ -300,15 +315,17 @@ def main() -> None:
     print("\nwhere a decision's picture ages (medians over the decisions), ms:")
     for stage, seconds in stages_s.items():
         print(f"  {stage:<36} {1e3 * seconds:7.1f}")
-    print("the detection's cost by the picture's zoom (median), ms:")
-    for band, milliseconds in cost_by_zoom_ms.items():
-        print(f"  {band:<36} {milliseconds:7.1f}")
+    print("by the picture's zoom: the detection's time (ms), the people found (px tall), the model's recall there:")
+    for band, figures in by_zoom.items():
+        print(
+            f"  {band:<12} {figures['ms']:7.1f} ms {figures['people_height_px']:6.1f} px recall {figures['recall']:.2f}"
+        )
     if args.json is not None:
         document = {
             **row,
             "mota_offline_per_seed": offline_seeds,
             "stages_s": stages_s,
-            "detection_ms_by_zoom": cost_by_zoom_ms,
+            "detection_by_zoom": by_zoom,
         }
         write_json(args.json, {"busy": document} if args.busy_cores else document)
 
