@@ -76,12 +76,16 @@ class PoseTimeline:
         standing still then (no spread), the samples either side of it not moving (a camera says it moves
         from a command on, before its pose changes), and no sooner than that move could land."""
         at = self.at(time_s)
+        return at is not None and not np.any(at.sd > 0) and self._still_since_landing(time_s)
+
+    def _still_since_landing(self, time_s: float) -> bool:
+        """Whether ``time_s`` is no sooner than the last move could land and the samples at or before it
+        and after it (the nearest each side) do not say the camera moves."""
         with self._condition:
             samples, lands_s = list(self._samples), self._lands_s
-        if at is None or np.any(at.sd > 0) or time_s < lands_s:
-            return False
         after = int(np.searchsorted([sample[0] for sample in samples], time_s, side="right"))
-        return not any(moving for _, _, moving in samples[max(after - 1, 0) : after + 1])
+        around = samples[max(after - 1, 0) : after + 1]
+        return time_s >= lands_s and not any(moving for _, _, moving in around)
 
     def wait_past(self, time_s: float, timeout_s: float) -> bool:
         """Wait at most ``timeout_s`` for a sample at ``time_s`` or later; whether there is one."""

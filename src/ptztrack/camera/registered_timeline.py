@@ -178,13 +178,8 @@ class RegisteredTimeline(PoseTimeline):
         it, and the next may start), the samples either side of it are not moving, and it was captured
         no sooner than that move could land."""
         with self._condition:
-            samples, lands_s = list(self._samples), self._lands_s
-        times = np.array([sample[0] for sample in samples])
-        if not np.any(np.abs(times - time_s) <= SAME_PICTURE_S):
-            return False
-        after = int(np.searchsorted(times, time_s, side="right"))
-        around = samples[max(after - 1, 0) : after + 1]  # the sample at or before, and the one after
-        return time_s >= lands_s and not any(moving for _, _, moving in around)
+            times = np.array([sample[0] for sample in self._samples])
+        return bool(np.any(np.abs(times - time_s) <= SAME_PICTURE_S)) and self._still_since_landing(time_s)
 
     def _append(self, time_s: float, pose: np.ndarray, moving: bool, sd: np.ndarray, reckoned: bool) -> None:
         """Add a sample (the condition held), dropping those older than KEEP_S, and wake the waiting."""

@@ -21,13 +21,13 @@ with four stages in their own threads:
 * the tracker and the policy (the calling thread): every picture predicts
   the tracker to its capture time (the scenario's time: wall time times
   ``time_scale``), and a detected one updates it, with the pose's
-  uncertainty in the measurement noise; once no newer picture waits, the
+  uncertainty in the measurement noise (a picture without a pose only
+  predicts: it costs its step); once no newer picture waits, the
   policy decides on the tracks as the newest picture left them, and the
   camera is sent there. While the camera still moves to its last target,
-  and until a detected picture taken at rest there is in the belief, it is
-  given that target only (the paper's camera is sent no new decision while
-  it moves), and so it is when no picture was detected since the last
-  decision (no new evidence to choose on).
+  and until a picture taken at rest there is in the belief, it is given
+  that target only (the paper's camera is sent no new decision while it
+  moves).
 
 So a busy machine drops pictures rather than falling behind: a decision
 follows each picture the tracker takes and is never made on a picture older
@@ -268,8 +268,6 @@ def run_live_network(
     # Whether each camera's newest picture used shows it at rest where it was last sent: only then has the
     # belief seen what its last move was for, and may it choose the next.
     settled = [False for _ in cameras]
-    # Whether a picture was detected since the last decision.
-    evidence = False
     used = 0
     started_s = time.time()
     for detector in detectors:
@@ -295,10 +293,8 @@ def run_live_network(
             if at is not None and detections is not None:  # else the decision is made on the prediction
                 image = partial(_CapturedView(frame.image).image, used, pose)
                 update, measured = track(tracker.updater(index), detections, pose, image, pose_sd)
-                planned, evidence = update.tracks, True
-            # A picture at rest that was not detected leaves the belief as it was: it settles nothing.
-            at_rest = cameras[index].timeline.settled(frame.time_s)
-            settled[index] = at_rest and (detections is not None or settled[index])
+                planned = update.tracks
+            settled[index] = cameras[index].timeline.settled(frame.time_s)
             row = {
                 "capture_time_s": frame.time_s,
                 "picked_s": picked_s,
@@ -320,15 +316,10 @@ def run_live_network(
                 last_decided_s = decided_s
                 if plan_ahead is not None:
                     planned = plan_ahead(planned, max(decided_s - frame.time_s, 0.0) * time_scale)
-                # Without a picture detected since the last decision there is no new evidence to choose on:
-                # every camera keeps its target.
                 contexts = [
-                    _context(camera, grid, sent_to, used, planned, policy_rng, decided_s, since_s, free)
-                    for camera, grid, sent_to, free in zip(
-                        cameras, grids, commanded, np.logical_and(settled, evidence), strict=True
-                    )
+                    _context(camera, grid, sent_to, used, planned, policy_rng, decided_s, since_s, at_rest)
+                    for camera, grid, sent_to, at_rest in zip(cameras, grids, commanded, settled, strict=True)
                 ]
-                evidence = False
                 choices, row["decision_s"] = timed(policy.choose, contexts)
                 sent = []
                 for k, (camera, grid, choice) in enumerate(zip(cameras, grids, choices, strict=True)):
@@ -369,9 +360,8 @@ def _context(
 ) -> DecisionContext:
     """The decision context of ``camera`` at epoch ``decided_s``: where it is (the pose it was sent to,
     ``commanded`` (3,), where no pose is known yet), the nearest grid action to that, and what it may reach:
-    while it moves, and unless a detected picture taken at rest where it went is in the belief and a
-    picture was detected since the last decision (``settled``), only the action nearest to its target (the
-    paper's camera is sent no new decision while it moves)."""
+    while it moves, and until a picture taken at rest where it went is in the belief (``settled``), only
+    the action nearest to its target (the paper's camera is sent no new decision while it moves)."""
     now = camera.timeline.at(decided_s)
     here = commanded if now is None else now.pose
     if camera.timeline.moving() or not settled:
