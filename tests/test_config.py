@@ -81,6 +81,17 @@ def test_an_unknown_association_is_refused_naming_the_field():
         scenario_from_dict({"tracker": {"clutter_density_per_px2": -1e-6}})
 
 
+def test_the_long_run_tracker_options_are_read_and_student_t_noise_is_refused_for_the_cjpdaf():
+    tracker = load_scenario(EXAMPLE.parent / "long_run.yaml").tracker
+    assert (tracker.noise_dof, tracker.negative_information, tracker.keep_within_area) == (4.0, True, True)
+    assert (tracker.association_cost, tracker.lost_tracks_kept) == ("likelihood", 20)
+    assert scenario_from_dict({}).tracker.noise_dof == float("inf")
+    with pytest.raises(ScenarioError, match="tracker: association cjpdaf assumes Gaussian pixel noise"):
+        scenario_from_dict({"tracker": {"association": "cjpdaf", "noise_dof": 4}})
+    with pytest.raises(ScenarioError, match="tracker.noise_dof: Input should be greater than 2"):
+        scenario_from_dict({"tracker": {"noise_dof": 2}})
+
+
 def test_hog_needs_a_recording_with_video():
     with pytest.raises(ScenarioError, match="'hog' needs a recording with a video"):
         scenario_from_dict({"detector": {"kind": "hog"}})

@@ -9,7 +9,7 @@ from scipy.stats import chi2
 
 from ptztrack.geometry.ptz import PTZCamera, apply_homography, feet_jacobian, ground_to_image, look_at
 from ptztrack.track import kalman
-from ptztrack.track.association import student_t_gate
+from ptztrack.track.association import associate, student_t_gate
 from ptztrack.track.evidence import birth_exposure
 from ptztrack.track.kalman import constant_velocity_model
 from ptztrack.track.lifecycle import existence_after_detection, existence_after_miss, start_ground_tracks, start_tracks
@@ -451,3 +451,15 @@ def test_a_detection_is_paired_only_with_a_track_whose_gate_lies_in_front_of_the
     if not paired:
         np.testing.assert_array_equal(updated.covariance[0], tracks.covariance[0])
         np.testing.assert_array_equal(updated.mean[0], tracks.mean[0])
+
+
+def test_the_likelihood_cost_gives_a_detection_to_the_sure_track_and_the_mahalanobis_cost_to_the_uncertain():
+    """A detection 4 px from a sure track (S = 4 I px^2) and 26 px from an uncertain one (S = 2500 I): squared
+    Mahalanobis distances 4 and 0.27, negative log-likelihoods 4 + log 16 = 6.8 and 0.27 + log 2500^2 = 15.9."""
+    predicted_px = np.array([[300.0, 240.0], [330.0, 240.0]])
+    S = np.stack([4.0 * np.eye(2), 2500.0 * np.eye(2)])
+    detection_px = np.array([[304.0, 240.0]])
+    pairable = np.array([True, True])
+    by_distance = associate(predicted_px, pairable, S, detection_px, 0.99, "mahalanobis")
+    by_likelihood = associate(predicted_px, pairable, S, detection_px, 0.99, "likelihood")
+    assert by_distance[0].tolist() == [1] and by_likelihood[0].tolist() == [0]

@@ -191,6 +191,7 @@ def ekf_tracker(scenario: Scenario, world: World) -> EkfTracker | TemplateTracke
         model,
         learner=None if learned is None else learned.observe,
         clutter_per_view=None if learned is None or not learned.learning else lambda: learned.clutter_per_view,
+        area_polygon_m=world.area_polygon_m if parameters.keep_within_area and not people_can_leave(scenario) else None,
     )
     if config.measurement_source == "detector":
         return tracker

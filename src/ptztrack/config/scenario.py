@@ -192,6 +192,11 @@ class Tracker(_Strict):
     max_position_sigma_m : where people can leave the scene (a recording, or ``people.enter_leave``),
     a track this uncertain is deleted; where they never leave, uncertainty deletes nobody.
     report_position_sigma_m : a track more uncertain than this is kept but not reported.
+    noise_dof : the feet pixels' noise's degrees of freedom: .inf for Gaussian noise, a few for Student-t noise,
+    whose far detections update less (the Hungarian association only).
+    negative_information, keep_within_area, association_cost, lost_tracks_kept : what a miss and the
+    walkable area say of a track's position, the association's cost, and the deleted tracks kept to be
+    taken back (:class:`~ptztrack.track.parameters.TrackerParameters`).
     """
 
     kind: Annotated[str, _registered("trackers")] = "ekf"
@@ -217,8 +222,19 @@ class Tracker(_Strict):
     clutter_density_per_px2: Annotated[NonNegativeFloat, at_most(1, "detections per pixel")] = (
         TrackerParameters.clutter_density_per_px2
     )
+    noise_dof: float = Field(TrackerParameters.noise_dof, gt=2, allow_inf_nan=True)
+    negative_information: bool = TrackerParameters.negative_information
+    keep_within_area: bool = TrackerParameters.keep_within_area
+    association_cost: Literal["mahalanobis", "likelihood"] = TrackerParameters.association_cost
+    lost_tracks_kept: Annotated[int, Field(ge=0), at_most(10_000, "tracks")] = TrackerParameters.lost_tracks_kept
     measurement_source: Literal["detector", "spatiogram"] = "detector"
     detector_every_steps: Annotated[int, Field(ge=1), at_most(_MAX_FRAMES, "steps")] = 5
+
+    @model_validator(mode="after")
+    def _gaussian_noise_for_cjpdaf(self):
+        if self.association == "cjpdaf" and self.noise_dof != float("inf"):
+            raise ValueError(f"association cjpdaf assumes Gaussian pixel noise: noise_dof .inf (got {self.noise_dof})")
+        return self
 
 
 class Control(_Strict):

@@ -25,26 +25,37 @@ def gated_innovations(predicted_px, pairable, S, feet_px, gate_probability: floa
     return residual, distance2, allowed
 
 
-def associate(predicted_px, pairable, S, feet_px, gate_probability: float) -> tuple[np.ndarray, np.ndarray]:
-    """Hungarian assignment of detections to predicted tracks on the Mahalanobis distance.
+def associate(
+    predicted_px, pairable, S, feet_px, gate_probability: float, cost: str = "mahalanobis"
+) -> tuple[np.ndarray, np.ndarray]:
+    """Hungarian assignment of detections to predicted tracks.
 
     predicted_px : (n, 2) and pairable : (n,) as for :func:`gated_innovations`;
     S : (n, 2, 2) innovation covariances; feet_px : (K, 2) detections.
     Pairs whose squared Mahalanobis distance exceeds the chi-square quantile
     ``gate_probability`` (2 degrees of freedom) are not allowed, nor are
-    tracks that are not pairable. Returns matched (track_index, detection_index) arrays.
+    tracks that are not pairable. cost : 'mahalanobis', the squared Mahalanobis distance ``d2``, or
+    'likelihood', the pair's negative log-likelihood ``d2 + log det S`` (up to a constant), under which
+    an uncertain track, whose every detection is near, no longer outbids a sure one for its detection.
+    Returns matched (track_index, detection_index) arrays.
     """
     if len(predicted_px) == 0 or len(feet_px) == 0:
         return np.zeros(0, dtype=int), np.zeros(0, dtype=int)
     _, distance2, allowed = gated_innovations(predicted_px, pairable, S, feet_px, gate_probability)
-    return assign_gated(distance2, allowed, gate_probability)
+    if cost == "likelihood":
+        distance2 = distance2 + np.linalg.slogdet(S)[1][:, None]
+    return assign_gated(distance2, allowed)
 
 
-def assign_gated(distance2, allowed, gate_probability: float) -> tuple[np.ndarray, np.ndarray]:
-    """The Hungarian assignment on squared Mahalanobis distances (n, K) among the ``allowed`` (n, K)
-    pairs; returns matched (track_index, measurement_index) arrays."""
-    cost = np.where(allowed, distance2, chi2.ppf(gate_probability, df=2) * 1e3)
-    rows, cols = linear_sum_assignment(cost)
+def assign_gated(cost, allowed) -> tuple[np.ndarray, np.ndarray]:
+    """The Hungarian assignment on the costs (n, K) among the ``allowed`` (n, K) pairs: as many pairs as
+    can be allowed, at the least total cost among those; returns matched (track_index, measurement_index)
+    arrays."""
+    cost = np.asarray(cost, dtype=float)
+    # A pair not allowed costs more than every allowed assignment together, so it is taken only where
+    # no allowed pair is left, and then dropped.
+    forbidden = (np.abs(cost[allowed]).sum() + 1.0) * 2.0 if np.any(allowed) else 1.0
+    rows, cols = linear_sum_assignment(np.where(allowed, cost, forbidden))
     keep = allowed[rows, cols]
     return rows[keep], cols[keep]
 

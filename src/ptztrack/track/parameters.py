@@ -30,6 +30,13 @@ class TrackerParameters:
     birth : which detections the Hungarian association starts tracks from: 'unassigned' (every detection
         assigned to no track) or 'outside_gates' (only those in the gate of no surviving track, as the
         CJPDAF does: a detection another track could explain is not taken for a new person).
+    negative_information : a look that misses a track also moves its position out of where the camera
+        would have seen it (:mod:`ptztrack.track.negative_information`); keep_within_area : where people
+        never leave, every track is truncated to the walkable area after each update (same module).
+    association_cost : the Hungarian assignment's cost, 'mahalanobis' or 'likelihood'
+        (:func:`ptztrack.track.association.associate`).
+    lost_tracks_kept : how many deleted tracks are kept to be taken back by a detection that would start
+        a track (:mod:`ptztrack.track.lost_tracks`); 0: none.
     """
 
     acceleration_sigma_m_s2: float = 1.5
@@ -47,3 +54,7 @@ class TrackerParameters:
     existence_to_report: float = 0.5
     noise_dof: float = math.inf
     birth: Literal["unassigned", "outside_gates"] = "unassigned"
+    negative_information: bool = False
+    keep_within_area: bool = False
+    association_cost: Literal["mahalanobis", "likelihood"] = "mahalanobis"
+    lost_tracks_kept: int = 0

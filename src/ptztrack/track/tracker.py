@@ -58,6 +58,8 @@ from ptztrack.track.lifecycle import (
     start_ground_tracks,
     start_tracks,
 )
+from ptztrack.track.lost_tracks import kept_lost, revived
+from ptztrack.track.negative_information import after_miss, within_area
 from ptztrack.track.observation import gate_in_front, ground_points, observation_matrix, predicted_feet_px
 from ptztrack.track.parameters import TrackerParameters
 from ptztrack.track.pixel_noise import innovation_likelihood, squared_distances, student_t_noise, student_t_weight
@@ -116,7 +118,7 @@ def update_tracks(
     S = kalman.innovation_covariance(tracks.covariance, C, V)
     gate = student_t_gate(parameters.gate_probability, parameters.noise_dof)
     pairable = gate_in_front(camera, pose, tracks.mean, tracks.covariance, gate)
-    track_index, detection_index = associate(predicted_px, pairable, S, feet_px, gate)
+    track_index, detection_index = associate(predicted_px, pairable, S, feet_px, gate, parameters.association_cost)
     innovation_px = feet_px[detection_index] - predicted_px[track_index]
     if parameters.association == "cjpdaf" and not np.isinf(parameters.noise_dof):
         raise ValueError("the CJPDAF assumes Gaussian pixel noise (noise_dof inf)")
@@ -145,6 +147,11 @@ def update_tracks(
         updated_index = track_index
     if detectable is None:
         detectable = (in_front & inside_image(camera, predicted_px)).astype(float)
+    if parameters.negative_information:
+        detectable = np.asarray(detectable, dtype=float)
+        missed = np.setdiff1d(np.flatnonzero(detectable > 0), updated_index)
+        moved = after_miss(camera, pose, mean[missed], covariance[missed], detectable[missed])
+        mean[missed], covariance[missed] = moved
     likelihood_px2 = np.zeros(len(tracks))
     likelihood_px2[track_index] = innovation_likelihood(innovation_px, S[track_index], parameters.noise_dof)
     survivors, keep = _after_update(tracks, mean, covariance, updated_index, detectable, parameters, likelihood_px2)
@@ -194,7 +201,7 @@ def update_tracks_on_ground(
     S = tracks.covariance[:, None, :2, :2] + covariance_m2[None, :, :, :]
     distance2 = np.einsum("tki,tkij,tkj->tk", residual, np.linalg.inv(S), residual)
     allowed = distance2 <= chi2.ppf(parameters.gate_probability, df=2)
-    track_index, measurement_index = assign_gated(distance2, allowed, parameters.gate_probability)
+    track_index, measurement_index = assign_gated(distance2, allowed)
     mean, covariance = tracks.mean.copy(), tracks.covariance.copy()
     mean[track_index], covariance[track_index] = kalman.update(
         tracks.mean[track_index],
@@ -318,12 +325,15 @@ class EkfTracker:
     learner: Callable[[TrackerEvidence], None] | None = None
     clutter_per_view: Callable[[], float] | None = None
     bias: PixelBias | None = None
+    area_polygon_m: np.ndarray | None = None
+    lost: Tracks = field(default_factory=Tracks.empty)
     unseen_s: float = field(default=math.inf, init=False, repr=False)
 
     def predict(self, dt_s: float | None = None) -> Tracks:
         dt_s = self.step_s if dt_s is None else dt_s
         self.elapse(dt_s)
         self.tracks = tracks_ahead(self.tracks, dt_s, self.parameters.acceleration_sigma_m_s2)
+        self.lost = tracks_ahead(self.lost, dt_s, self.parameters.acceleration_sigma_m_s2)
         return self.tracks
 
     def elapse(self, dt_s: float) -> None:
@@ -362,7 +372,12 @@ class EkfTracker:
             bias_px = bias.estimate()
             detections = replace(detections, feet_px=detections.feet_px - bias_px)
         update = update_tracks(tracks, detections.feet_px, self.camera, pose, V, parameters, looked)
-        self.tracks = update.tracks
+        update, lost = revived(update, tracks.next_id, self.lost, detections.feet_px, self.camera, pose, V, parameters)
+        lost = kept_lost(lost, tracks.select(~np.isin(tracks.ids, update.tracks.ids)), parameters)
+        if self.area_polygon_m is not None:
+            update = replace(update, tracks=self._within_area(update.tracks))
+            lost = self._within_area(lost)
+        self.tracks, self.lost = update.tracks, lost
         if bias is not None:
             innovation_px, S = paired_innovations(tracks, update, detections.feet_px, self.camera, pose, V)
             weight = student_t_weight(squared_distances(innovation_px, S), parameters.noise_dof)
@@ -372,6 +387,10 @@ class EkfTracker:
             exposure = birth_exposure(tracks, update, self.camera, pose, V, parameters)
             self.learner(replace(evidence, excess_px2=evidence.excess_px2 - np.trace(pose_noise), exposure=exposure))
         return update
+
+    def _within_area(self, tracks: Tracks) -> Tracks:
+        mean, covariance = within_area(tracks.mean, tracks.covariance, self.area_polygon_m)
+        return replace(tracks, mean=mean, covariance=covariance)
 
     def reported(self) -> Tracks:
         """The tracks whose existence is ``existence_to_report`` or more (with the 'bayes' update), detected
