@@ -38,6 +38,18 @@ UNDEFINED_BECAUSE = {
 }
 
 
+def metric_accumulator(truth_positions_m, track_ids, track_positions_m, gate_m: float = GATE_M):
+    """The motmetrics accumulator of tracks against the truth (arguments as :func:`clear_metrics`): its
+    ``mot_events`` pair every person with a track, frame by frame (MATCH, SWITCH, MISS, FP)."""
+    accumulator = mm.MOTAccumulator(auto_id=True)
+    for truth_frame, ids, positions in zip(truth_positions_m, track_ids, track_positions_m, strict=True):
+        present = np.flatnonzero(~np.isnan(truth_frame[:, 0]))
+        distance_m = np.linalg.norm(truth_frame[present, None, :] - np.asarray(positions)[None, :, :], axis=-1)
+        distance_m[distance_m > gate_m] = np.nan
+        accumulator.update(present.tolist(), np.asarray(ids).tolist(), distance_m)
+    return accumulator
+
+
 def clear_metrics(truth_positions_m, track_ids, track_positions_m, gate_m: float = GATE_M) -> dict:
     """CLEAR-MOT and identity metrics of tracks against the truth.
 
@@ -47,12 +59,7 @@ def clear_metrics(truth_positions_m, track_ids, track_positions_m, gate_m: float
     Returns mota, motp_m, idf1, switches, false_positives, misses, objects and
     matches (every truth-track correspondence, switches included).
     """
-    accumulator = mm.MOTAccumulator(auto_id=True)
-    for truth_frame, ids, positions in zip(truth_positions_m, track_ids, track_positions_m, strict=True):
-        present = np.flatnonzero(~np.isnan(truth_frame[:, 0]))
-        distance_m = np.linalg.norm(truth_frame[present, None, :] - np.asarray(positions)[None, :, :], axis=-1)
-        distance_m[distance_m > gate_m] = np.nan
-        accumulator.update(present.tolist(), np.asarray(ids).tolist(), distance_m)
+    accumulator = metric_accumulator(truth_positions_m, track_ids, track_positions_m, gate_m)
     summary = mm.metrics.create().compute(
         accumulator,
         metrics=[
@@ -96,7 +103,7 @@ def network_metrics(episode: NetworkEpisode) -> dict:
     return {**tracking_metrics(episode.truth, episode.tracks), **looking_metrics(episode.cameras)}
 
 
-def tracks_within(tracks: list[Tracks], polygon_m) -> list[Tracks]:
+def tracks_within(tracks: Sequence[Tracks], polygon_m) -> list[Tracks]:
     """Each step's tracks whose ground position lies inside the polygon (K, 2) m: the ones a truth
     annotated only there can score."""
     return [step.select(inside(polygon_m, step.mean[:, :2])) if len(step) else step for step in tracks]
@@ -112,7 +119,7 @@ def truth_within(truth: GroundTruth, polygon_m) -> GroundTruth:
     return replace(truth, positions_m=positions_m)
 
 
-def tracking_metrics(truth: GroundTruth, tracks: list[Tracks]) -> dict:
+def tracking_metrics(truth: GroundTruth, tracks: Sequence[Tracks]) -> dict:
     """:func:`clear_metrics` of the reported ``tracks`` of every step against ``truth``."""
     return clear_metrics(truth.positions_m, [step.ids for step in tracks], [step.mean[:, :2] for step in tracks])
 

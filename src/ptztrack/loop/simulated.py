@@ -29,13 +29,14 @@ list meet, there, the same detector luck (common random numbers).
 import time
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
-from typing import Protocol
+from typing import Any, Protocol
 
 import numpy as np
 
 from ptztrack.loop.alone import AlonePolicy, AloneTracker
+from ptztrack.loop.history import StepHistory
 from ptztrack.loop.steps import (
-    PER_STEP,
+    STEP_NUMBERS,
     Episode,
     Look,
     StepObserver,
@@ -84,7 +85,7 @@ class NetworkEpisode:
 
     truth: GroundTruth
     area_polygon_m: np.ndarray
-    tracks: list[Tracks]
+    tracks: Sequence[Tracks]
     decision_s: np.ndarray
     cameras: tuple[Episode, ...]
     update_s: np.ndarray
@@ -191,8 +192,14 @@ def run_network_loop(
 
     nearest = [camera.start_action for camera in world.cameras]
     commanded = [camera.grid.poses[camera.start_action] for camera in world.cameras]
-    per_camera: list[dict[str, list]] = [{name: [] for name in PER_STEP} for _ in world.cameras]
-    reported: list[Tracks] = []
+    # A long run's memory grows by its numbers only: the per-step numbers go into arrays made for the run,
+    # tracks and detections into step histories, and every camera's episode shares the network's tracks.
+    reported: StepHistory[Tracks] = StepHistory()
+    per_camera: list[dict[str, Any]] = [
+        {name: np.empty((steps, *shape), dtype) for name, (shape, dtype) in STEP_NUMBERS.items()}
+        | {"tracks": reported, "detections": StepHistory()}
+        for _ in world.cameras
+    ]
     decision_times_s, update_times_s, step_times_s = [], [], []
     cameras = fleet(camera_workers(world, seed))
     try:
@@ -225,9 +232,10 @@ def run_network_loop(
             update_times_s.append(update_s)
             step_times_s.append(time.perf_counter() - step_started)
             for index, (context, record, history) in enumerate(zip(contexts, records, per_camera, strict=True)):
+                for name in STEP_NUMBERS:
+                    history[name][step] = record[name]
+                history["detections"].append(record["detections"])
                 record["tracks"] = tracks
-                for name, value in record.items():
-                    history[name].append(value)
                 if observer is not None:
                     observer(step, context, {**record, "camera": index})
     finally:

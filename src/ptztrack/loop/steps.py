@@ -7,7 +7,7 @@ and where the camera lands and which pose the tracker believes. The simulated lo
 """
 
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from functools import partial
 from typing import Any
@@ -78,12 +78,22 @@ class Episode:
     tracker_poses: np.ndarray
     pose_known: np.ndarray
     decision_s: np.ndarray
-    tracks: list[Tracks]
-    detections: list[Detections]
+    tracks: Sequence[Tracks]
+    detections: Sequence[Detections]
 
 
 # What the loop records at every step, as the fields of Episode.
-PER_STEP = ("actions", "commanded", "poses", "tracker_poses", "pose_known", "decision_s", "tracks", "detections")
+# A camera's per-step numbers: name -> (shape per step, dtype); with its tracks and detections, the
+# episode's per-step records.
+STEP_NUMBERS = {
+    "actions": ((), np.int64),
+    "commanded": ((3,), np.float64),
+    "poses": ((3,), np.float64),
+    "tracker_poses": ((3,), np.float64),
+    "pose_known": ((), np.bool_),
+    "decision_s": ((), np.float64),
+}
+PER_STEP = (*STEP_NUMBERS, "tracks", "detections")
 
 
 StepObserver = Callable[[int, DecisionContext, dict], None]
@@ -168,8 +178,9 @@ def take_in(world: World, tracker: Updater, step: int, seen: Look) -> dict:
     }
 
 
-def episode_of(world: World, per_step: dict[str, list]) -> Episode:
-    """The :class:`Episode` of the camera of ``world`` from its steps' records ({PER_STEP name: list})."""
+def episode_of(world: World, per_step: dict[str, Sequence]) -> Episode:
+    """The :class:`Episode` of the camera of ``world`` from its steps' records ({PER_STEP name: the steps'
+    values in order})."""
     arrays = {name: np.asarray(per_step[name]) for name in PER_STEP if name not in ("tracks", "detections")}
     return Episode(
         world.truth,
