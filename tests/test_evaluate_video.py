@@ -62,6 +62,16 @@ def test_the_video_holds_the_drawn_frames_and_the_same_seed_gives_the_same_bytes
     assert (tmp_path / "a.mp4").read_bytes() == (tmp_path / "b.mp4").read_bytes()
 
 
+def test_a_long_runs_video_shows_its_last_steps():
+    scenario = scenario_from_dict({"frames": 5, "detector": {"kind": "ideal"}})
+    episode = run_episode(scenario, "random", 3)
+    render_view = view_renderer(episode_world(scenario, 3))
+    every_step = list(episode_frames(episode, render_view, "random"))
+    last_three = list(episode_frames(episode, render_view, "random", max_steps=3))
+    assert len(every_step) == 5 and len(last_three) == 3
+    np.testing.assert_array_equal(np.stack(last_three), np.stack(every_step[2:]))
+
+
 def test_the_synthetic_view_shows_the_people_the_detector_saw():
     scenario = scenario_from_dict({"frames": 1, "detector": {"kind": "ideal", "pixel_noise_px": 0.0}})
     episode = run_episode(scenario, "fix", 0)

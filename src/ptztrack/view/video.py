@@ -13,7 +13,9 @@ The view comes from a caller's ``render_view(step, pose)``;
 :func:`view_renderer` builds it for a :class:`~ptztrack.loop.steps.World`: the
 camera backend's image (the recorded frame seen by the virtual camera, say),
 or where the backend renders none, the camera model's picture of the true
-people. Everything is drawn with OpenCV
+people. A run longer than ``VIDEO_MAX_STEPS`` steps has a video of its last ``VIDEO_MAX_STEPS`` (each
+caption gives its step): its whole run is in the folder's tables, and drawing every step of an hour's
+run would take longer than the run's last minutes are worth. Everything is drawn with OpenCV
 and encoded by OpenCV's MPEG-4 Part 2 writer ('mp4v'; its H.264 encoder is
 not in the pip wheels).
 """
@@ -38,6 +40,7 @@ RenderView = Callable[[int, np.ndarray], np.ndarray]
 
 PANEL_SIZE_PX = (640, 480)  # (width, height) of the view and of the map
 CAPTION_HEIGHT_PX = 48  # two lines of text
+VIDEO_MAX_STEPS = 3000
 FRAME_SIZE_PX = (2 * PANEL_SIZE_PX[0], PANEL_SIZE_PX[1] + CAPTION_HEIGHT_PX)
 SIGMAS = 2.0  # ellipses at 2 standard deviations hold 86 % of a 2-D Gaussian
 GRID_STEP_M = 5.0
@@ -160,7 +163,7 @@ def view_renderer(world: World) -> RenderView:
 def write_episode_video(path: str | Path, episode: Episode, render_view: RenderView, label: str = "") -> None:
     """Write the episode video to ``path`` (.mp4, MPEG-4 Part 2) at the scene's frame rate.
 
-    One frame (FRAME_SIZE_PX) per step. Written to a temporary file beside
+    One frame (FRAME_SIZE_PX) per step, of the last ``VIDEO_MAX_STEPS`` steps. Written to a temporary file beside
     ``path`` and renamed, so a failure leaves no partial file and keeps an old one.
     """
     write_video(path, episode_frames(episode, render_view, label), episode.truth.frame_rate_hz, FRAME_SIZE_PX)
@@ -190,11 +193,15 @@ def write_video(
         raise
 
 
-def episode_frames(episode: Episode, render_view: RenderView, label: str = "") -> Iterator[np.ndarray]:
-    """The video's frames, one per step: (FRAME_SIZE_PX[1], FRAME_SIZE_PX[0], 3) uint8 BGR."""
+def episode_frames(
+    episode: Episode, render_view: RenderView, label: str = "", max_steps: int = VIDEO_MAX_STEPS
+) -> Iterator[np.ndarray]:
+    """The video's frames, one per step of the last ``max_steps``: (FRAME_SIZE_PX[1], FRAME_SIZE_PX[0], 3)
+    uint8 BGR."""
     transform = map_transform(episode)
     background = map_background(episode, transform)
-    for step, pose in enumerate(episode.poses):
+    first = max(len(episode.poses) - max_steps, 0)
+    for step, pose in enumerate(episode.poses[first:], start=first):
         view = render_view(step, pose)
         view = view_panel(episode.camera, view, pose, episode.detections[step], episode.tracks[step])
         ground = map_panel(episode, step, background, transform)
