@@ -9,7 +9,9 @@ the run's folder as ``ptztrack run --out`` does and times it. It prints and writ
   last ``--window`` steps, each scored on its own;
 - ``rss_mb_at``: step -> resident memory (MB) when that step was decided;
 - ``write_s``: seconds to write the folder; ``run_s``: seconds to run the steps;
-- ``tracks_started``: the tracks the run started (one person kept as themselves starts one).
+- ``track_ids_reported``: the distinct track ids the run reported (one person kept as themselves has one);
+- ``switch_unmatched_steps``: at each identity switch, the steps since the person was last matched to a
+  track, as percentiles 10, 50 and 90 (how long the switched tracks had gone unseen).
 
     python benchmarks/soak.py [--frames 20000] [--seed 0] [--scenario synthetic] [--window 2000]
                               [--rss-every 1000] [--json PATH]
@@ -20,12 +22,13 @@ import tempfile
 import time
 from pathlib import Path
 
+import numpy as np
 import psutil
 
 from ptztrack.builders.episode import episode_world, make_policy, run_episode
 from ptztrack.cli.run import DETECTOR_MODEL_FILE
 from ptztrack.cli.scenario import build_scenario
-from ptztrack.evaluate.metrics import clear_metrics, episode_metrics
+from ptztrack.evaluate.metrics import clear_metrics, episode_metrics, metric_accumulator
 from ptztrack.evaluate.report import write_outputs
 from ptztrack.files import run_folder, write_json
 from ptztrack.loop.executors import Progress
@@ -37,6 +40,22 @@ def window_switches(episode, first: int, stop: int) -> int:
     tracks = episode.tracks[first:stop]
     truth = episode.truth.positions_m[first:stop]
     return int(clear_metrics(truth, [step.ids for step in tracks], [step.mean[:, :2] for step in tracks])["switches"])
+
+
+def switch_unmatched_steps(episode) -> list[float]:
+    """Percentiles 10, 50 and 90 of the steps since each switched person was last matched to a track."""
+    accumulator = metric_accumulator(
+        episode.truth.positions_m, [step.ids for step in episode.tracks], [step.mean[:, :2] for step in episode.tracks]
+    )
+    events = accumulator.mot_events.reset_index()
+    last_matched, gaps = {}, []
+    for frame, person, kind in events.loc[events.Type.isin(["MATCH", "SWITCH"]), ["FrameId", "OId", "Type"]].itertuples(
+        index=False
+    ):
+        if kind == "SWITCH" and person in last_matched:
+            gaps.append(frame - last_matched[person])
+        last_matched[person] = frame
+    return np.percentile(gaps, [10, 50, 90]).tolist() if gaps else []
 
 
 def main() -> None:
@@ -85,13 +104,15 @@ def main() -> None:
         "id_switches_per_100_steps": 100.0 * metrics["switches"] / steps,
         "switches_first_2000": window_switches(episode, 0, args.window),
         "switches_last_2000": window_switches(episode, steps - args.window, steps),
-        "tracks_started": int(episode.tracks[-1].next_id) if steps else 0,
+        "track_ids_reported": len(set().union(*(step.ids.tolist() for step in episode.tracks))),
+        "switch_unmatched_steps": switch_unmatched_steps(episode),
         "rss_mb_at": rss_mb_at,
         "run_s": run_s,
         "write_s": write_s,
     }
     for key, value in document.items():
         shown = {k: round(v) for k, v in value.items()} if isinstance(value, dict) else value
+        shown = [round(v) for v in shown] if isinstance(shown, list) else shown
         print(f"{key:>27}  {shown:.4g}" if isinstance(shown, float) else f"{key:>27}  {shown}")
     if args.json is not None:
         write_json(args.json, document)
