@@ -47,6 +47,27 @@ def associate(
     return assign_gated(distance2, allowed)
 
 
+def associate_on_ground(
+    mean, covariance, position_m, covariance_m2, gate_probability: float, cost: str = "mahalanobis"
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Hungarian assignment of ground measurements to tracks.
+
+    mean : (n, 4) and covariance : (n, 4, 4) the tracks; position_m : (K, 2) and covariance_m2 : (K, 2, 2) the
+    measurements ``z = [I 0] x + r``, ``r ~ N(0, R_k)``. A pair's innovation covariance is ``P_xy + R_k``; pairs
+    beyond the chi-square quantile ``gate_probability`` (2 degrees of freedom) of its squared Mahalanobis
+    distance are not allowed; cost as :func:`associate`. Returns matched (track_index, measurement_index)
+    and every pair's residual (n, K, 2) m.
+    """
+    residual = position_m[None, :, :] - mean[:, None, :2]
+    S = covariance[:, None, :2, :2] + covariance_m2[None, :, :, :]
+    distance2 = np.einsum("tki,tkij,tkj->tk", residual, np.linalg.inv(S), residual)
+    allowed = distance2 <= chi2.ppf(gate_probability, df=2)
+    if cost == "likelihood":
+        distance2 = distance2 + np.linalg.slogdet(S)[1]
+    track_index, measurement_index = assign_gated(distance2, allowed)
+    return track_index, measurement_index, residual
+
+
 def assign_gated(cost, allowed) -> tuple[np.ndarray, np.ndarray]:
     """The Hungarian assignment on the costs (n, K) among the ``allowed`` (n, K) pairs: as many pairs as
     can be allowed, at the least total cost among those; returns matched (track_index, measurement_index)

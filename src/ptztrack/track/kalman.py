@@ -35,6 +35,12 @@ def gain(P, C, V) -> np.ndarray:
     return np.swapaxes(np.linalg.solve(S, C @ P), -1, -2)
 
 
+def update_position(x, P, innovation, R) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`update` with a measurement of the position, ``z = [I 0] x + r``: innovation (n, 2) m, R (n, 2, 2)
+    m^2."""
+    return update(x, P, innovation, np.broadcast_to(np.eye(2, x.shape[-1]), (*x.shape[:-1], 2, x.shape[-1])), R)
+
+
 def update(x, P, innovation, C, V) -> tuple[np.ndarray, np.ndarray]:
     """EKF update with the innovation ``o - g(x-)`` (n, 2) and ``C = dg/dx`` at ``x-``.
 

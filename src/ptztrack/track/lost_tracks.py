@@ -6,9 +6,10 @@ would start a new track, a new identity. A deleted track is therefore kept as *l
 so ever more uncertain), for as long as it is localised within ``max_position_sigma_m`` (people who
 can leave are forgotten once they could have left) and among the ``lost_tracks_kept`` most recently
 lost. A detection that would start a track is first associated with the lost tracks (the Hungarian
-assignment on the pair's negative log-likelihood, in the same chi-square gate as every association), and
-one that falls in a lost track's gate takes that track back: its id, its hits, its state updated by the
-detection (the EKF update of :mod:`ptztrack.track.kalman`), at the existence of a new track. A second
+assignment on the pair's negative log-likelihood, in the same chi-square gate as every association, on
+the ground), and one that falls in a lost track's gate takes that track back: its id, its hits, its state
+updated by the detection's ground point (the Kalman update of :mod:`ptztrack.track.kalman`), at the
+existence of a new track. A second
 stage of association, as trackers that keep a lost tracks' buffer (DeepSORT's and ByteTrack's) have it,
 here on the ground belief's own likelihood.
 """
@@ -17,10 +18,8 @@ from dataclasses import replace
 
 import numpy as np
 
-from ptztrack.geometry.ptz import PTZCamera
 from ptztrack.track import kalman
-from ptztrack.track.association import associate, student_t_gate
-from ptztrack.track.observation import gate_in_front, observation_matrix, predicted_feet_px
+from ptztrack.track.association import associate_on_ground
 from ptztrack.track.parameters import TrackerParameters
 from ptztrack.types import Tracks, TrackUpdate
 
@@ -46,45 +45,30 @@ def kept_lost(lost: Tracks, deleted: Tracks, parameters: TrackerParameters) -> T
 
 
 def revived(
-    update: TrackUpdate,
-    first_new_id: int,
-    lost: Tracks,
-    feet_px,
-    camera: PTZCamera,
-    pose,
-    V,
-    parameters: TrackerParameters,
+    update: TrackUpdate, first_new_id: int, lost: Tracks, parameters: TrackerParameters
 ) -> tuple[TrackUpdate, Tracks]:
-    """The update with every new track (id ``first_new_id`` or more) whose detection falls in a lost track's
-    gate replaced by that lost track, updated by the detection (the module's docstring); and the lost
-    tracks left.
+    """The update with every new track (id ``first_new_id`` or more) whose position falls in a lost track's
+    gate replaced by that lost track, updated by it (the module's docstring); and the lost tracks left.
 
-    feet_px : (K, 2) the step's detections, as the update pairs them; V : (2, 2) px^2 their noise.
+    A new track's position and its covariance are its detection's ground point and the detection's noise
+    carried to the ground (:func:`~ptztrack.track.lifecycle.start_tracks`), so it is matched as a ground
+    measurement (:func:`~ptztrack.track.association.associate_on_ground`): a lost track may be uncertain
+    over the whole scene, and its gate behind the camera, where a pixel's linearisation would not hold.
     """
     new_rows = np.flatnonzero(update.tracks.ids >= first_new_id)
     if len(new_rows) == 0 or len(lost) == 0:
         return update, lost
-    measurement_of = dict(zip(update.track_ids.tolist(), update.measurement_index.tolist(), strict=True))
-    feet_px = np.asarray(feet_px, dtype=float).reshape(-1, 2)[
-        [measurement_of[track_id] for track_id in update.tracks.ids[new_rows].tolist()]
-    ]
-    predicted_px, _ = predicted_feet_px(camera, pose, lost.mean)
-    C = observation_matrix(camera, pose, lost.mean)
-    S = kalman.innovation_covariance(lost.covariance, C, V)
-    gate = student_t_gate(parameters.gate_probability, parameters.noise_dof)
-    pairable = gate_in_front(camera, pose, lost.mean, lost.covariance, gate)
-    lost_index, new_index = associate(predicted_px, pairable, S, feet_px, gate, "likelihood")
+    tracks = update.tracks
+    position_m, covariance_m2 = tracks.mean[new_rows, :2], tracks.covariance[new_rows, :2, :2]
+    lost_index, new_index, residual = associate_on_ground(
+        lost.mean, lost.covariance, position_m, covariance_m2, parameters.gate_probability, "likelihood"
+    )
     if len(lost_index) == 0:
         return update, lost
     rows = new_rows[new_index]
-    mean, covariance = kalman.update(
-        lost.mean[lost_index],
-        lost.covariance[lost_index],
-        feet_px[new_index] - predicted_px[lost_index],
-        C[lost_index],
-        V,
+    mean, covariance = kalman.update_position(
+        lost.mean[lost_index], lost.covariance[lost_index], residual[lost_index, new_index], covariance_m2[new_index]
     )
-    tracks = update.tracks
     ids, hits = tracks.ids.copy(), tracks.hits.copy()
     revived_id = dict(zip(ids[rows].tolist(), lost.ids[lost_index].tolist(), strict=True))
     ids[rows], hits[rows] = lost.ids[lost_index], lost.hits[lost_index] + 1

@@ -45,12 +45,11 @@ from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 
 import numpy as np
-from scipy.stats import chi2
 
 from ptztrack.geometry.ptz import PTZCamera, inside_image, pose_noise_px2
 from ptztrack.roles import ImageSource
 from ptztrack.track import jpdaf, kalman
-from ptztrack.track.association import assign_gated, associate, gated_innovations, student_t_gate
+from ptztrack.track.association import associate, associate_on_ground, gated_innovations, student_t_gate
 from ptztrack.track.evidence import birth_exposure, paired_innovations, tracker_evidence
 from ptztrack.track.lifecycle import (
     existence_after_detection,
@@ -183,11 +182,12 @@ def update_tracks_on_ground(
     occupancy map's modes, :mod:`ptztrack.occupancy.lpom`), the tracker's step after prediction.
 
     position_m : (K, 2) measured positions; covariance_m2 : (K, 2, 2) their noise ``R``. The
-    observation is linear, ``z = [I 0] x + r``; association is the Hungarian assignment on the
-    Mahalanobis distance with innovation covariance ``P_xy + R_k`` per pair, gated as in
-    :func:`update_tracks`, and an unassigned measurement starts a track with ``R_k`` as its position
-    covariance and ``existence_at_birth``. Fixed cameras watch every track: an undetected track
-    loses existence as in :func:`update_tracks`, with ``detectable`` (scalar or (n,)) the probability
+    observation is linear, ``z = [I 0] x + r``; association is the Hungarian assignment on
+    ``association_cost`` with innovation covariance ``P_xy + R_k`` per pair, gated as in
+    :func:`update_tracks` (:func:`~ptztrack.track.association.associate_on_ground`), and an unassigned
+    measurement starts a track with ``R_k`` as its position covariance and ``existence_at_birth``. Fixed
+    cameras watch every track: an undetected track loses existence as in :func:`update_tracks`, with
+    ``detectable`` (scalar or (n,)) the probability
     that the map finds each track's person were it there. Only the Hungarian association is available.
     """
     if parameters.association != "hungarian":
@@ -196,18 +196,19 @@ def update_tracks_on_ground(
         )
     position_m = np.asarray(position_m, dtype=float).reshape(-1, 2)
     covariance_m2 = np.asarray(covariance_m2, dtype=float).reshape(-1, 2, 2)
-    C = np.broadcast_to(np.eye(2, 4), (len(tracks), 2, 4))
-    residual = position_m[None, :, :] - tracks.mean[:, None, :2]
-    S = tracks.covariance[:, None, :2, :2] + covariance_m2[None, :, :, :]
-    distance2 = np.einsum("tki,tkij,tkj->tk", residual, np.linalg.inv(S), residual)
-    allowed = distance2 <= chi2.ppf(parameters.gate_probability, df=2)
-    track_index, measurement_index = assign_gated(distance2, allowed)
+    track_index, measurement_index, residual = associate_on_ground(
+        tracks.mean,
+        tracks.covariance,
+        position_m,
+        covariance_m2,
+        parameters.gate_probability,
+        parameters.association_cost,
+    )
     mean, covariance = tracks.mean.copy(), tracks.covariance.copy()
-    mean[track_index], covariance[track_index] = kalman.update(
+    mean[track_index], covariance[track_index] = kalman.update_position(
         tracks.mean[track_index],
         tracks.covariance[track_index],
         residual[track_index, measurement_index],
-        C[track_index],
         covariance_m2[measurement_index],
     )
     survivors, keep = _after_update(
@@ -372,7 +373,7 @@ class EkfTracker:
             bias_px = bias.estimate()
             detections = replace(detections, feet_px=detections.feet_px - bias_px)
         update = update_tracks(tracks, detections.feet_px, self.camera, pose, V, parameters, looked)
-        update, lost = revived(update, tracks.next_id, self.lost, detections.feet_px, self.camera, pose, V, parameters)
+        update, lost = revived(update, tracks.next_id, self.lost, parameters)
         lost = kept_lost(lost, tracks.select(~np.isin(tracks.ids, update.tracks.ids)), parameters)
         if self.area_polygon_m is not None:
             update = replace(update, tracks=self._within_area(update.tracks))
