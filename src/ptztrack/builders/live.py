@@ -2,9 +2,10 @@
 episode that the run metrics score (against a virtual camera's truth log,
 :mod:`ptztrack.builders.virtual_camera`)."""
 
-from collections.abc import Callable, Sequence
-from dataclasses import replace
-from typing import TYPE_CHECKING, cast, get_args
+from collections.abc import Callable, Iterator, Sequence
+from contextlib import contextmanager
+from dataclasses import dataclass, replace
+from typing import cast, get_args
 
 import cv2
 import numpy as np
@@ -31,9 +32,6 @@ from ptztrack.roles import NetworkPolicy, NetworkTracker, Policy
 from ptztrack.track.tracker import tracks_ahead
 from ptztrack.types import GroundTruth
 from ptztrack.view.video import RenderView
-
-if TYPE_CHECKING:
-    pass
 
 
 def shown_steps(truth_log, times_s) -> np.ndarray:
@@ -186,44 +184,80 @@ def run_live_episode(
     if len(calibrations) != len(addresses) or not addresses:
         raise ValueError(f"{len(addresses)} camera addresses with {len(calibrations)} calibrations")
     check_pose_source(calibrations, pose_source)
+    network = live_network(scenario, calibrations, policy, seed, coordination)
+    with connected_cameras(addresses, calibrations, network.worlds, timeout_s, transport, pose_source) as cameras:
+        observer = None if observe is None else observe(network.worlds, network.shown)
+        live = run_live_network(
+            network.worlds, network.policy, network.tracker, cameras, steps, time_scale, seed, observer,
+            keep_images, plan_ahead_of(scenario),
+        )  # fmt: skip
+    return network.worlds, live
+
+
+@dataclass(frozen=True)
+class LiveNetwork:
+    """What a live run decides and tracks with: every camera's world, the network's policy and belief,
+    and ``shown``, the policy a view draws (the camera's own for one camera, the network's for several)."""
+
+    worlds: list[World]
+    policy: NetworkPolicy
+    tracker: NetworkTracker
+    shown: Policy | NetworkInformationPolicy
+
+
+def live_network(
+    scenario: Scenario,
+    calibrations: Sequence[CameraCalibrationFile],
+    policy: str,
+    seed: int,
+    coordination: Coordination = "joint",
+) -> LiveNetwork:
+    """The worlds, policy and belief of a live run of the cameras of ``calibrations``, warmed up
+    (:func:`~ptztrack.loop.live.warm_up`), as :func:`run_live_episode` describes them."""
     # The first camera's detector model draws from the one-camera run's stream, every other from its own.
     model_seed = episode_streams(seed).detector_model
-    model_seeds = [model_seed, *model_seed.spawn(len(addresses) - 1)]
+    model_seeds = [model_seed, *model_seed.spawn(len(calibrations) - 1)]
     worlds = [
         live_world(scenario, calibration, seed, camera_seed)
         for calibration, camera_seed in zip(calibrations, model_seeds, strict=True)
     ]
-    shown: Policy | NetworkInformationPolicy
     if len(worlds) == 1:
         shown = make_policy(policy, scenario, worlds[0])
         alone = make_tracker(None, scenario, worlds[0])
         warm_up(worlds[0], shown, alone)
-        network_policy: NetworkPolicy = AlonePolicy(shown)
-        tracker: NetworkTracker = AloneTracker(alone)
-    elif isinstance(policy, str) and policy in get_args(InformationMethod):
-        method = cast(InformationMethod, policy)
-        shown = policy_of_cameras([(scenario, world, False) for world in worlds], coordination, method)
-        belief = belief_of_cameras([(scenario, world) for world in worlds])
-        for world, member, updater in zip(worlds, shown.cameras, belief.cameras, strict=True):
-            warm_up(world, member.policy, updater)
-        network_policy, tracker = shown, belief
-    else:
+        return LiveNetwork(worlds, AlonePolicy(shown), AloneTracker(alone), shown)
+    if not (isinstance(policy, str) and policy in get_args(InformationMethod)):
         raise ValueError(f"a network of cameras decides by intg or smpl, not {policy}")
+    method = cast(InformationMethod, policy)
+    network_policy = policy_of_cameras([(scenario, world, False) for world in worlds], coordination, method)
+    belief = belief_of_cameras([(scenario, world) for world in worlds])
+    for world, member, updater in zip(worlds, network_policy.cameras, belief.cameras, strict=True):
+        warm_up(world, member.policy, updater)
+    return LiveNetwork(worlds, network_policy, belief, network_policy)
+
+
+@contextmanager
+def connected_cameras(
+    addresses: Sequence[CameraAddress],
+    calibrations: Sequence[CameraCalibrationFile],
+    worlds: Sequence[World],
+    timeout_s: float = 5.0,
+    transport: str = "tcp",
+    pose_source: PoseSource = "status",
+) -> Iterator[list[LiveONVIFCamera]]:
+    """The live cameras at ``addresses`` (each with its calibration and world, in the same order),
+    connected and started; a :class:`CameraError` if one cannot be used. All are closed when the block
+    ends (Ctrl-C included)."""
     cameras: list[LiveONVIFCamera] = []
     try:
         # Each camera starts as soon as it is connected, so that one that cannot be is closed with the others.
         for address, calibration, world in zip(addresses, calibrations, worlds, strict=True):
             cameras.append(_live_camera(address, calibration, timeout_s, transport, world, pose_source))
             cameras[-1].start()
-        observer = None if observe is None else observe(worlds, shown)
-        live = run_live_network(
-            worlds, network_policy, tracker, cameras, steps, time_scale, seed, observer, keep_images,
-            plan_ahead_of(scenario),
-        )  # fmt: skip
+        yield cameras
     finally:
         for camera in cameras:
             camera.close()
-    return worlds, live
 
 
 def offline_counterpart(scenario: Scenario, world: World, live: LiveEpisode, truth_log) -> Scenario:

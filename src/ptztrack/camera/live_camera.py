@@ -87,7 +87,9 @@ class LiveONVIFCamera:
     image_delay_s : how much older than its arrival a picture is; transport : RTSP over 'tcp' or 'udp'.
     sweep : place the camera by its pictures (module docstring; ``timeline`` a RegisteredTimeline and
     ``spaces`` in world degrees), None to ask GetStatus.
-    ``frames.latest`` holds the newest picture; ``failures`` counts the calls that failed;
+    ``frames.latest`` holds the newest picture; ``failures`` counts the calls that failed (each an
+    outage), ``reconnects`` the connections made again after one; ``away_since_s`` is the epoch second
+    the camera was lost (None while connected) and ``lost_because`` the failure's one line;
     ``registration`` is the pictures' registration once swept.
     """
 
@@ -114,7 +116,9 @@ class LiveONVIFCamera:
         self.transport, self.poll_s, self._clock = transport, poll_s, clock
         self.client: ONVIFClient | None = connect()
         self.frames = FrameStream(self._open_pictures, image_delay_s)
-        self.failures = 0
+        self.failures, self.reconnects = 0, 0
+        self.away_since_s: float | None = None
+        self.lost_because = ""
         self._lock = threading.Lock()
         self._wake, self._stopping = threading.Event(), threading.Event()
         self._pending: np.ndarray | None = None
@@ -283,6 +287,8 @@ class LiveONVIFCamera:
             self._retry_s = min(2 * self._retry_s, LONGEST_RETRY_S)
             return None
         log.warning("camera back after %.1f s", self._clock() - self._lost_at)
+        self.reconnects += 1
+        self.away_since_s = None
         self._retry_s = FIRST_RETRY_S
         with self._lock:
             self._pending = self._last_target  # the target the camera may not have had
@@ -290,6 +296,7 @@ class LiveONVIFCamera:
 
     def _lose(self, error: CameraError) -> None:
         self.failures += 1
+        self.away_since_s, self.lost_because = time.time(), str(error)
         log.warning("camera lost (%s); the tracker runs on predictions, retrying in %.1f s", error, self._retry_s)
         client, self.client = self.client, None
         if client is not None:

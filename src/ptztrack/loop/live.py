@@ -72,6 +72,9 @@ IDLE_WAIT_S = 0.5
 DETECTOR_DUTY_INVERSE = 2.0
 
 
+RowSink = Callable[[int, dict], None]
+"""``sink(camera, row)``: a picture's row of a live run, handed over as it is made (camera: its index)."""
+
 PlanAhead = Callable[[Tracks, float], Tracks]
 """``plan_ahead(tracks, seconds)``: the tracks a live policy plans on, from the belief's and the scenario
 seconds since the capture of the picture the decision is made on."""
@@ -224,6 +227,8 @@ def run_live_network(
     observer: StepObserver | None = None,
     keep_images: bool = False,
     plan_ahead: PlanAhead | None = None,
+    sink: RowSink | None = None,
+    stop: threading.Event | None = None,
 ) -> tuple[LiveEpisode, ...]:
     """Drive every camera of ``cameras``, each deciding in its world of ``worlds`` (in the same order; a
     network's :attr:`ptztrack.loop.simulated.NetworkWorld.cameras`), with one ground belief: use at most
@@ -241,6 +246,11 @@ def run_live_network(
     ``plan_ahead(tracks, seconds)``, the tracks the policy plans on, given the belief's and the scenario
     seconds since the capture of the picture decided on (None: the belief's as they are); the rest as
     :func:`run_live`.
+
+    sink : ``sink(camera, row)`` is handed every picture's row (the :class:`LiveEpisode` fields of one
+    picture, after the decision that followed it) instead of keeping it: the episodes returned are then
+    empty, and a run of unbounded ``steps`` holds no history. stop : the run ends, as Ctrl-C ends it,
+    once this is set (within IDLE_WAIT_S and a picture's tracking).
     """
     streams = episode_streams(seed)
     policy_rng = np.random.default_rng(streams.policy)
@@ -275,7 +285,7 @@ def run_live_network(
     last_time_s: float | None = None
     last_decided_s: float | None = None
     try:
-        while used < steps:
+        while used < steps and not (stop is not None and stop.is_set()):
             try:
                 item = detected.get(timeout=IDLE_WAIT_S)
             except queue.Empty:
@@ -332,7 +342,10 @@ def run_live_network(
                 observer(
                     used, contexts[index], {**row, "actions": actions[index], "image": frame.image, "camera": index}
                 )
-            rows[index].append(row)
+            if sink is None:
+                rows[index].append(row)
+            else:
+                sink(index, row)
             used += 1
     except KeyboardInterrupt:
         pass  # the rows recorded whole so far are the run
