@@ -21,13 +21,13 @@ import contextlib
 import json
 import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from importlib import resources
 
 import uvicorn
 from starlette.applications import Starlette
 from starlette.responses import HTMLResponse
-from starlette.routing import Route, WebSocketRoute
+from starlette.routing import BaseRoute, Route, WebSocketRoute
 from starlette.websockets import WebSocket, WebSocketDisconnect
 
 from ptztrack.names import LOOPBACK
@@ -172,8 +172,9 @@ def page_html() -> str:
     return resources.files("ptztrack.view").joinpath("web/index.html").read_text(encoding="utf-8")
 
 
-def view_app(hub: ViewHub) -> Starlette:
-    """The page at ``/`` and the state's WebSocket at ``/ws``."""
+def view_app(hub: ViewHub, routes: Sequence[BaseRoute] = ()) -> Starlette:
+    """The page at ``/`` and the state's WebSocket at ``/ws``, and ``routes`` beside them (a service's
+    health, say)."""
     html = page_html()
 
     async def index(request) -> HTMLResponse:
@@ -217,7 +218,7 @@ def view_app(hub: ViewHub) -> Starlette:
             receiving.cancel()
             hub.page_closed(page)
 
-    return Starlette(routes=[Route("/", index), WebSocketRoute("/ws", socket)])
+    return Starlette(routes=[Route("/", index), WebSocketRoute("/ws", socket), *routes])
 
 
 async def _receive_commands(websocket: WebSocket, hub: ViewHub) -> None:
@@ -237,12 +238,13 @@ async def _receive_commands(websocket: WebSocket, hub: ViewHub) -> None:
 class ViewServer:
     """uvicorn serving :func:`view_app` on 127.0.0.1 in a background thread (a context manager).
 
-    port : 0 for any free port; ``address`` is the page's URL once started.
+    port : 0 for any free port; ``address`` is the page's URL once started; routes : served beside the
+    view (:func:`view_app`).
     """
 
-    def __init__(self, hub: ViewHub, port: int = 0):
+    def __init__(self, hub: ViewHub, port: int = 0, routes: Sequence[BaseRoute] = ()):
         self.hub = hub
-        config = uvicorn.Config(view_app(hub), host=HOST, port=port, log_level="warning", lifespan="off")
+        config = uvicorn.Config(view_app(hub, routes), host=HOST, port=port, log_level="warning", lifespan="off")
         self._server = uvicorn.Server(config)
         self._thread = threading.Thread(target=self._server.run, name="ptztrack-view", daemon=True)
 
