@@ -1,5 +1,5 @@
 """The command line's arguments of the real and virtual cameras: ``ptztrack live``, ``ptztrack camera
-calibrate`` and ``ptztrack serve-camera``.
+calibrate``, ``ptztrack serve-camera`` and ``ptztrack serve``.
 """
 
 from pathlib import Path
@@ -141,3 +141,11 @@ def add_camera_commands(commands, policies: list[str]) -> None:
         "--geometry-seed", type=non_negative_int, help="a true mapping drawn from this seed, not told to clients"
     )
     serve.set_defaults(handler="ptztrack.cli.camera:serve_camera_command")
+
+    service = commands.add_parser(
+        "serve",
+        help="run the cameras of a service configuration until SIGTERM or Ctrl-C: tracks to rotated files, "
+        "events as JSON lines and over MQTT, /healthz and /metrics (docs: ptztrack as a service)",
+    )
+    service.add_argument("config", type=Path, help="the service's YAML file (cameras, output, events, mqtt, ...)")
+    service.set_defaults(handler="ptztrack.cli.serve:serve_command")
