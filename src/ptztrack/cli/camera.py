@@ -66,7 +66,12 @@ def live_command(args: argparse.Namespace) -> int:
         return _live_network(args, scenario, calibrations, addresses, truth_log, steps)
     print(f"live: {args.policy} on {addresses[0]}, up to {steps} pictures, RTSP over {args.transport}")
     label = f"live {args.policy}"
-    with Watch(args.view, args.out is not None, lambda w, p: ViewState(w[0], p, steps, label, truth=False)) as watch:
+
+    def view(worlds, policy) -> ViewState:
+        return ViewState(worlds[0], policy, steps, label, truth=False)
+
+    # A camera's run never waits for a page: pages join and leave as they like.
+    with Watch(args.view, args.out is not None, view, hold=False) as watch:
         (world,), (live,) = run_live_episode(
             scenario, calibrations, addresses, args.policy, steps, args.time_scale, args.seed,
             timeout_s=args.timeout_s, transport=args.transport, keep_images=args.out is not None,
@@ -119,7 +124,7 @@ def _live_network(args, scenario, calibrations, addresses, truth_log, steps: int
             ]
         )
 
-    with Watch(args.view, args.out is not None, view) as watch:
+    with Watch(args.view, args.out is not None, view, hold=False) as watch:
         worlds, lives = run_live_episode(
             scenario, calibrations, addresses, args.policy, steps, args.time_scale, args.seed, args.coordination,
             args.timeout_s, args.transport, keep_images=args.out is not None, observe=watch.observe,

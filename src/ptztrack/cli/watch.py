@@ -17,20 +17,22 @@ class Watch:
     of the steps (``progress``; None: none).
 
     view : ``view(world, policy)`` gives the run's :class:`ViewState`.
+    hold : the run waits after its first step for a page to open it (a simulated run, to be watched from
+    its start); without, pages join and leave a run that never waits for them (a live camera's).
     """
 
-    def __init__(self, port: int | None, keep: bool, view, progress: Progress | None = None):
-        self.view, self.port, self.keep, self.progress = view, port, keep, progress
+    def __init__(self, port: int | None, keep: bool, view, progress: Progress | None = None, hold: bool = True):
+        self.view, self.port, self.keep, self.progress, self.hold = view, port, keep, progress, hold
         self.views: list[StepView] = []
         self.view_state: ViewState | None = None
-        # A run started with a view waits after its first step for a page to open it.
-        self.hub = None if port is None else ViewHub(paused=True, resume_on_connect=True)
+        self.hub = None if port is None else ViewHub(paused=hold, resume_on_connect=hold)
         self._server: ViewServer | None = None
 
     def __enter__(self) -> "Watch":
         if self.hub is not None and self.port is not None:
             self._server = ViewServer(self.hub, self.port).__enter__()
-            print(f"view at {self._server.address} (the run starts when a page opens it)", flush=True)
+            when = "the run starts when a page opens it" if self.hold else "pages may join and leave at any time"
+            print(f"view at {self._server.address} ({when})", flush=True)
         return self
 
     def __exit__(self, *failure) -> None:
