@@ -113,7 +113,8 @@ class EventOutlet:
         self._lock = threading.Lock()
         self.written, self.acknowledged, self.unpublished = 0, 0, 0
         self._sent = 0
-        self._acks = threading.Condition(self._lock)
+        # Apart from the writers' lock: paho calls on_publish holding its own lock, which publish takes.
+        self._acks = threading.Condition()
         self._file: TextIO = sys.stdout if events == "stdout" else open(Path(events), "a", encoding="utf-8")  # noqa: SIM115
         self._client = None if mqtt is None else self._connect(mqtt, client_id)
         self.prefix = "ptztrack" if mqtt is None else mqtt.topic_prefix
@@ -160,7 +161,9 @@ class EventOutlet:
             if self._client is None:
                 return
             # Kept by paho while the broker is away, and sent when it is back; refused when its queue is full.
-            if self._client.publish(topic, message, qos=1).rc == self._queue_full:
+            refused = self._client.publish(topic, message, qos=1).rc == self._queue_full
+        with self._acks:
+            if refused:
                 self.unpublished += 1
             else:
                 self._sent += 1
