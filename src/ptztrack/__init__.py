@@ -1,7 +1,8 @@
 """ptztrack: multi-person tracking with cameras that move.
 
 The public API is flat: ``from ptztrack import run_episode, scenario_from_dict``. One runner per mode,
-each with one camera or many: ``run_episode`` (simulated) and ``run_live_episode`` (live cameras).
+each with one camera or many: ``run_episode`` (simulated) and ``run_live_episode`` (live cameras); and
+``serve`` (with ``load_service_config``), the cameras of a service until stopped.
 Names are imported on first use (from the modules named relative to this package), so
 ``import ptztrack`` stays cheap.
 
@@ -62,6 +63,8 @@ _HOME = {
     "network_world": ".builders.network",
     "run_episode": ".builders.episode",
     "run_live_episode": ".builders.live",
+    "serve": ".service",
+    "load_service_config": ".service",
     "network_metrics": ".evaluate.metrics",
     "Cell": ".experiments.cells",
     "synthetic_cells": ".experiments.ptz_tables",
@@ -97,6 +100,7 @@ if TYPE_CHECKING:
     from .registry import names as registered_names
     from .registry import register
     from .roles import CameraBackend, Detector, Policy, Tracker
+    from .service import load_service_config, serve
     from .types import DecisionContext, Detections, GroundTruth, PeopleInView, Tracks, TrackUpdate
 
 

@@ -161,11 +161,11 @@ def run_camera(
     def save_model() -> None:
         if isinstance(model, OnlineDetectorModel):
             model.save(model_path)
-            health.model_trials = model_trials(model)
 
     def sink(index: int, row: dict) -> None:
         nonlocal next_save_s
         health.stepped(row["capture_time_s"])
+        health.model_trials = model_trials(model)
         files.append(row)
         events.step(row["capture_time_s"], row["tracks"])
         if time.monotonic() >= next_save_s:  # on the loop's thread: the model is not changing meanwhile
