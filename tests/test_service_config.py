@@ -22,8 +22,8 @@ def test_a_minimal_file_takes_the_defaults_and_its_paths_are_beside_it(tmp_path)
     path = _written(tmp_path, CAMERA + "output: out\nevents: events.jsonl\nmqtt: {port: 1884}\n")
     config = load_service_config(path)
     (camera,) = config.cameras
-    assert (camera.name, camera.policy, camera.detector, camera.calibration, camera.scenario) == (
-        "front", "smpl", "hog", "virtual", "pets"
+    assert (camera.name, camera.policy, camera.detector, camera.calibration, camera.scenario, camera.pose) == (
+        "front", "smpl", "hog", "virtual", "pets", "status"
     )  # fmt: skip
     assert config.output == str(tmp_path / "out") and config.events == str(tmp_path / "events.jsonl")
     assert config.mqtt is not None and (config.mqtt.host, config.mqtt.port) == ("127.0.0.1", 1884)
@@ -38,6 +38,7 @@ def test_a_minimal_file_takes_the_defaults_and_its_paths_are_beside_it(tmp_path)
         (CAMERA + "  - name: front\n    url: onvif://h\n", "front appears more than once"),
         (CAMERA + "    adress: x\n", "cameras.0.adress: unknown key"),
         (CAMERA + "    policy: best\n", "cameras.0.policy: expected one of"),
+        (CAMERA + "    transport: quic\n", "cameras.0.transport: Input should be 'tcp' or 'udp' (got 'quic')"),
         (CAMERA + "mqtt: {port: 70000}\n", "mqtt.port: Input should be less than or equal to 65535 (got 70000)"),
         (CAMERA + "mqtt: {topic_prefix: a/#}\n", "mqtt.topic_prefix: String should match pattern"),
         (CAMERA + "rotate_s: 0\n", "rotate_s: Input should be greater than 0 (got 0)"),

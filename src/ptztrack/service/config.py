@@ -6,7 +6,7 @@ the file's folder unless absolute.
 """
 
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Literal
 
 import pydantic
 from pydantic import Field, model_validator
@@ -29,7 +29,9 @@ class ServiceCamera(_Strict):
     (``ptztrack camera calibrate``), or 'virtual' for ``serve-camera``'s; policy, detector : registered
     names; scenario : 'pets' (built in) or a scenario YAML, what the camera looks at (its grid, area,
     tracker); time_scale : the scenario's seconds per wall-clock second (1 for a real camera); seed :
-    the seed of every random draw of the camera's loop.
+    the seed of every random draw of the camera's loop; pose : the camera's pose from GetStatus
+    ('status') or registered from its pictures ('registered', as ``ptztrack live --pose``); transport :
+    RTSP over 'tcp' or 'udp'.
     """
 
     name: _Name
@@ -40,6 +42,8 @@ class ServiceCamera(_Strict):
     scenario: str = "pets"
     time_scale: Annotated[PositiveFloat, at_most(100, "times the wall clock")] = 1.0
     seed: Annotated[int, Field(ge=0)] = 0
+    pose: Literal["status", "registered"] = "status"
+    transport: Literal["tcp", "udp"] = "tcp"
 
 
 class MQTTSection(_Strict):

@@ -16,6 +16,7 @@ start is tried again with the same backoff. Setting ``stop`` ends every loop; ea
 then closed whole, its model saved and its tracks' 'end' events emitted.
 """
 
+import contextlib
 import logging
 import sys
 import threading
@@ -26,6 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from ptztrack.builders.live import connected_cameras, live_network, plan_ahead_of
+from ptztrack.builders.live_registered import check_pose_source
 from ptztrack.builders.recording import pets_scenario
 from ptztrack.builders.virtual_camera import virtual_calibration
 from ptztrack.camera.live_camera import FIRST_RETRY_S, LONGEST_RETRY_S, LiveONVIFCamera
@@ -79,37 +81,34 @@ def serve(config: ServiceConfig, stop: threading.Event, started: Callable[[str],
     healths = [CameraHealth(camera.name) for camera in config.cameras]
     hub = ViewHub()
     failures: list[BaseException] = []
-    with EventOutlet(config.events, config.mqtt) as outlet:
-        server = None if config.http_port is None else ViewServer(hub, config.http_port, health_routes(healths))
-        if server is not None:
-            server.__enter__()
+    with contextlib.ExitStack() as stack:
+        outlet = stack.enter_context(EventOutlet(config.events, config.mqtt))
+        server = None
+        if config.http_port is not None:
+            server = stack.enter_context(ViewServer(hub, config.http_port, health_routes(healths)))
+        threads = [
+            threading.Thread(
+                target=_camera_thread,
+                args=(camera, config, health, outlet, hub if number == 0 else None, stop, failures),
+                name=f"serve-{camera.name}",
+                daemon=True,  # a camera's close that hangs past the stop's wait does not hold the process
+            )
+            for number, (camera, health) in enumerate(zip(config.cameras, healths, strict=True))
+        ]
+        for thread in threads:
+            thread.start()
+        where = "" if server is None else f"; health at {server.address}healthz, metrics at {server.address}metrics"
+        started(f"serving {len(config.cameras)} camera{'s' if len(config.cameras) > 1 else ''}{where}")
         try:
-            threads = [
-                threading.Thread(
-                    target=_camera_thread,
-                    args=(camera, config, health, outlet, hub if number == 0 else None, stop, failures),
-                    name=f"serve-{camera.name}",
-                    daemon=True,  # a camera's close that hangs past the stop's wait does not hold the process
-                )
-                for number, (camera, health) in enumerate(zip(config.cameras, healths, strict=True))
-            ]
-            for thread in threads:
-                thread.start()
-            where = "" if server is None else f"; health at {server.address}healthz, metrics at {server.address}metrics"
-            started(f"serving {len(config.cameras)} camera{'s' if len(config.cameras) > 1 else ''}{where}")
-            try:
-                while not stop.wait(0.2) and not failures:
-                    pass
-            except KeyboardInterrupt:
+            while not stop.wait(0.2) and not failures:
                 pass
-            stop.set()
-            # Each camera's files are closed whole once its status is 'stopped' (its camera may still be closing).
-            deadline_s = time.monotonic() + STOP_WAIT_S
-            while any(health.status != "stopped" for health in healths) and time.monotonic() < deadline_s:
-                time.sleep(0.02)
-        finally:
-            if server is not None:
-                server.__exit__(None, None, None)
+        except KeyboardInterrupt:
+            pass
+        stop.set()
+        # Each camera's files are closed whole once its status is 'stopped' (its camera may still be closing).
+        deadline_s = time.monotonic() + STOP_WAIT_S
+        while any(health.status != "stopped" for health in healths) and time.monotonic() < deadline_s:
+            time.sleep(0.02)
     if failures:
         raise failures[0]
     return healths
@@ -141,6 +140,7 @@ def run_camera(
     calibration = (
         virtual_calibration() if camera.calibration == "virtual" else load_camera_calibration(camera.calibration)
     )
+    check_pose_source([calibration], camera.pose)
     address = camera_address(camera.url)
     network = live_network(scenario, [calibration], camera.policy, camera.seed)
     (world,) = network.worlds
@@ -181,7 +181,10 @@ def run_camera(
         retry_s = FIRST_RETRY_S
         while not stop.is_set():
             try:
-                with connected_cameras([address], [calibration], network.worlds, CALL_TIMEOUT_S) as cameras:
+                connected = connected_cameras(
+                    [address], [calibration], network.worlds, CALL_TIMEOUT_S, camera.transport, camera.pose
+                )
+                with connected as cameras:
                     health.status = "running"
                     watcher = threading.Thread(
                         target=_watch, args=(camera.name, cameras[0], health, counted, stop), daemon=True
