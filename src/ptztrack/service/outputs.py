@@ -103,10 +103,6 @@ class TrackFiles:
         mot.write(mot_lines(self._frame, tracks))
         jsonl.write(json.dumps(record, separators=(",", ":")) + "\n")
 
-    def flush(self) -> None:
-        for file in self._files:
-            file.flush()
-
     def close(self) -> None:
         """Close the current period's files and rename them whole."""
         for file, path in zip(self._files, self._paths, strict=True):

@@ -12,7 +12,8 @@ A camera that goes away is reconnected by the camera itself, with backoff
 (:class:`ptztrack.camera.live_camera.LiveONVIFCamera`): the loop goes on with the same belief and
 detector model, and uses no pictures meanwhile. A watcher per camera logs one line when it is lost and
 one when it is back, and emits 'offline' and 'online' events. A camera that cannot be reached at the
-start is tried again with the same backoff. Setting ``stop`` ends every loop; each camera's files are
+start is tried again with the same backoff, one line and an 'offline' event at the first try, one line
+and an 'online' event once it answers. Setting ``stop`` ends every loop; each camera's files are
 then closed whole, its model saved and its tracks' 'end' events emitted.
 """
 
@@ -185,6 +186,9 @@ def run_camera(
                     [address], [calibration], network.worlds, CALL_TIMEOUT_S, camera.transport, camera.pose
                 )
                 with connected as cameras:
+                    if health.status == "offline":
+                        log.warning("camera %s answers; running", camera.name)
+                        counted("status", _status("online", camera.name, time.time(), "", cameras[0]))
                     health.status = "running"
                     watcher = threading.Thread(
                         target=_watch, args=(camera.name, cameras[0], health, counted, stop), daemon=True
@@ -198,8 +202,9 @@ def run_camera(
                     health.status = "stopped"
                 return
             except CameraError as error:
-                if health.status != "offline":
+                if health.status != "offline":  # one line and one event until it answers
                     log.warning("camera %s unreachable (%s); trying again with backoff", camera.name, error)
+                    counted("status", _status("offline", camera.name, time.time(), str(error)))
                 health.status = "offline"
                 stop.wait(retry_s)
                 retry_s = min(2 * retry_s, LONGEST_RETRY_S)
@@ -227,20 +232,22 @@ def _watch(name: str, camera: LiveONVIFCamera, health: CameraHealth, emit, stop:
             log.warning(
                 "camera %s lost (%s); tracking on predictions, reconnecting with backoff", name, camera.lost_because
             )
-            emit("status", _status("offline", name, camera.away_since_s or time.time(), camera, camera.lost_because))
+            emit("status", _status("offline", name, camera.away_since_s or time.time(), camera.lost_because, camera))
         if camera.reconnects > reconnects:
             reconnects = health.reconnects = camera.reconnects
             health.status = "running"
             log.warning("camera %s back (reconnect %d)", name, reconnects)
-            emit("status", _status("online", name, time.time(), camera, ""))
+            emit("status", _status("online", name, time.time(), "", camera))
 
 
-def _status(kind: str, name: str, time_s: float, camera: LiveONVIFCamera, reason: str) -> dict:
+def _status(kind: str, name: str, time_s: float, reason: str, camera: LiveONVIFCamera | None = None) -> dict:
+    """A status event of camera ``name``: 'offline' (with the reason) or 'online', and the connected
+    ``camera``'s outages and reconnects so far (none before it was first connected)."""
     return {
         "type": kind,
         "camera": name,
         "time_s": round(time_s, 6),
         "reason": reason,
-        "outages": camera.failures,
-        "reconnects": camera.reconnects,
+        "outages": 0 if camera is None else camera.failures,
+        "reconnects": 0 if camera is None else camera.reconnects,
     }
