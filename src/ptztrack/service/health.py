@@ -44,6 +44,11 @@ class CameraHealth:
             self.last_picture_s = capture_time_s
             self._recent_s.append(time.time())
 
+    def emitted(self) -> None:
+        """One more event (from the loop's thread or the camera's watcher)."""
+        with self._lock:
+            self.events += 1
+
     def steps_per_s(self, now_s: float) -> float:
         """Pictures used per second over the last RATE_WINDOW_S."""
         with self._lock:

@@ -150,7 +150,7 @@ def run_camera(
     emit = outlet.emitter(camera.name)
 
     def counted(kind: str, payload: dict) -> None:
-        health.events += 1
+        health.emitted()
         emit(kind, payload)
 
     events = TrackEvents(
