@@ -26,6 +26,7 @@ from ptztrack.geometry.area import bounds_m
 from ptztrack.geometry.ptz import ground_footprint
 from ptztrack.loop.steps import Episode
 from ptztrack.track.observation import ground_points
+from ptztrack.types import Tracks
 from ptztrack.view.video import RenderView, write_episode_video
 
 TRACK_COLUMNS = ("frame", "id", "x_m", "y_m", "vx_m_s", "vy_m_s", "var_x_m2", "cov_xy_m2", "var_y_m2")
@@ -107,14 +108,18 @@ def detections_csv(episode: Episode) -> bytes:
     return _csv(DETECTION_COLUMNS, rows)
 
 
-def tracks_mot(episode: Episode) -> bytes:
-    """The reported tracks in the MOTChallenge layout, one row per track and step, no header."""
-    rows = (
-        [step + 1, int(track_id), -1, -1, -1, -1, 1, _exact(mean[0]), _exact(mean[1]), 0]
-        for step, tracks in enumerate(episode.tracks)
+def mot_rows(frame: int, tracks: Tracks) -> list[list]:
+    """One picture's tracks as MOTChallenge rows (``frame, id, -1, -1, -1, -1, 1, x_m, y_m, 0``), the
+    positions exact."""
+    return [
+        [frame, int(track_id), -1, -1, -1, -1, 1, _exact(mean[0]), _exact(mean[1]), 0]
         for track_id, mean in zip(tracks.ids, tracks.mean, strict=True)
-    )
-    return _csv((), rows)
+    ]
+
+
+def tracks_mot(episode: Episode) -> bytes:
+    """The reported tracks in the MOTChallenge layout, one row per track and step (from 1), no header."""
+    return _csv((), (row for step, tracks in enumerate(episode.tracks) for row in mot_rows(step + 1, tracks)))
 
 
 def truth_mot(episode: Episode) -> bytes:

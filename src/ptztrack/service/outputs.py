@@ -16,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ptztrack.evaluate.report import mot_rows
 from ptztrack.types import Tracks
 
 PART = ".part"
@@ -28,12 +29,9 @@ def _stamp(time_s: float) -> str:
 
 
 def mot_lines(frame: int, tracks: Tracks) -> str:
-    """The tracks of one picture as MOTChallenge rows, in the columns of a run folder's tracks_mot.txt
-    (:data:`ptztrack.evaluate.report.MOT_COLUMNS`), positions exact (the float's repr)."""
-    return "".join(
-        f"{frame},{int(track_id)},-1,-1,-1,-1,1,{float(mean[0])!r},{float(mean[1])!r},0\n"
-        for track_id, mean in zip(tracks.ids, tracks.mean, strict=True)
-    )
+    """The tracks of one picture as the lines of a run folder's tracks_mot.txt
+    (:func:`ptztrack.evaluate.report.mot_rows`)."""
+    return "".join(",".join(map(str, row)) + "\n" for row in mot_rows(frame, tracks))
 
 
 def track_states(tracks: Tracks) -> list[dict]:
