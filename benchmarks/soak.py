@@ -1,8 +1,9 @@
 """A long run as `ptztrack run --frames N --out DIR` makes it: identities, memory and the time to write.
 
 Runs the scenario (the default synthetic scene, ``smpl``) for ``--frames`` steps in this process, as
-``ptztrack run`` does, sampling the process's resident memory every ``--rss-every`` steps, then writes
-the run's folder as ``ptztrack run --out`` does and times it. It prints and writes (``--json``):
+``ptztrack run --out`` does (watched as it watches, keeping the view states its folder gets), sampling
+the process's resident memory every ``--rss-every`` steps, then writes the run's folder as it does and
+times it. It prints and writes (``--json``):
 
 - ``idf1``, ``mota``, ``id_switches_per_100_steps`` over the run;
 - ``switches_first_2000`` and ``switches_last_2000``: the identity switches of the run's first and
@@ -20,14 +21,16 @@ the run's folder as ``ptztrack run --out`` does and times it. It prints and writ
 import argparse
 import tempfile
 import time
+from functools import partial
 from pathlib import Path
 
 import numpy as np
 import psutil
 
 from ptztrack.builders.episode import episode_world, make_policy, run_episode
-from ptztrack.cli.run import DETECTOR_MODEL_FILE
+from ptztrack.cli.run import DETECTOR_MODEL_FILE, run_view
 from ptztrack.cli.scenario import build_scenario
+from ptztrack.cli.watch import Watch
 from ptztrack.evaluate.metrics import clear_metrics, episode_metrics, metric_accumulator
 from ptztrack.evaluate.report import write_outputs
 from ptztrack.files import run_folder, write_json
@@ -74,25 +77,30 @@ def main() -> None:
     world = episode_world(scenario, args.seed)
     policy = make_policy(args.policy, scenario, world)
     process, rss_mb_at = psutil.Process(), {}
-    progress = Progress("step", quiet=False)
+    # As `ptztrack run --out` watches its run: the view states it keeps for the folder, a progress bar.
+    watch = Watch(None, True, partial(run_view, label=args.policy), Progress("step", quiet=False))
 
-    def observe(step, context, row) -> None:
-        if (step + 1) % args.rss_every == 0:
-            rss_mb_at[step + 1] = process.memory_info().rss / 2**20
-        progress(step + 1, args.frames)
+    with watch:
+        watched = watch.observe(world, policy)
 
-    started_s = time.perf_counter()
-    episode = run_episode(scenario, policy, args.seed, world, observer=observe)
-    run_s = time.perf_counter() - started_s
+        def observe(step, context, row) -> None:
+            watched(step, context, row)
+            if (step + 1) % args.rss_every == 0:
+                rss_mb_at[step + 1] = process.memory_info().rss / 2**20
+
+        started_s = time.perf_counter()
+        episode = run_episode(scenario, policy, args.seed, world, observer=observe)
+        run_s = time.perf_counter() - started_s
     metrics = episode_metrics(episode)
     steps = len(episode.actions)
     with tempfile.TemporaryDirectory() as directory:
         started_s = time.perf_counter()
         with run_folder(Path(directory) / "run", overwrite=False) as folder:
             write_outputs(folder, episode, metrics, f"soak, {args.policy}, seed {args.seed}", view_renderer(world))
+            watch.write(folder)
             if world.detector_model is not None:
                 world.detector_model.save(folder / DETECTOR_MODEL_FILE)
-        write_s = time.perf_counter() - started_s
+    write_s = time.perf_counter() - started_s
     document = {
         "scenario": args.scenario,
         "policy": args.policy,

@@ -31,7 +31,7 @@ def run_command(args: argparse.Namespace) -> int:
     refuse_if_too_large(scenario, (args.policy,))
     world = episode_world(scenario, args.seed)
     policy = make_policy(args.policy, scenario, world)
-    watch = Watch(args.view, args.out is not None, partial(_run_view, label=args.policy), Progress("step", args.quiet))
+    watch = Watch(args.view, args.out is not None, partial(run_view, label=args.policy), Progress("step", args.quiet))
     with watch:
         episode = run_episode(scenario, policy, args.seed, world, observer=watch.observe(world, policy))
     metrics = episode_metrics(episode)
@@ -52,7 +52,7 @@ def run_command(args: argparse.Namespace) -> int:
     return 0
 
 
-def _run_view(world, policy, label: str) -> ViewState:
+def run_view(world, policy, label: str) -> ViewState:
     """The view of a run in ``world``: the backend's images (the synthetic scene's drawn), its grid."""
     return ViewState(world, policy, world.truth.positions_m.shape[0], label, view_renderer(world))
 

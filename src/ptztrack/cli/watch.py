@@ -1,20 +1,22 @@
 """What watches a run of ``run``, ``follow`` or ``live``: its web view, its view states, its progress bar."""
 
+from collections import deque
 from pathlib import Path
 
 from ptztrack.cli.interrupt import raise_if_interrupted
 from ptztrack.loop.executors import Progress
 from ptztrack.loop.steps import StepObserver
 from ptztrack.names import VIEW_STATES_FILE
+from ptztrack.view.video import VIDEO_MAX_STEPS
 from ptztrack.view.view_state import StepView, ViewState
 from ptztrack.view.web_view import ViewHub, ViewServer
 
 
 class Watch:
     """What watches a run of ``run``, ``follow`` or ``live``: the web view on 127.0.0.1:``port`` (None:
-    none; a context manager: the server runs inside the block), where ``keep``, every step's view
-    state, for the run folder's view_states.jsonl (what ``ptztrack view`` replays), and a progress bar
-    of the steps (``progress``; None: none).
+    none; a context manager: the server runs inside the block), where ``keep``, the view states of the
+    last ``VIDEO_MAX_STEPS`` steps (those of the run's video), for the run folder's view_states.jsonl
+    (what ``ptztrack view`` replays), and a progress bar of the steps (``progress``; None: none).
 
     view : ``view(world, policy)`` gives the run's :class:`ViewState`.
     hold : the run waits after its first step for a page to open it (a simulated run, to be watched from
@@ -23,7 +25,7 @@ class Watch:
 
     def __init__(self, port: int | None, keep: bool, view, progress: Progress | None = None, hold: bool = True):
         self.view, self.port, self.keep, self.progress, self.hold = view, port, keep, progress, hold
-        self.views: list[StepView] = []
+        self.views: deque[StepView] = deque(maxlen=VIDEO_MAX_STEPS)
         self.view_state: ViewState | None = None
         self.hub = None if port is None else ViewHub(paused=hold, resume_on_connect=hold)
         self._server: ViewServer | None = None

@@ -17,7 +17,7 @@ import base64
 import json
 import time
 from collections import deque
-from collections.abc import Iterable, Iterator, Sequence
+from collections.abc import Iterable, Iterator, MutableSequence, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -137,7 +137,7 @@ class ViewState:
             image=_jpeg(taken) if taken is not None else None,
         )
 
-    def observer(self, publish=None, keep: list[StepView] | None = None) -> StepObserver:
+    def observer(self, publish=None, keep: MutableSequence[StepView] | None = None) -> StepObserver:
         """The loop's observer: it counts every step, keeps each step's :class:`StepView` in ``keep``
         (for :meth:`write`) and hands each step to ``publish(step, last, take)`` (a live view's
         :meth:`ViewHub.after_step <ptztrack.view.web_view.ViewHub.after_step>`), which calls
@@ -266,7 +266,7 @@ class NetworkViewState:
         # Each camera's latest step, context and record: taken into a view only when a state is due.
         self._latest: list[tuple[int, DecisionContext, dict] | None] = [None] * len(self.cameras)
 
-    def observer(self, publish=None, keep: list[NetworkStepView] | None = None) -> StepObserver:
+    def observer(self, publish=None, keep: MutableSequence[NetworkStepView] | None = None) -> StepObserver:
         """The loop's observer, as :meth:`ViewState.observer`'s, over every camera's latest step."""
 
         def observe(step: int, context: DecisionContext, record: dict) -> None:
