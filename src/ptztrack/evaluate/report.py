@@ -17,6 +17,7 @@ from pathlib import Path
 
 import matplotlib
 import numpy as np
+from matplotlib.collections import PolyCollection
 from matplotlib.figure import Figure
 from matplotlib.patches import Polygon
 
@@ -27,7 +28,7 @@ from ptztrack.geometry.ptz import ground_footprint
 from ptztrack.loop.steps import Episode
 from ptztrack.track.observation import ground_points
 from ptztrack.types import Tracks
-from ptztrack.view.video import RenderView, write_episode_video
+from ptztrack.view.video import VIDEO_MAX_STEPS, RenderView, write_episode_video
 
 TRACK_COLUMNS = ("frame", "id", "x_m", "y_m", "vx_m_s", "vy_m_s", "var_x_m2", "cov_xy_m2", "var_y_m2")
 STEP_COLUMNS = (
@@ -156,20 +157,21 @@ def tracks_csv(episode: Episode) -> bytes:
 
 
 def episode_figure(episode: Episode, title: str = "") -> Figure:
-    """Ground-plane picture: true paths (grey), tracks (coloured by id), camera footprints over time (outlines)."""
+    """Ground-plane picture of the last ``VIDEO_MAX_STEPS`` steps (those of the run's video): true paths
+    (grey), tracks (coloured by id), camera footprints over time (outlines)."""
     figure = Figure(figsize=(7, 7))
     axes = figure.add_subplot()
     camera = episode.camera
-    footprints = ground_footprint(camera, episode.poses, max_range_m=40.0)
-    for footprint in footprints:
-        axes.fill(*footprint.T, facecolor="none", edgecolor="tab:blue", alpha=0.25, lw=0.8)
+    first = max(len(episode.poses) - VIDEO_MAX_STEPS, 0)
+    footprints = ground_footprint(camera, episode.poses[first:], max_range_m=40.0)
+    axes.add_collection(PolyCollection(list(footprints), facecolors="none", edgecolors="tab:blue", alpha=0.25, lw=0.8))
     axes.fill(*footprints[-1].T, color="tab:blue", alpha=0.08, lw=0)
     axes.add_patch(Polygon(episode.area_polygon_m, closed=True, fill=False, ls="--", color="black", lw=1))
-    for path in np.swapaxes(episode.truth.positions_m, 0, 1):
+    for path in np.swapaxes(episode.truth.positions_m[first:], 0, 1):
         axes.plot(*path.T, color="0.55", lw=3, alpha=0.6, solid_capstyle="round")
     colours = matplotlib.colormaps["tab20"]
     track_paths: dict[int, list] = {}
-    for tracks in episode.tracks:
+    for tracks in episode.tracks[first:]:
         for track_id, mean in zip(tracks.ids, tracks.mean, strict=True):
             track_paths.setdefault(int(track_id), []).append(mean[:2])
     for track_id, points in track_paths.items():
