@@ -84,7 +84,11 @@ def test_an_unknown_association_is_refused_naming_the_field():
 def test_the_long_run_tracker_options_are_read_and_student_t_noise_is_refused_for_the_cjpdaf():
     tracker = load_scenario(EXAMPLE.parent / "long_run.yaml").tracker
     assert (tracker.noise_dof, tracker.negative_information, tracker.keep_within_area) == (4.0, True, True)
-    assert (tracker.association_cost, tracker.lost_tracks_kept) == ("likelihood", 20)
+    assert (tracker.association_cost, tracker.lost_tracks_kept, tracker.velocity_time_constant_s) == (
+        "likelihood",
+        20,
+        5,
+    )
     assert scenario_from_dict({}).tracker.noise_dof == float("inf")
     with pytest.raises(ScenarioError, match="tracker: association cjpdaf assumes Gaussian pixel noise"):
         scenario_from_dict({"tracker": {"association": "cjpdaf", "noise_dof": 4}})

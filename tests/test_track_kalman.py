@@ -66,3 +66,20 @@ def test_tracks_ahead_walk_on_at_their_velocity_and_grow_as_white_acceleration_m
     np.testing.assert_allclose(ahead.covariance[0][np.ix_([0, 2], [0, 2])], variance)
     np.testing.assert_allclose(ahead.covariance[0][0, 1], 0.0)
     assert ahead.ids[0] == 7 and np.array_equal(tracks.mean, [[1.0, 2.0, 1.0, -0.5]])
+
+
+@pytest.mark.parametrize("velocity_time_constant_s", [0.5, 5.0])
+def test_a_decaying_velocity_composes_over_time_and_carries_a_walker_tau_v_at_most(velocity_time_constant_s):
+    """F(dt1) F(dt2) = F(dt1 + dt2); a walker at v for ever is predicted ``tau v`` on; an infinite time
+    constant is the constant-velocity model."""
+    F_short, _ = kalman.constant_velocity_model(0.2, 1.5, velocity_time_constant_s)
+    F_long, _ = kalman.constant_velocity_model(0.6, 1.5, velocity_time_constant_s)
+    np.testing.assert_allclose(F_short @ F_short @ F_short, F_long, atol=1e-12)
+    F_ever, _ = kalman.constant_velocity_model(1e4, 1.5, velocity_time_constant_s)
+    np.testing.assert_allclose(
+        F_ever @ [1.0, 2.0, 1.2, -0.5],
+        [1.0 + 1.2 * velocity_time_constant_s, 2.0 - 0.5 * velocity_time_constant_s, 0.0, 0.0],
+        atol=1e-9,
+    )
+    for model in (kalman.constant_velocity_model(0.2, 1.5, np.inf), kalman.constant_velocity_model(0.2, 1.5)):
+        np.testing.assert_array_equal(model[0], np.array([[1, 0, 0.2, 0], [0, 1, 0, 0.2], [0, 0, 1, 0], [0, 0, 0, 1]]))

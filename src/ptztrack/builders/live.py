@@ -114,8 +114,9 @@ def plan_ahead_of(scenario: Scenario) -> PlanAhead:
     """The tracks a live policy plans on: the belief's predicted from the capture of the picture decided on
     to a step after the decision, as an offline policy plans on the tracks predicted to the step its
     picture is taken at."""
-    step_s, acceleration_sigma_m_s2 = 1.0 / scenario.frame_rate_hz, scenario.tracker.acceleration_sigma_m_s2
-    return lambda tracks, since_capture_s: tracks_ahead(tracks, since_capture_s + step_s, acceleration_sigma_m_s2)
+    step_s, tracker = 1.0 / scenario.frame_rate_hz, scenario.tracker
+    motion = (tracker.acceleration_sigma_m_s2, tracker.velocity_time_constant_s)
+    return lambda tracks, since_capture_s: tracks_ahead(tracks, since_capture_s + step_s, *motion)
 
 
 def _live_camera(

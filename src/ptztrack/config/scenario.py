@@ -192,6 +192,7 @@ class Tracker(_Strict):
     max_position_sigma_m : where people can leave the scene (a recording, or ``people.enter_leave``),
     a track this uncertain is deleted; where they never leave, uncertainty deletes nobody.
     report_position_sigma_m : a track more uncertain than this is kept but not reported.
+    velocity_time_constant_s : how fast a track's velocity is predicted to decay (s); .inf: constant velocity.
     noise_dof : the feet pixels' noise's degrees of freedom: .inf for Gaussian noise, a few for Student-t noise,
     whose far detections update less (the Hungarian association only).
     negative_information, keep_within_area, association_cost, lost_tracks_kept : what a miss and the
@@ -204,6 +205,7 @@ class Tracker(_Strict):
     acceleration_sigma_m_s2: Annotated[PositiveFloat, at_most(100, "metres per second squared")] = (
         TrackerParameters.acceleration_sigma_m_s2
     )
+    velocity_time_constant_s: float = Field(TrackerParameters.velocity_time_constant_s, gt=0, allow_inf_nan=True)
     initial_speed_sigma_m_s: Annotated[PositiveFloat, at_most(100, "metres per second")] = (
         TrackerParameters.initial_speed_sigma_m_s
     )

@@ -7,13 +7,26 @@ observation), ``V`` (observation noise). The paper prints
 ``P- = F^T P F + U``; the standard and intended form is ``F P F^T + U``.
 """
 
+import math
+
 import numpy as np
 
 
-def constant_velocity_model(dt_s: float, acceleration_sigma_m_s2: float) -> tuple[np.ndarray, np.ndarray]:
-    """``F`` and ``U`` (4, 4) for a constant-velocity walker driven by white acceleration noise."""
+def constant_velocity_model(
+    dt_s: float, acceleration_sigma_m_s2: float, velocity_time_constant_s: float = math.inf
+) -> tuple[np.ndarray, np.ndarray]:
+    """``F`` and ``U`` (4, 4) for a walker driven by white acceleration noise, its velocity constant or,
+    with a finite ``velocity_time_constant_s`` ``tau``, decaying towards 0: ``v' = e^(-dt/tau) v``,
+    ``x' = x + tau (1 - e^(-dt/tau)) v`` (an integrated Ornstein-Uhlenbeck velocity, the Singer model's
+    mean), so that a walker unseen for long is predicted to have gone ``tau v`` at most, not on at ``v``
+    for ever. ``U`` is the constant-velocity model's either way."""
     F = np.eye(4)
-    F[0, 2] = F[1, 3] = dt_s
+    if math.isinf(velocity_time_constant_s):
+        F[0, 2] = F[1, 3] = dt_s
+    else:
+        decay = math.exp(-dt_s / velocity_time_constant_s)
+        F[0, 2] = F[1, 3] = velocity_time_constant_s * (1.0 - decay)
+        F[2, 2] = F[3, 3] = decay
     block = acceleration_sigma_m_s2**2 * np.array([[dt_s**4 / 4, dt_s**3 / 2], [dt_s**3 / 2, dt_s**2]])
     U = np.kron(block, np.eye(2))
     return F, U

@@ -11,6 +11,8 @@ class TrackerParameters:
     """The ground-plane tracker's parameters (see :func:`ptztrack.track.tracker.update_tracks`).
 
     acceleration_sigma_m_s2 : the constant-velocity model's white acceleration noise per axis (m/s^2).
+    velocity_time_constant_s : how fast a track's velocity is predicted to decay (s); inf: constant velocity
+        (:func:`ptztrack.track.kalman.constant_velocity_model`).
     initial_speed_sigma_m_s : spread of a new track's velocity per axis (m/s).
     gate_probability : the chi-square gate (2 degrees of freedom) of the association.
     existence_at_birth, existence_when_detected, existence_to_delete : the existence probability
@@ -40,6 +42,7 @@ class TrackerParameters:
     """
 
     acceleration_sigma_m_s2: float = 1.5
+    velocity_time_constant_s: float = math.inf
     initial_speed_sigma_m_s: float = 0.9
     gate_probability: float = 0.99
     existence_at_birth: float = 0.5

@@ -80,10 +80,15 @@ def predict_tracks(tracks: Tracks, F, U) -> Tracks:
     return replace(tracks, mean=mean, covariance=covariance)
 
 
-def tracks_ahead(tracks: Tracks, dt_s: float, acceleration_sigma_m_s2: float) -> Tracks:
-    """``tracks`` predicted ``dt_s`` seconds on by the constant-velocity model whose white acceleration
-    has ``acceleration_sigma_m_s2`` (m/s^2) per axis."""
-    return predict_tracks(tracks, *kalman.constant_velocity_model(dt_s, acceleration_sigma_m_s2))
+def tracks_ahead(
+    tracks: Tracks, dt_s: float, acceleration_sigma_m_s2: float, velocity_time_constant_s: float = math.inf
+) -> Tracks:
+    """``tracks`` predicted ``dt_s`` seconds on by the walker model whose white acceleration has
+    ``acceleration_sigma_m_s2`` (m/s^2) per axis and whose velocity decays with ``velocity_time_constant_s``
+    (s; inf: constant velocity; :func:`ptztrack.track.kalman.constant_velocity_model`)."""
+    return predict_tracks(
+        tracks, *kalman.constant_velocity_model(dt_s, acceleration_sigma_m_s2, velocity_time_constant_s)
+    )
 
 
 def update_tracks(
@@ -333,8 +338,9 @@ class EkfTracker:
     def predict(self, dt_s: float | None = None) -> Tracks:
         dt_s = self.step_s if dt_s is None else dt_s
         self.elapse(dt_s)
-        self.tracks = tracks_ahead(self.tracks, dt_s, self.parameters.acceleration_sigma_m_s2)
-        self.lost = tracks_ahead(self.lost, dt_s, self.parameters.acceleration_sigma_m_s2)
+        motion = (self.parameters.acceleration_sigma_m_s2, self.parameters.velocity_time_constant_s)
+        self.tracks = tracks_ahead(self.tracks, dt_s, *motion)
+        self.lost = tracks_ahead(self.lost, dt_s, *motion)
         return self.tracks
 
     def elapse(self, dt_s: float) -> None:
