@@ -11,14 +11,16 @@ times it. It prints and writes (``--json``):
 - ``rss_mb_at``: step -> resident memory (MB) when that step was decided;
 - ``write_s``: seconds to write the folder; ``run_s``: seconds to run the steps;
 - ``track_ids_reported``: the distinct track ids the run reported (one person kept as themselves has one);
-- ``switch_unmatched_steps``: at each identity switch, the steps since the person was last matched to a
-  track, as percentiles 10, 50 and 90 (how long the switched tracks had gone unseen).
+- ``switch_gaps``: at each identity switch, the steps since the person was last matched to a track and
+  since the track that took them was last detected (how long the switched track had gone unseen), as
+  percentiles 10, 50 and 90.
 
     python benchmarks/soak.py [--frames 20000] [--seed 0] [--scenario synthetic] [--window 2000]
                               [--rss-every 1000] [--json PATH]
 """
 
 import argparse
+import bisect
 import tempfile
 import time
 from functools import partial
@@ -45,20 +47,35 @@ def window_switches(episode, first: int, stop: int) -> int:
     return int(clear_metrics(truth, [step.ids for step in tracks], [step.mean[:, :2] for step in tracks])["switches"])
 
 
-def switch_unmatched_steps(episode) -> list[float]:
-    """Percentiles 10, 50 and 90 of the steps since each switched person was last matched to a track."""
+def switch_gaps(episode) -> dict[str, list[float]]:
+    """At each identity switch, percentiles 10, 50 and 90 of the steps since the person was last matched to a
+    track (``person_unmatched_steps``) and of the steps since the track that took them was last detected
+    (``track_unseen_steps``: how long the switched track had gone unseen)."""
     accumulator = metric_accumulator(
         episode.truth.positions_m, [step.ids for step in episode.tracks], [step.mean[:, :2] for step in episode.tracks]
     )
+    detected_at: dict[int, list[int]] = {}
+    hits_of: dict[int, int] = {}
+    for step, tracks in enumerate(episode.tracks):
+        for track_id, hits in zip(tracks.ids.tolist(), tracks.hits.tolist(), strict=True):
+            if hits != hits_of.get(track_id):
+                detected_at.setdefault(track_id, []).append(step)
+            hits_of[track_id] = hits
     events = accumulator.mot_events.reset_index()
-    last_matched, gaps = {}, []
-    for frame, person, kind in events.loc[events.Type.isin(["MATCH", "SWITCH"]), ["FrameId", "OId", "Type"]].itertuples(
-        index=False
-    ):
+    matched = events.loc[events.Type.isin(["MATCH", "SWITCH"]), ["FrameId", "OId", "HId", "Type"]]
+    last_matched, person_gaps, track_gaps = {}, [], []
+    for frame, person, track_id, kind in matched.itertuples(index=False):
         if kind == "SWITCH" and person in last_matched:
-            gaps.append(frame - last_matched[person])
+            person_gaps.append(frame - last_matched[person])
+            detections = detected_at.get(int(track_id), [])
+            before = bisect.bisect_left(detections, frame)
+            if before > 0:
+                track_gaps.append(frame - detections[before - 1])
         last_matched[person] = frame
-    return np.percentile(gaps, [10, 50, 90]).tolist() if gaps else []
+    return {
+        name: np.percentile(gaps, [10, 50, 90]).tolist() if gaps else []
+        for name, gaps in (("person_unmatched_steps", person_gaps), ("track_unseen_steps", track_gaps))
+    }
 
 
 def main() -> None:
@@ -113,14 +130,13 @@ def main() -> None:
         "switches_first_2000": window_switches(episode, 0, args.window),
         "switches_last_2000": window_switches(episode, steps - args.window, steps),
         "track_ids_reported": len(set().union(*(step.ids.tolist() for step in episode.tracks))),
-        "switch_unmatched_steps": switch_unmatched_steps(episode),
+        "switch_gaps": switch_gaps(episode),
         "rss_mb_at": rss_mb_at,
         "run_s": run_s,
         "write_s": write_s,
     }
     for key, value in document.items():
-        shown = {k: round(v) for k, v in value.items()} if isinstance(value, dict) else value
-        shown = [round(v) for v in shown] if isinstance(shown, list) else shown
+        shown = {k: np.round(v).astype(int).tolist() for k, v in value.items()} if isinstance(value, dict) else value
         print(f"{key:>27}  {shown:.4g}" if isinstance(shown, float) else f"{key:>27}  {shown}")
     if args.json is not None:
         write_json(args.json, document)
