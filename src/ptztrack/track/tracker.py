@@ -312,6 +312,11 @@ class EkfTracker:
         estimate); its density over the image replaces ``parameters.clutter_density_per_px2``.
     bias : the camera's feet-pixel bias, estimated from the innovations as the run goes and taken off its
         detections (:mod:`ptztrack.track.sensor_bias`; None: none).
+    area_polygon_m : (K, 2) m, the walkable area every track is truncated to after each update, where
+        people never leave and ``parameters.keep_within_area`` (:mod:`ptztrack.track.negative_information`;
+        None: none).
+    lost : the deleted tracks kept to be taken back (:mod:`ptztrack.track.lost_tracks`), predicted with
+        the live ones.
 
     A picture's weight. The detector model, the pixel noise ``V`` and the existence update are those of
     one look per ``step_s``; pictures closer together than that (a live stream, which delivers several
