@@ -19,10 +19,12 @@ indicator (density truncation, Simon and Simon 2010, "Constrained Kalman filteri
 function truncation for turbofan engine health estimation").
 
 Either posterior is moment-matched to a Gaussian over the position, integrated on a fixed quasi-random
-point set (:data:`UNIT_POINTS`), and carried to the velocity through the prior's cross-covariance:
+point set (:func:`unit_points`), and carried to the velocity through the prior's cross-covariance:
 with ``K = P_{:,x} P_xx^-1`` (4, 2), ``m' = m + K (mu' - m_x)`` and ``P' = P + K (Sigma' - P_xx) K^T``,
 the exact moments of a Gaussian prior whose position alone the evidence concerns.
 """
+
+import functools
 
 import numpy as np
 from matplotlib.path import Path
@@ -31,19 +33,19 @@ from scipy.stats import norm, qmc
 from ptztrack.geometry.ptz import PTZCamera, apply_homography, ground_to_image, inside_image
 
 
-def _unit_points(count_log2: int) -> np.ndarray:
-    """``2^count_log2`` scrambled Sobol points in two dimensions mapped through the normal quantile, then
-    centred and whitened, so that their mean is exactly 0 and their covariance exactly I: evidence that
-    weighs every point alike leaves a track exactly as it was."""
-    points = norm.ppf(qmc.Sobol(d=2, scramble=True, seed=20071).random_base2(count_log2))
+@functools.cache
+def unit_points() -> np.ndarray:
+    """The quadrature of the position's posterior moments (M, 2): 256 scrambled Sobol points in two
+    dimensions mapped through the normal quantile, then centred and whitened, so that their mean is
+    exactly 0 and their covariance exactly I (evidence that weighs every point alike leaves a track
+    exactly as it was). The seed fixes the rule, not a draw of a run; made at its first use, not at
+    import (a Ctrl-C while scipy builds it would be printed, not raised)."""
+    points = norm.ppf(qmc.Sobol(d=2, scramble=True, seed=20071).random_base2(8))
     points -= points.mean(axis=0)
     factor = np.linalg.cholesky(np.cov(points.T, bias=True))
     return points @ np.linalg.inv(factor).T
 
 
-# A deterministic quadrature for the moments of the position's posterior (the seed fixes the rule, not a
-# draw of a run).
-UNIT_POINTS = _unit_points(8)
 # A track whose evidence weighs every point within this of 1 is left as it is.
 UNCHANGED_WEIGHT = 1e-9
 
@@ -52,7 +54,7 @@ def position_points(mean, covariance) -> np.ndarray:
     """The quadrature points (n, M, 2) m of each track's position ``N(mean[:, :2], covariance[:, :2, :2])``
     (mean (n, 4), covariance (n, 4, 4))."""
     factor = np.linalg.cholesky(covariance[:, :2, :2])
-    return mean[:, None, :2] + UNIT_POINTS[None] @ np.swapaxes(factor, -1, -2)
+    return mean[:, None, :2] + unit_points()[None] @ np.swapaxes(factor, -1, -2)
 
 
 def moment_matched(mean, covariance, points, weights) -> tuple[np.ndarray, np.ndarray]:
