@@ -52,6 +52,21 @@ def test_a_track_inside_the_area_is_left_exactly_as_it_was_and_one_on_its_edge_i
     assert covariance[0, 0, 0] < 1.0
 
 
+def test_a_track_with_one_quadrature_point_in_the_area_is_moved_onto_it_with_a_covariance_still_positive_definite():
+    """Evidence on a single point (a track all but wholly outside the area) leaves a position spread of one
+    point's share of the prior, not 0: the track can be truncated again, and its mean is that point."""
+    mean, covariance = track([7.5, 7.5, 0.0, 0.0], [1.0, 1.0], 0.5, 0.5)
+    points = position_points(mean, covariance)
+    weights = np.zeros(points.shape[:2])
+    weights[0, 17] = 1.0
+    after_mean, after_covariance = moment_matched(mean, covariance, points, weights)
+    np.testing.assert_allclose(after_mean[0, :2], points[0, 17])
+    np.testing.assert_allclose(np.linalg.eigvalsh(after_covariance[0, :2, :2]), [1.0 / 256, 1.0 / 256])
+    assert np.all(np.linalg.eigvalsh(after_covariance[0]) > 0)
+    again_mean, _ = within_area(after_mean, after_covariance, AREA_M)
+    np.testing.assert_allclose(again_mean, after_mean)
+
+
 def test_a_track_wholly_outside_the_area_is_left_as_it_is():
     outside = track([30.0, 30.0, 0.0, 0.0], [0.5, 0.5])
     mean, covariance = within_area(*outside, AREA_M)

@@ -5,7 +5,7 @@ The terms are the arrays that grow with the scenario's sizes, with coefficients 
 code (peak resident memory of ``run_episode`` at growing sizes, 2 steps unless said):
 
 * the interpreter and libraries: 320 MB (a 2-step synthetic run of ``fix``: 317 MB);
-* the history of a run: 105 kB a step (2000 steps of ``fix``: 490 MB);
+* the history of a run and its scoring: 1 kB per person and step (decisions page);
 * the simulated detector's occlusion, each person measured in the view centred on them: 160 N^2
   bytes for N people (1000 people: +159 MB);
 * ``smpl``'s joint draws and their boxes: 230 bytes per sample and track (4000 samples of 400
@@ -25,7 +25,7 @@ from ptztrack.scene.pets import load_mot_ground_truth
 from ptztrack.scene.trajectories import read_trajectories
 
 INTERPRETER_BYTES = 320e6
-HISTORY_BYTES_PER_STEP = 105e3
+HISTORY_BYTES_PER_PERSON_STEP = 1e3
 DETECTOR_OCCLUSION_BYTES_PER_PERSON_PAIR = 160.0
 SMPL_BYTES_PER_SAMPLE_TRACK = 230.0
 EXPLORATION_BYTES_PER_ACTION_CELL = 160.0
@@ -54,7 +54,7 @@ def estimated_memory_bytes(scenario: Scenario, policies: tuple[str, ...]) -> dic
     actions = scenario.actions.pan_deg.count * scenario.actions.tilt_deg.count * len(scenario.actions.zoom)
     terms = {
         "interpreter": INTERPRETER_BYTES,
-        "history": HISTORY_BYTES_PER_STEP * scenario.frames,
+        "history": HISTORY_BYTES_PER_PERSON_STEP * people * scenario.frames,
         "detector occlusion": DETECTOR_OCCLUSION_BYTES_PER_PERSON_PAIR * people**2
         if scenario.recording is None
         else 0.0,

@@ -64,11 +64,20 @@ def moment_matched(mean, covariance, points, weights) -> tuple[np.ndarray, np.nd
     mean : (n, 4); covariance : (n, 4, 4); points : (n, M, 2) from :func:`position_points`; weights : (n, M)
     in [0, 1], with a positive sum per track. Returns the mean (n, 4) and covariance (n, 4, 4) (the
     module's docstring).
+
+    The points resolve a spread no finer than one point's share of the prior: each eigenvalue of the
+    position's covariance is at least ``lambda_min(P_xx) / M``, so that evidence leaving weight on one
+    point, or on points in a line, still gives a positive definite covariance.
     """
     share = weights / weights.sum(axis=1, keepdims=True)
     position_mean = np.einsum("nm,nmi->ni", share, points)
     centred = points - position_mean[:, None, :]
     position_covariance = np.einsum("nm,nmi,nmj->nij", share, centred, centred)
+    spread, axes = np.linalg.eigh(position_covariance)
+    resolution = np.linalg.eigvalsh(covariance[:, :2, :2])[:, :1] / points.shape[1]
+    unresolved = spread[:, 0] < resolution[:, 0]
+    floored = np.maximum(spread[unresolved], resolution[unresolved])
+    position_covariance[unresolved] = (axes[unresolved] * floored[:, None, :]) @ np.swapaxes(axes[unresolved], -1, -2)
     gain = covariance[:, :, :2] @ np.linalg.inv(covariance[:, :2, :2])
     mean = mean + np.einsum("nij,nj->ni", gain, position_mean - mean[:, :2])
     change = position_covariance - covariance[:, :2, :2]

@@ -58,6 +58,6 @@ class TrackerParameters:
     noise_dof: float = math.inf
     birth: Literal["unassigned", "outside_gates"] = "unassigned"
     negative_information: bool = False
-    keep_within_area: bool = False
+    keep_within_area: bool = True
     association_cost: Literal["mahalanobis", "likelihood"] = "mahalanobis"
     lost_tracks_kept: int = 0
