@@ -1,6 +1,7 @@
 """The service's configuration file: what a user writes, and one line naming the file, the field and the
 value for what is wrong."""
 
+import sys
 from pathlib import Path
 
 import pytest
@@ -80,3 +81,11 @@ def _cameras(count: int, engine: str) -> ServiceConfig:
 )
 def test_the_first_camera_is_a_thread_and_auto_puts_the_others_in_ray_beyond_the_cores(count, engine, cores, engines):
     assert camera_engines(_cameras(count, engine), cores) == engines
+
+
+def test_cameras_on_ray_without_ray_installed_exit_2_with_one_line(tmp_path, capsys, monkeypatch):
+    monkeypatch.setitem(sys.modules, "ray", None)  # as if not installed: importing it fails, find_spec is None
+    path = _written(tmp_path, CAMERA + "  - name: side\n    url: onvif://127.0.0.1:8081\nengine: ray\n")
+    assert main(["serve", str(path)]) == 2
+    error = capsys.readouterr().err
+    assert error.count("\n") == 1 and "2 cameras" in error and "pip install 'ptztrack[ray]'" in error
