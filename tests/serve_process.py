@@ -9,6 +9,8 @@ import sys
 import time
 import urllib.error
 import urllib.request
+from collections.abc import Iterator
+from contextlib import contextmanager
 
 TIMEOUT_S = 90.0
 
@@ -19,6 +21,18 @@ def virtual_camera(port: int) -> subprocess.Popen:
     camera = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
     assert f"onvif://127.0.0.1:{port}" in camera.stdout.readline()
     return camera
+
+
+@contextmanager
+def virtual_cameras() -> Iterator[list[subprocess.Popen]]:
+    """A list to put :func:`virtual_camera`'s processes in, each killed at the end of the block."""
+    cameras: list[subprocess.Popen] = []
+    try:
+        yield cameras
+    finally:
+        for camera in cameras:
+            camera.kill()
+            camera.wait()
 
 
 def serve_process(config, cameras: int = 1) -> tuple[subprocess.Popen, str]:

@@ -15,7 +15,7 @@ from mqtt_broker import Subscriber, free_port, mosquitto
 from ptztrack.config import ScenarioError
 from ptztrack.loop.executors import connect_ray
 from ptztrack.service import ServiceConfig, serve
-from serve_process import health, serve_process, stop, until, virtual_camera, whole_rows
+from serve_process import health, serve_process, stop, until, virtual_camera, virtual_cameras, whole_rows
 
 pytest.importorskip("ipycam", reason="the virtual ONVIF camera needs ipycam (pip install --no-deps ipycam==1.3.0)")
 NAMES = ("front", "side")
@@ -34,8 +34,8 @@ def test_a_camera_in_a_ray_actor_writes_its_files_and_its_events_lines_and_healt
         named = [{"name": name, "url": f"onvif://127.0.0.1:{port}"} for name, port in zip(NAMES, ports, strict=True)]
         settings = {"output": "out", "events": "events.jsonl", "mqtt": {"port": broker}, "http_port": 0}
         config.write_text(yaml.safe_dump({"cameras": named, **settings, "rotate_s": 2, "engine": "ray"}))
-        cameras = [virtual_camera(ports[0])]
-        try:
+        with virtual_cameras() as cameras:
+            cameras.append(virtual_camera(ports[0]))
             service, address = serve_process(config, cameras=2)
             try:
                 # The Ray processes the service started, to see them gone after it.
@@ -47,10 +47,6 @@ def test_a_camera_in_a_ray_actor_writes_its_files_and_its_events_lines_and_healt
                 report = health(address)
             finally:
                 stop_s, errors = stop(service)
-        finally:
-            for camera in cameras:
-                camera.kill()
-                camera.wait()
         received = subscriber.count_settles()
         subscriber.close()
     assert service.returncode == 0 and stop_s <= 2.0, (stop_s, errors)

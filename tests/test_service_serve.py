@@ -3,7 +3,6 @@ and started again, the service stopped by SIGTERM and started again, a real brok
 messages."""
 
 import json
-import subprocess
 
 import numpy as np
 import pytest
@@ -11,7 +10,7 @@ import yaml
 
 from mqtt_broker import Subscriber, free_port, mosquitto
 from ptztrack.detect.detector_model import HEIGHT_BIN_EDGES_PX, PRIOR_TRIALS_PER_BIN
-from serve_process import serve_process, stop, until, virtual_camera, whole_rows
+from serve_process import serve_process, stop, until, virtual_camera, virtual_cameras, whole_rows
 
 pytest.importorskip("ipycam", reason="the virtual ONVIF camera needs ipycam (pip install --no-deps ipycam==1.3.0)")
 # One live loop at a time (one xdist worker), as tests/test_loop_live_onvif.py runs them.
@@ -26,8 +25,7 @@ def test_serve_goes_on_through_a_camera_restart_stops_on_sigterm_whole_and_keeps
         camera = {"name": "front", "url": f"onvif://127.0.0.1:{port}", "calibration": "virtual", "policy": "smpl"}
         settings = {"output": "out", "events": "events.jsonl", "mqtt": {"port": broker}, "http_port": 0}
         config.write_text(yaml.safe_dump({"cameras": [camera], **settings, "rotate_s": 2, "model_save_s": 2}))
-        cameras: list[subprocess.Popen] = []
-        try:
+        with virtual_cameras() as cameras:
             # The service starts before its camera is up: it tries again until the camera answers.
             service, health = serve_process(config)
             try:
@@ -55,10 +53,6 @@ def test_serve_goes_on_through_a_camera_restart_stops_on_sigterm_whole_and_keeps
             finally:
                 _, errors = stop(service)
             assert service.returncode == 0 and "Traceback" not in errors
-        finally:
-            for running in cameras:
-                running.kill()
-                running.wait()
         received = subscriber.count_settles()
         subscriber.close()
     prior_trials = PRIOR_TRIALS_PER_BIN * (len(HEIGHT_BIN_EDGES_PX) - 1)
