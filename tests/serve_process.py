@@ -17,10 +17,20 @@ TIMEOUT_S = 90.0
 
 def virtual_camera(port: int) -> subprocess.Popen:
     """`ptztrack serve-camera` on 127.0.0.1:``port``, up."""
-    command = [sys.executable, "-m", "ptztrack.cli", "serve-camera", "--port", str(port)]
-    camera = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
-    assert f"onvif://127.0.0.1:{port}" in camera.stdout.readline()
+    (camera,) = virtual_cameras_up([port])
     return camera
+
+
+def virtual_cameras_up(ports: list[int]) -> list[subprocess.Popen]:
+    """`ptztrack serve-camera` on each of 127.0.0.1:``ports``, started together, each up."""
+    command = [sys.executable, "-m", "ptztrack.cli", "serve-camera", "--port"]
+    cameras = [
+        subprocess.Popen([*command, str(port)], stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
+        for port in ports
+    ]
+    for camera, port in zip(cameras, ports, strict=True):
+        assert f"onvif://127.0.0.1:{port}" in camera.stdout.readline()
+    return cameras
 
 
 @contextmanager
