@@ -29,10 +29,10 @@ CameraLoop = Callable[[ServiceCamera, ServiceConfig, CameraHealth, Emit, None, t
 """``run(camera, config, health, emit, hub, stop)``: one camera's loop until ``stop`` (the runner's
 ``run_camera``; no web view, ``hub`` None)."""
 
-Drained = tuple[dict, list[tuple[str, dict]], list[tuple[str, int, str]], BaseException | None]
+Drained = tuple[dict, list[tuple[str, dict]], list[tuple[str, int, str]], bool, BaseException | None]
 """What :meth:`CameraActor.drain` returns: the health's snapshot, the events (topic's last part,
-payload) and the log records (logger, level, message) queued since the last drain, and the loop's
-failure (None while it has none)."""
+payload) and the log records (logger, level, message) queued since the last drain, whether the loop
+has ended (nothing more will come), and then its failure (None if it ended without one)."""
 
 
 class _Queued(logging.Handler):
@@ -76,14 +76,16 @@ class CameraActor:
             self.health.status = "stopped"
 
     def drain(self) -> Drained:
-        """The health, then what was queued since the last drain, and the failure (see ``Drained``)."""
-        # The snapshot first: a loop 'stopped' in it has queued its last events before, so they come too.
+        """The health, what was queued since the last drain, whether the loop ended and how (``Drained``)."""
+        # In this order: a loop whose thread has ended has kept its failure and queued its last events, and a
+        # snapshot 'stopped' comes after the camera's last events were queued; so they come with it.
+        ended = not self._thread.is_alive()
         snapshot = self.health.snapshot()
         with self._lock:  # emptied in place: the log handler holds the list of lines
             events, lines = self._events[:], self._lines[:]
             self._events.clear()
             self._lines.clear()
-        return snapshot, events, lines, self._failure
+        return snapshot, events, lines, ended, self._failure if ended else None
 
     def stop(self) -> None:
         """End the loop: its files closed whole, its tracks' 'end' events queued, its model saved."""
@@ -135,7 +137,7 @@ class RayCameras:
         for reference in answered:
             index = self._pending.pop(reference)
             try:
-                snapshot, events, lines, failure = self._ray.get(reference)
+                snapshot, events, lines, ended, failure = self._ray.get(reference)
             except self._ray.exceptions.RayError as error:  # the actor's process died, or could not start
                 reason = str(error).strip().splitlines()[0] if str(error).strip() else type(error).__name__
                 self.failures.append(RuntimeError(f"camera {self.names[index]}: its Ray actor failed ({reason})"))
@@ -149,8 +151,8 @@ class RayCameras:
             self.healths[index].take(snapshot)
             if failure is not None:
                 self.failures.append(failure)
-            if snapshot["status"] == "stopped":
-                self._running[index] = False  # its last events are in; nothing more will come
+            if ended:
+                self._running[index] = False
             else:
                 self._pending[self.actors[index].drain.remote()] = index
 
