@@ -1,6 +1,7 @@
 """``ptztrack serve CONFIG``: the cameras of a service configuration, run until SIGTERM or Ctrl-C."""
 
 import argparse
+import gc
 import signal
 import threading
 
@@ -14,4 +15,7 @@ def serve_command(args: argparse.Namespace) -> int:
     signal.signal(signal.SIGTERM, lambda signum, frame: stop.set())
     serve(config, stop, started=lambda line: print(line, flush=True))
     print("ptztrack serve: stopped; every file closed whole", flush=True)
+    # The interpreter's last collections would walk every object Numba, SciPy and Ray made, a second of
+    # the two SIGTERM may take; nothing left needs them, and the memory goes back with the process.
+    gc.freeze()
     return 0

@@ -64,7 +64,11 @@ class ServiceConfig(_Strict):
     track_end_s : how long a track unreported is still the same event (then an 'end'); http_port : the
     port of /healthz, /metrics and the web view on 127.0.0.1 (0: any free port; null: none);
     model_save_s : how often each camera's learned detector model is saved (and at the stop);
-    rotate_s : how often the tracks' files are rotated (an hour; shorter in a test).
+    rotate_s : how often the tracks' files are rotated (an hour; shorter in a test); engine : where the
+    cameras' loops run, 'threads' (each in a thread of the service's process), 'ray' (every camera but
+    the first, whose loop feeds the web view, in a Ray actor: a process of its own on the cluster of
+    ``RAY_ADDRESS``, else a local one; needs the ``ray`` extra) or 'auto' ('threads' while the cameras
+    are no more than the machine's cores, else 'ray'); see :func:`camera_engines`.
     """
 
     cameras: Annotated[list[ServiceCamera], Field(min_length=1), at_most_items(64, "cameras of one service")]
@@ -76,6 +80,7 @@ class ServiceConfig(_Strict):
     http_port: _Port | None = 0
     model_save_s: _Seconds = 300.0
     rotate_s: _Seconds = 3600.0
+    engine: Literal["auto", "threads", "ray"] = "auto"
 
     @model_validator(mode="after")
     def _unique_names(self):
@@ -84,6 +89,14 @@ class ServiceConfig(_Strict):
         if repeated:
             raise ValueError(f"camera names must differ: {', '.join(repeated)} appears more than once")
         return self
+
+
+def camera_engines(config: ServiceConfig, cores: int) -> list[str]:
+    """Where each camera of ``config`` runs on a machine of ``cores`` cores: 'thread' (a thread of the
+    service's process) or 'ray' (a Ray actor), by ``config.engine``; the first camera is always a thread."""
+    count = len(config.cameras)
+    actors = config.engine == "ray" or (config.engine == "auto" and count > cores)
+    return ["thread"] + ["ray" if actors else "thread"] * (count - 1)
 
 
 def load_service_config(path: str | Path) -> ServiceConfig:
@@ -97,7 +110,8 @@ def load_service_config(path: str | Path) -> ServiceConfig:
         config = ServiceConfig.model_validate(data)
     except pydantic.ValidationError as error:
         raise ScenarioError(_first_error_line(error, str(path))) from None
-    folder = path.parent
+    # Absolute: a camera in a Ray actor reads and writes them from another process, whose folder may differ.
+    folder = path.absolute().parent
 
     def beside(value: str, keep: tuple[str, ...]) -> str:
         return value if value in keep else str(folder / value)

@@ -49,6 +49,23 @@ class CameraHealth:
         with self._lock:
             self.events += 1
 
+    def snapshot(self) -> dict:
+        """Its counters, and the times (epoch s) of its steps of the last RATE_WINDOW_S, as plain data:
+        what :meth:`take` copies into the service's health of a camera that runs in another process."""
+        with self._lock:
+            since_s = time.time() - RATE_WINDOW_S
+            counters = {name: value for name, value in vars(self).items() if not name.startswith("_")}
+            return {**counters, "recent_s": [used_s for used_s in self._recent_s if used_s >= since_s]}
+
+    def take(self, snapshot: dict) -> None:
+        """Its counters and recent steps as ``snapshot`` (of :meth:`snapshot`) tells them."""
+        with self._lock:
+            for name, value in snapshot.items():
+                if name != "recent_s":
+                    setattr(self, name, value)
+            self._recent_s.clear()
+            self._recent_s.extend(snapshot["recent_s"])
+
     def steps_per_s(self, now_s: float) -> float:
         """Pictures used per second over the last RATE_WINDOW_S."""
         with self._lock:

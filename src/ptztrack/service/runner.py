@@ -1,7 +1,8 @@
 """The service: every camera of the configuration in a loop of its own, until stopped.
 
 Each camera runs the live loop (:func:`ptztrack.loop.live.run_live_network`, a camera alone) in a
-thread of its own, unbounded, every picture's row handed to the camera's sink instead of kept: its
+thread of its own (or, as the configuration's ``engine`` tells, in a Ray actor:
+:mod:`ptztrack.service.actors`), unbounded, every picture's row handed to the camera's sink instead of kept: its
 tracks appended to its rotated files (:mod:`ptztrack.service.outputs`), its track events emitted
 (:mod:`ptztrack.service.events`), its health counted (:mod:`ptztrack.service.health`), and its learned
 detector model saved every ``model_save_s`` (``<output>/<camera>/detector_model.json``, written to a
@@ -18,7 +19,9 @@ then closed whole, its model saved and its tracks' 'end' events emitted.
 """
 
 import contextlib
+import importlib.util
 import logging
+import os
 import sys
 import threading
 import time
@@ -36,8 +39,9 @@ from ptztrack.camera.onvif_client import CameraError, camera_address
 from ptztrack.config import Scenario, load_camera_calibration, load_scenario
 from ptztrack.detect.detector_model import OnlineDetectorModel
 from ptztrack.loop.live import run_live_network
-from ptztrack.service.config import ServiceCamera, ServiceConfig
-from ptztrack.service.events import EventOutlet, TrackEvents
+from ptztrack.service.actors import DRAIN_S, RayCameras
+from ptztrack.service.config import ServiceCamera, ServiceConfig, camera_engines
+from ptztrack.service.events import Emit, EventOutlet, TrackEvents
 from ptztrack.service.health import CameraHealth, health_routes
 from ptztrack.service.outputs import TrackFiles
 from ptztrack.view.view_state import ViewState
@@ -75,8 +79,16 @@ def model_trials(model) -> float:
 def serve(config: ServiceConfig, stop: threading.Event, started: Callable[[str], None] = print) -> list[CameraHealth]:
     """Run every camera of ``config`` until ``stop`` is set (or Ctrl-C); the cameras' health at the end.
 
+    Each camera runs in a thread of this process or in a Ray actor, as :func:`camera_engines` tells.
     started : told one line once the service is up (the health's address, when it has one).
     """
+    engines = camera_engines(config, os.cpu_count() or 1)
+    on_ray = [number for number, engine in enumerate(engines) if engine == "ray"]
+    if on_ray and importlib.util.find_spec("ray") is None:
+        raise RuntimeError(
+            f"{len(config.cameras)} cameras on {os.cpu_count()} cores (engine '{config.engine}'): all but the first "
+            "run in Ray actors, which need Ray: pip install 'ptztrack[ray]' (or engine: threads)"
+        )
     # The camera's own lines do not name it: the watchers' lines say what they say, with its name.
     logging.getLogger("ptztrack.loop.live").setLevel(logging.ERROR)
     healths = [CameraHealth(camera.name) for camera in config.cameras]
@@ -87,38 +99,57 @@ def serve(config: ServiceConfig, stop: threading.Event, started: Callable[[str],
         server = None
         if config.http_port is not None:
             server = stack.enter_context(ViewServer(hub, config.http_port, health_routes(healths)))
+        actors = None
+        if on_ray:  # left before the outlet: its last events are emitted while the outlet is open
+            actors = stack.enter_context(
+                RayCameras(
+                    run_camera,
+                    [config.cameras[number] for number in on_ray],
+                    config,
+                    [healths[number] for number in on_ray],
+                    [outlet.emitter(config.cameras[number].name) for number in on_ray],
+                    failures,
+                )
+            )
         threads = [
             threading.Thread(
                 target=_camera_thread,
-                args=(camera, config, health, outlet, hub if number == 0 else None, stop, failures),
+                args=(camera, config, health, outlet.emitter(camera.name), hub if number == 0 else None, stop,
+                      failures),
                 name=f"serve-{camera.name}",
                 daemon=True,  # a camera's close that hangs past the stop's wait does not hold the process
             )
             for number, (camera, health) in enumerate(zip(config.cameras, healths, strict=True))
-        ]
+            if engines[number] == "thread"
+        ]  # fmt: skip
         for thread in threads:
             thread.start()
         where = "" if server is None else f"; health at {server.address}healthz, metrics at {server.address}metrics"
         started(f"serving {len(config.cameras)} camera{'s' if len(config.cameras) > 1 else ''}{where}")
         try:
-            while not stop.wait(0.2) and not failures:
-                pass
+            while not stop.wait(DRAIN_S) and not failures:
+                if actors is not None:
+                    actors.drain()
         except KeyboardInterrupt:
             pass
         stop.set()
+        if actors is not None:
+            actors.stop()
         # Each camera's files are closed whole once its status is 'stopped' (its camera may still be closing).
         deadline_s = time.monotonic() + STOP_WAIT_S
         while any(health.status != "stopped" for health in healths) and time.monotonic() < deadline_s:
             time.sleep(0.02)
+            if actors is not None:
+                actors.drain()
     if failures:
         raise failures[0]
     return healths
 
 
-def _camera_thread(camera, config, health, outlet, hub, stop, failures) -> None:
+def _camera_thread(camera, config, health, emit, hub, stop, failures) -> None:
     """:func:`run_camera`, its failure handed to the service's thread (which raises it)."""
     try:
-        run_camera(camera, config, health, outlet, hub, stop)
+        run_camera(camera, config, health, emit, hub, stop)
     except BaseException as error:  # noqa: BLE001 - raised again by serve()
         failures.append(error)
         health.status = "stopped"
@@ -128,12 +159,13 @@ def run_camera(
     camera: ServiceCamera,
     config: ServiceConfig,
     health: CameraHealth,
-    outlet: EventOutlet,
+    emit: Emit,
     hub: ViewHub | None,
     stop: threading.Event,
 ) -> None:
     """One camera's loop until ``stop``: connected (again and again while it cannot be), its rows into
-    its files, events and health, its model saved every ``config.model_save_s`` and at the end."""
+    its files, its events into ``emit`` and its health into ``health``, its model saved every
+    ``config.model_save_s`` and at the end; the web view fed through ``hub`` (None: none)."""
     folder = Path(config.output) / camera.name
     folder.mkdir(parents=True, exist_ok=True)
     model_path = folder / MODEL_FILE
@@ -147,7 +179,6 @@ def run_camera(
     (world,) = network.worlds
     model = world.detector_model
     health.model_trials = model_trials(model)
-    emit = outlet.emitter(camera.name)
 
     def counted(kind: str, payload: dict) -> None:
         health.emitted()
