@@ -37,6 +37,10 @@ Emit = Callable[[str, dict], None]
 ACK_WAIT_S = 1.0
 # What paho keeps while the broker is away, beyond which events are written but not published.
 MAX_QUEUED_MESSAGES = 100_000
+# How long the outlet waits for the broker at its start. Messages published before the first connection
+# are sent by paho's thread when it connects, while later ones go out at once, so they could overtake
+# them; a broker that answers within this wait gets every message in order.
+CONNECT_WAIT_S = 5.0
 
 
 @dataclass
@@ -126,9 +130,14 @@ class EventOutlet:
         client.max_queued_messages_set(MAX_QUEUED_MESSAGES)
         client.reconnect_delay_set(1, 8)
         client.on_publish = self._on_publish
-        client.on_connect = lambda client, data, flags, reason, properties: log.warning(
-            "MQTT broker %s:%d: %s", mqtt.host, mqtt.port, "connected" if not reason.is_failure else reason
-        )
+        connected = threading.Event()
+
+        def on_connect(client, data, flags, reason, properties) -> None:
+            log.warning("MQTT broker %s:%d: %s", mqtt.host, mqtt.port, "connected" if not reason.is_failure else reason)
+            if not reason.is_failure:
+                connected.set()
+
+        client.on_connect = on_connect
         client.on_disconnect = lambda client, data, flags, reason, properties: (
             log.warning("MQTT broker %s:%d lost (%s); reconnecting", mqtt.host, mqtt.port, reason)
             if reason.is_failure
@@ -140,6 +149,9 @@ class EventOutlet:
         self._queue_full = paho.MQTT_ERR_QUEUE_SIZE
         client.connect_async(mqtt.host, mqtt.port)
         client.loop_start()
+        if not connected.wait(CONNECT_WAIT_S):
+            log.warning("MQTT broker %s:%d not connected after %.0f s; events are queued until it is", mqtt.host,
+                        mqtt.port, CONNECT_WAIT_S)  # fmt: skip
         return client
 
     def _on_publish(self, client, userdata, mid, reason, properties) -> None:
