@@ -3,10 +3,12 @@
 Python raises KeyboardInterrupt where the signal arrives. Inside Numba's compiler, which runs while a
 run warms up, that is unsafe: in a ctypes callback the exception is printed and dropped (the command
 would go on to its end), elsewhere it can leave LLVM's objects half-built (a double free at exit).
-So the handler records the signal and raises at once only outside the compiler. Inside it, where one
-function can take seconds to compile, the signal is looked at again every ``POLL_S`` and raised once
-the compiler has returned, or, if it has not after ``COMPILER_WAIT_S``, the process ends without
-unwinding (:func:`_end_now`). The steps of a run also ask :func:`raise_if_interrupted`, for a
+Under SciPy's compiled code (its Cython, as the scrambled Sobol points of the tracker's quadrature
+are made) a KeyboardInterrupt is likewise printed as ignored. So the handler records the signal and
+raises at once only outside those packages. Inside them, where one call can take seconds, the signal
+is looked at again every ``POLL_S`` and raised once the call has returned, or, if it has not after
+``COMPILER_WAIT_S``, the process ends without unwinding (:func:`_end_now`).
+The steps of a run also ask :func:`raise_if_interrupted`, for a
 KeyboardInterrupt that some library caught. A command that ends on Ctrl-C by design (a camera served
 until stopped) catches the KeyboardInterrupt itself and ends as it means to.
 
@@ -32,7 +34,7 @@ INTERRUPTED_STATUS = 130
 COMPILER_WAIT_S = 1.0
 POLL_S = 0.05
 
-_COMPILER_PACKAGES = ("numba", "llvmlite")
+_COMPILER_PACKAGES = ("numba", "llvmlite", "scipy")
 
 _interrupted = threading.Event()
 _raised = threading.Event()
@@ -51,7 +53,7 @@ def _on_sigint(signum, frame) -> None:
 
 
 def _inside_compiler(frame) -> bool:
-    """Whether the interrupted code runs inside Numba's compiler (any frame of its stack in it)."""
+    """Whether the interrupted code runs inside Numba's compiler or SciPy (any frame of its stack in them)."""
     while frame is not None:
         if frame.f_globals.get("__name__", "").partition(".")[0] in _COMPILER_PACKAGES:
             return True

@@ -39,7 +39,8 @@ def unit_points() -> np.ndarray:
     dimensions mapped through the normal quantile, then centred and whitened, so that their mean is
     exactly 0 and their covariance exactly I (evidence that weighs every point alike leaves a track
     exactly as it was). The seed fixes the rule, not a draw of a run; made at its first use, not at
-    import (a Ctrl-C while scipy builds it would be printed, not raised)."""
+    import (a command's Ctrl-C under scipy's compiled code waits for it to return:
+    :mod:`ptztrack.cli.interrupt`)."""
     points = norm.ppf(qmc.Sobol(d=2, scramble=True, seed=20071).random_base2(8))
     points -= points.mean(axis=0)
     factor = np.linalg.cholesky(np.cov(points.T, bias=True))
