@@ -9,9 +9,10 @@ once halfway and started again. Debian's Mosquitto runs on 127.0.0.1 with a subs
 ``ptztrack/+/events`` and ``ptztrack/+/status``. It prints and writes (``--json``):
 
 - ``steps``: the pictures the service used, both cameras, both runs (the rows of its tracks' files);
-- ``steps_lost_outside_outages``: the pictures lost in gaps between consecutive rows of a camera
-  longer than ``GAP_S`` that hold no outage (no 'offline' event of that camera, no stop of the
-  service): the gap over the camera's median interval, less one;
+- ``steps_lost_outside_outages``: the pictures lost in gaps between consecutive rows of a camera,
+  less the time the gap shares with the camera's outages (from its 'offline' event to its 'online'
+  one) and the service's stop (from SIGTERM to its second run's cameras running), where that is
+  longer than ``GAP_S``: over the camera's median interval, less one;
 - ``mqtt_messages``: the messages the subscriber got; ``events_written``: the lines of the events file;
 - ``rss_mb_start``, ``rss_mb_end``: the service's resident memory a minute after its second start
   and at its end (``rss_mb`` holds every sample: minute, run, MB);
@@ -117,18 +118,34 @@ class Counter:
         self.count += 1
 
 
-def lost_steps(times_s: np.ndarray, outages_s: list[float]) -> int:
-    """Pictures lost in the gaps of ``times_s`` (sorted capture times, s) longer than GAP_S that hold none
-    of ``outages_s`` (the times an outage began)."""
+def lost_steps(times_s: np.ndarray, away_s: list[tuple[float, float]]) -> int:
+    """Pictures lost in the gaps of ``times_s`` (sorted capture times, s) outside the intervals ``away_s``
+    ((start, end) s: a camera's outages, the service's stop): each gap less the time it shares with
+    those intervals, counted where that is longer than GAP_S, in the camera's median interval, less one."""
     if len(times_s) < 3:
         return 0
     gaps_s = np.diff(times_s)
     interval_s = float(np.median(gaps_s))
     lost = 0
     for start_s, gap_s in zip(times_s[:-1], gaps_s, strict=True):
-        if gap_s > GAP_S and not any(start_s <= outage_s <= start_s + gap_s for outage_s in outages_s):
-            lost += int(round(gap_s / interval_s)) - 1
+        shared_s = sum(max(0.0, min(start_s + gap_s, end_s) - max(start_s, begin_s)) for begin_s, end_s in away_s)
+        if gap_s - shared_s > GAP_S:
+            lost += int(round((gap_s - shared_s) / interval_s)) - 1
     return lost
+
+
+def outages_of(camera: str, events: list[dict], stops: list[tuple[float, float]]) -> list[tuple[float, float]]:
+    """A camera's outages (start, end) s: each 'offline' event to the camera's next 'online' event or the
+    service's next stop, whichever is first (a service started again says 'online' only for a camera
+    that was offline at its start)."""
+    times = {kind: [event["time_s"] for event in events if event["type"] == kind and event["camera"] == camera]
+             for kind in ("offline", "online")}  # fmt: skip
+    outages = []
+    for begin_s in times["offline"]:
+        ends_s = [end_s for end_s in times["online"] if end_s > begin_s]
+        ends_s += [stop_s for stop_s, _ in stops if stop_s > begin_s]
+        outages.append((begin_s, min(ends_s, default=np.inf)))
+    return outages
 
 
 def whole_files(folder: Path) -> tuple[bool, int]:
@@ -177,7 +194,8 @@ def main() -> None:
     next_restart_s, halfway_s = every_s, total_s / 2
     service, address = start_serve(config_path, errors)
     process, run = psutil.Process(service.pid), 1
-    rss_mb, stops_s, stopped_at_s = [], [], []
+    # The service's stop: SIGTERM sent to its second run's cameras running (s since the epoch).
+    rss_mb, stops_s, stopped = [], [], []
     trials_before = trials_after = None
     next_sample_s = 60.0
     try:
@@ -195,7 +213,7 @@ def main() -> None:
                 next_restart_s += every_s
                 print(f"{elapsed_s / 60:5.1f} min: the cameras killed and restarted")
             if run == 1 and elapsed_s >= halfway_s:
-                stopped_at_s.append(time.time())
+                stopped_at_s = time.time()
                 stops_s.append(stop(service))
                 trials_before = sum(
                     float(np.sum(json.loads(path.read_text())["trials"]))
@@ -207,12 +225,12 @@ def main() -> None:
                 while any(report["status"] != "running" for report in health(address)["cameras"].values()):
                     assert time.monotonic() < deadline_s, "the second run's cameras are not running"
                     time.sleep(0.2)
+                stopped.append((stopped_at_s, time.time()))
                 trials_after = sum(report["model_trials"] for report in health(address)["cameras"].values())
                 next_sample_s = elapsed_s + 60.0
                 print(f"{elapsed_s / 60:5.1f} min: serve stopped in {stops_s[-1]:.2f} s and started again")
             time.sleep(0.5)
         rss_mb.append((round((time.monotonic() - started_s) / 60, 2), run, round(process.memory_info().rss / 2**20, 1)))
-        stopped_at_s.append(time.time())
         stops_s.append(stop(service))
     finally:
         for running in [service, *cameras]:
@@ -236,11 +254,8 @@ def main() -> None:
                 for line in path.read_text().splitlines()
             ]
         )
-        outages_s = [
-            event["time_s"] for event in events if event["type"] == "offline" and event["camera"] == camera["name"]
-        ]
         steps += len(times_s)
-        lost += lost_steps(times_s, outages_s + stopped_at_s[:1])
+        lost += lost_steps(times_s, outages_of(camera["name"], events, stopped) + stopped)
     whole, rotated = whole_files(folder / "output")
     second_run = [sample for sample in rss_mb if sample[1] == 2]
     result = {
