@@ -59,6 +59,16 @@ def box_feet_px(boxes_px) -> np.ndarray:
     return np.stack([boxes_px[:, 0] + boxes_px[:, 2] / 2, boxes_px[:, 1] + boxes_px[:, 3]], axis=-1)
 
 
+def box_iou(a, b) -> np.ndarray:
+    """Intersection over union of boxes (..., 4) (left, top, width, height); broadcasts."""
+    a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+    low = np.maximum(a[..., :2], b[..., :2])
+    high = np.minimum(a[..., :2] + a[..., 2:], b[..., :2] + b[..., 2:])
+    intersection = np.prod(np.clip(high - low, 0.0, None), axis=-1)
+    union = np.prod(a[..., 2:], axis=-1) + np.prod(b[..., 2:], axis=-1) - intersection
+    return np.where(union > 0, intersection / np.where(union > 0, union, 1.0), 0.0)
+
+
 FIT_BOX_HEIGHTS = 0.5
 """The median distance, in box heights, from annotated people's ground positions projected into a view
 to their boxes' feet beyond which the calibration is taken not to fit the view: half a person's height
