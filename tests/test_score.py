@@ -33,6 +33,7 @@ def printed_figures(text: str) -> dict[str, str]:
     return {pair[0]: pair[1] for pair in pairs if len(pair) == 2}
 
 
+@pytest.mark.slow
 def test_score_on_the_files_of_a_run_reproduces_its_metrics(tmp_path, capsys):
     out = tmp_path / "run"
     assert main(["run", "--frames", "40", "--seed", "2", "--quiet", "--out", str(out)]) == 0
