@@ -124,6 +124,7 @@ def fills_world(rows: Annotations) -> bool:
 
 
 def refuse_without_world(path: str | Path, rows: Annotations) -> None:
+    """A :class:`DatasetError` if no row of ``path`` has a world position."""
     if not fills_world(rows):
         raise DatasetError(
             f"{path}: no world positions (columns 8-9 are -1 on every row); "
