@@ -15,6 +15,7 @@ PARSING_MODULES = {
     "ptztrack.cli.follow_arguments",
     "ptztrack.cli.multicamera_arguments",
     "ptztrack.cli.options",
+    "ptztrack.cli.score_arguments",
     "ptztrack.cli.interrupt",
     "ptztrack.registry",
     "ptztrack.names",
@@ -22,7 +23,9 @@ PARSING_MODULES = {
 }
 
 
-@pytest.mark.parametrize("command", [["--help"], ["run", "--help"], ["experiment", "pets", "--help"], ["bogus"]])
+@pytest.mark.parametrize(
+    "command", [["--help"], ["run", "--help"], ["experiment", "pets", "--help"], ["score", "--help"], ["bogus"]]
+)
 def test_help_and_bad_commands_load_no_subsystem(command):
     script = (
         "import contextlib, io, sys\n"

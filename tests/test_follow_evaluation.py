@@ -3,7 +3,8 @@
 import numpy as np
 import pytest
 
-from ptztrack.follow.evaluation import box_iou, follow_metrics, one_pass_scores
+from ptztrack.follow.evaluation import follow_metrics, one_pass_scores
+from ptztrack.scene.pets import box_iou
 
 
 def test_follow_metrics_of_a_short_run_computed_by_hand():

@@ -75,6 +75,7 @@ _HOME = {
     "format_table": ".experiments.ptz_tables",
     "episode_metrics": ".evaluate.metrics",
     "write_outputs": ".evaluate.report",
+    "score_files": ".evaluate.score",
 }
 _RENAMED = {"register": (".registry", "register"), "registered_names": (".registry", "names")}
 
@@ -91,6 +92,7 @@ if TYPE_CHECKING:
     from .config import Scenario, ScenarioError, load_dataset, load_scenario, scenario_from_dict
     from .evaluate.metrics import episode_metrics, network_metrics
     from .evaluate.report import write_outputs
+    from .evaluate.score import score_files
     from .experiments.cells import Cell, cell_metrics
     from .experiments.ptz_tables import format_table, recording_cells, summarise, synthetic_cells
     from .geometry.ptz import PTZCamera

@@ -30,6 +30,13 @@ KEPT_DETECTOR_MODELS = ("a-priori", "true")
 """The ``DETECTOR_MODELS`` whose curve is kept, not learned."""
 PROTOCOLS = ("a-priori", "two-fold")
 """How the PETS tables fix their detector's parameters (:func:`ptztrack.experiments.ptz_tables.protocol_folds`)."""
+GATE_M = 1.0
+"""The farthest a track may lie from a person on the ground, in metres, to be matched to them (MOTA, MOTP, IDF1)."""
+MATCH_MIN_IOU = 0.5
+"""In image coordinates, the least intersection over union of a track's box with a person's to match them
+(MOTChallenge's)."""
+SCORE_COORDINATES = ("world", "image")
+"""What ``ptztrack score`` matches tracks to people by: ground positions in metres, or boxes in pixels."""
 
 
 @dataclass(frozen=True)

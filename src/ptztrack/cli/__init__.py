@@ -4,7 +4,8 @@
 then imports the body of the command given from the module of its subject: ``run`` and ``view``
 (:mod:`.run`), the PTZ paper's experiments (:mod:`.ptz_paper`), ``msg`` (:mod:`.msg`),
 ``registration`` (:mod:`.registration`), ``follow`` (:mod:`.follow`), ``occupancy``
-(:mod:`.occupancy`), ``render`` (:mod:`.render`), and the real and virtual cameras (:mod:`.camera`).
+(:mod:`.occupancy`), ``render`` (:mod:`.render`), ``score`` (:mod:`.score`), and the real and virtual cameras
+(:mod:`.camera`).
 """
 
 import argparse

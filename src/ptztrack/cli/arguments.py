@@ -4,7 +4,8 @@ It and its sibling modules below import argparse, the registry's names and :mod:
 so that ``ptztrack --help`` stays quick; each command names its body as ``"module:function"``, which
 :func:`ptztrack.cli.main` imports when the command runs. The PTZ papers' commands are here; the cameras' are in
 :mod:`ptztrack.cli.camera_arguments`, the follow camera's in :mod:`ptztrack.cli.follow_arguments`, those of
-several cameras at once in :mod:`ptztrack.cli.multicamera_arguments`, and the options they share and
+several cameras at once in :mod:`ptztrack.cli.multicamera_arguments`, ``score``'s in
+:mod:`ptztrack.cli.score_arguments`, and the options they share and
 every option's type in :mod:`ptztrack.cli.options`.
 """
 
@@ -32,6 +33,7 @@ from ptztrack.cli.options import (
     protocol_field,
     strategies,
 )
+from ptztrack.cli.score_arguments import add_score_parser
 from ptztrack.names import POSE_SOURCES, PROTOCOLS, PetsProtocol, SyntheticProtocol
 
 
@@ -158,4 +160,5 @@ def parser() -> argparse.ArgumentParser:
     add_network_parser(experiments, detectors)
     add_camera_commands(commands, policies)
     add_render_parser(commands)
+    add_score_parser(commands)
     return root

@@ -8,7 +8,7 @@ from ptztrack.builders.episode import episode_world, make_policy, run_episode
 from ptztrack.cli.options import RUN_FOLDER_FILES
 from ptztrack.cli.scenario import command_scenario
 from ptztrack.cli.watch import Watch
-from ptztrack.evaluate.metrics import DISPLAY, episode_metrics
+from ptztrack.evaluate.metrics import episode_metrics, format_figures
 from ptztrack.evaluate.report import write_outputs
 from ptztrack.files import run_folder
 from ptztrack.loop.executors import Progress
@@ -21,9 +21,8 @@ RUN_FIGURES = ("mota", "motp_m", "idf1", "height_px", "detections", "zoom", "swi
 
 
 def format_metrics(metrics: dict) -> str:
-    """The run's figures (RUN_FIGURES), one a line, named and formatted as ``DISPLAY`` says."""
-    width = max(len(DISPLAY[key][0]) for key in RUN_FIGURES)
-    return "\n".join(f"{DISPLAY[key][0]:<{width}}  {DISPLAY[key][1].format(metrics[key])}" for key in RUN_FIGURES)
+    """The run's figures (RUN_FIGURES), one a line (:func:`~ptztrack.evaluate.metrics.format_figures`)."""
+    return format_figures(metrics, RUN_FIGURES)
 
 
 def run_command(args: argparse.Namespace) -> int:

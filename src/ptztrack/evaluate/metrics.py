@@ -6,7 +6,7 @@ allowed only within ``gate_m`` (1 m). Over several runs, the standard error of a
 figure's mean.
 """
 
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from dataclasses import replace
 
 import motmetrics as mm
@@ -15,9 +15,9 @@ import numpy as np
 from ptztrack.geometry.area import inside
 from ptztrack.loop.simulated import NetworkEpisode
 from ptztrack.loop.steps import Episode
+from ptztrack.names import GATE_M
 from ptztrack.types import GroundTruth, Tracks
 
-GATE_M = 1.0
 # How each figure is shown in tables: label and format.
 DISPLAY = {
     "mota": ("MOTA", "{:.1%}"),
@@ -27,27 +27,57 @@ DISPLAY = {
     "detections": ("# Dets", "{:.1f}"),
     "zoom": ("Zoom [x]", "{:.2f}"),
     "switches": ("ID switches", "{:.0f}"),
+    "motp_iou": ("MOTP [IoU]", "{:.1%}"),
+    "false_positives": ("False positives", "{:.0f}"),
+    "misses": ("Misses", "{:.0f}"),
+    "matches": ("Matches", "{:.0f}"),
+    "objects": ("Person-frames", "{:.0f}"),
 }
 # Why a figure can have no value: written beside it (metrics.json's ``undefined``), since JSON has no NaN.
 UNDEFINED_BECAUSE = {
     "mota": "no person was in view of the scene: MOTA divides by the number of person-instances",
     "motp_m": "no track was matched to a person: MOTP is a mean over matches",
+    "motp_iou": "no track was matched to a person: MOTP is a mean over matches",
     "idf1": "there was neither a person nor a track: IDF1 divides by their number",
     "height_px": "no detection had a known height",
     "zoom": "the episode has no steps",
 }
 
 
-def metric_accumulator(truth_positions_m, track_ids, track_positions_m, gate_m: float = GATE_M):
-    """The motmetrics accumulator of tracks against the truth (arguments as :func:`clear_metrics`): its
-    ``mot_events`` pair every person with a track, frame by frame (MATCH, SWITCH, MISS, FP)."""
+def format_figures(metrics: dict, figures: Sequence[str]) -> str:
+    """The ``figures`` of ``metrics``, one a line, named and formatted as ``DISPLAY`` says."""
+    width = max(len(DISPLAY[key][0]) for key in figures)
+    return "\n".join(f"{DISPLAY[key][0]:<{width}}  {DISPLAY[key][1].format(metrics[key])}" for key in figures)
+
+
+def gated_distances_m(truth_m, tracks_m, gate_m: float = GATE_M) -> np.ndarray:
+    """The distances (n, k) m from n people at truth_m (n, 2) m to k tracks at tracks_m (k, 2) m; NaN, where
+    motmetrics allows no match, beyond ``gate_m``."""
+    distance_m = np.linalg.norm(np.asarray(truth_m)[:, None, :] - np.asarray(tracks_m)[None, :, :], axis=-1)
+    distance_m[distance_m > gate_m] = np.nan
+    return distance_m
+
+
+def frames_accumulator(frames: Iterable[tuple]) -> mm.MOTAccumulator:
+    """The motmetrics accumulator of ``frames``, each (truth_ids (n,), track_ids (k,), distances (n, k)
+    with NaN where no match is allowed): its ``mot_events`` pair every person with a track, frame by
+    frame (MATCH, SWITCH, MISS, FP)."""
     accumulator = mm.MOTAccumulator(auto_id=True)
-    for truth_frame, ids, positions in zip(truth_positions_m, track_ids, track_positions_m, strict=True):
-        present = np.flatnonzero(~np.isnan(truth_frame[:, 0]))
-        distance_m = np.linalg.norm(truth_frame[present, None, :] - np.asarray(positions)[None, :, :], axis=-1)
-        distance_m[distance_m > gate_m] = np.nan
-        accumulator.update(present.tolist(), np.asarray(ids).tolist(), distance_m)
+    for truth_ids, track_ids, distances in frames:
+        accumulator.update(np.asarray(truth_ids).tolist(), np.asarray(track_ids).tolist(), distances)
     return accumulator
+
+
+def metric_accumulator(truth_positions_m, track_ids, track_positions_m, gate_m: float = GATE_M):
+    """The motmetrics accumulator of tracks against the truth (arguments as :func:`clear_metrics`, see
+    :func:`frames_accumulator`); the truth's ids are its columns."""
+
+    def frames():
+        for truth_frame, ids, positions in zip(truth_positions_m, track_ids, track_positions_m, strict=True):
+            present = np.flatnonzero(~np.isnan(truth_frame[:, 0]))
+            yield present, ids, gated_distances_m(truth_frame[present], positions, gate_m)
+
+    return frames_accumulator(frames())
 
 
 def clear_metrics(truth_positions_m, track_ids, track_positions_m, gate_m: float = GATE_M) -> dict:
@@ -59,7 +89,12 @@ def clear_metrics(truth_positions_m, track_ids, track_positions_m, gate_m: float
     Returns mota, motp_m, idf1, switches, false_positives, misses, objects and
     matches (every truth-track correspondence, switches included).
     """
-    accumulator = metric_accumulator(truth_positions_m, track_ids, track_positions_m, gate_m)
+    return accumulator_metrics(metric_accumulator(truth_positions_m, track_ids, track_positions_m, gate_m))
+
+
+def accumulator_metrics(accumulator: mm.MOTAccumulator, motp_key: str = "motp_m") -> dict:
+    """The figures of :func:`clear_metrics` from a motmetrics accumulator; MOTP, the mean distance of the
+    matches, under the name ``motp_key`` (it carries the distances' unit)."""
     summary = mm.metrics.create().compute(
         accumulator,
         metrics=[
@@ -77,7 +112,7 @@ def clear_metrics(truth_positions_m, track_ids, track_positions_m, gate_m: float
     row = summary.loc["episode"]
     return {
         "mota": float(row["mota"]),
-        "motp_m": float(row["motp"]),
+        motp_key: float(row["motp"]),
         "idf1": float(row["idf1"]),
         "switches": int(row["num_switches"]),
         "false_positives": int(row["num_false_positives"]),

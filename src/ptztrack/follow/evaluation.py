@@ -29,6 +29,7 @@ failure (its last box).
 import numpy as np
 
 from ptztrack.camera.virtual import VirtualPTZ
+from ptztrack.scene.pets import box_iou
 
 SUCCESS_THRESHOLDS = np.linspace(0.0, 1.0, 21)
 PRECISION_PX = 20.0
@@ -80,16 +81,6 @@ def follow_metrics(centres_px, heights_px, commanded, lost, image_size_px, targe
         "height_sd_ratio": float(heights.std() / heights.mean()),
         "annotated_steps": int(annotated.sum()),
     }
-
-
-def box_iou(a, b) -> np.ndarray:
-    """Intersection over union of boxes (..., 4) (left, top, width, height); broadcasts."""
-    a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
-    low = np.maximum(a[..., :2], b[..., :2])
-    high = np.minimum(a[..., :2] + a[..., 2:], b[..., :2] + b[..., 2:])
-    intersection = np.prod(np.clip(high - low, 0.0, None), axis=-1)
-    union = np.prod(a[..., 2:], axis=-1) + np.prod(b[..., 2:], axis=-1) - intersection
-    return np.where(union > 0, intersection / np.where(union > 0, union, 1.0), 0.0)
 
 
 def one_pass_scores(tracked_px, annotated_px) -> dict:

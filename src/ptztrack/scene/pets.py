@@ -6,6 +6,7 @@ and CVML XML with pixel boxes (``<frame number>`` from 0). Any problem gets a
 :class:`DatasetError` naming the file and what is wrong.
 """
 
+import io
 import re
 from dataclasses import dataclass
 from pathlib import Path
@@ -56,6 +57,16 @@ def box_feet_px(boxes_px) -> np.ndarray:
     """Where the people of boxes (K, 4+) px (left, top, width, height, ...) stand: their bottom centres (K, 2) px."""
     boxes_px = np.asarray(boxes_px, dtype=float)
     return np.stack([boxes_px[:, 0] + boxes_px[:, 2] / 2, boxes_px[:, 1] + boxes_px[:, 3]], axis=-1)
+
+
+def box_iou(a, b) -> np.ndarray:
+    """Intersection over union of boxes (..., 4) (left, top, width, height); broadcasts."""
+    a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+    low = np.maximum(a[..., :2], b[..., :2])
+    high = np.minimum(a[..., :2] + a[..., 2:], b[..., :2] + b[..., 2:])
+    intersection = np.prod(np.clip(high - low, 0.0, None), axis=-1)
+    union = np.prod(a[..., 2:], axis=-1) + np.prod(b[..., 2:], axis=-1) - intersection
+    return np.where(union > 0, intersection / np.where(union > 0, union, 1.0), 0.0)
 
 
 FIT_BOX_HEIGHTS = 0.5
@@ -128,8 +139,13 @@ def number_rows(
     ``columns`` finite numbers a line, whole frames and ids, frames from ``first_frame``; and the line
     (K,) of each in the file. ``what`` names the kind of file in errors, ``numbered`` the files whose
     frames are counted from ``first_frame`` (e.g. "in MOTChallenge files"), ``layout`` (e.g.
-    " (frame id x y)") follows the count of columns expected."""
+    " (frame id x y)") follows the count of columns expected. Comma-separated text is parsed by NumPy at
+    once; line by line only where a line is wrong, to name it."""
     path = Path(path)
+    if separator == ",":
+        parsed = _comma_rows(text, columns, first_frame)
+        if parsed is not None:
+            return parsed
     rows, lines = [], []
     for number, line in enumerate(text.splitlines(), 1):
         if not line.strip():
@@ -157,6 +173,24 @@ def number_rows(
     if not rows:
         raise DatasetError(f"{path}: no {what} rows")
     return np.asarray(rows), np.asarray(lines)
+
+
+def _comma_rows(text: str, columns: int, first_frame: int) -> tuple[np.ndarray, np.ndarray] | None:
+    """:func:`number_rows` of comma-separated ``text`` in one pass of NumPy's reader, or None where a line
+    is not as expected there (or there is none), for the line-by-line reading to name it."""
+    lines = np.flatnonzero([bool(line.strip()) for line in text.splitlines()]) + 1
+    if not len(lines):
+        return None
+    try:
+        table = np.loadtxt(io.StringIO(text), dtype=float, delimiter=",", comments=None, ndmin=2)
+    except ValueError:
+        return None
+    if table.shape != (len(lines), columns) or not np.all(np.isfinite(table)):
+        return None
+    frame_and_id = table[:, :2]
+    if np.any(frame_and_id != np.round(frame_and_id)) or np.any(table[:, 0] < first_frame):
+        return None
+    return table, lines
 
 
 def refuse_rows_beyond(path: str | Path, frame, line, frames: int, recording: str) -> None:
