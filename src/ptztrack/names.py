@@ -5,6 +5,14 @@ Plain Python values, and frozen dataclasses of them whose fields carry their one
 """
 
 from dataclasses import dataclass, field
+from importlib.metadata import PackageNotFoundError, version
+
+# The installed distribution's version: ``ptztrack --version``, ``ptztrack.__version__``, the virtual
+# camera's firmware.
+try:
+    VERSION = version("ptztrack")
+except PackageNotFoundError:  # a source tree that was not installed
+    VERSION = "0+unknown"
 
 RUN_FILES = (
     "metrics.json",
