@@ -41,7 +41,7 @@ SCENES = {
     },
 }
 SCENES["both"] = {**SCENES["walkers turn less"], **SCENES["camera high"]}
-POLICIES = {"fix": "fix", "patrol": "patrol", "rnd": "random", "intg": "intg", "smpl": "smpl"}
+POLICIES = ("fix", "patrol", "rnd", "intg", "smpl")
 
 
 def counted_in_view(episode) -> dict:
@@ -63,7 +63,7 @@ def counted_in_view(episode) -> dict:
 def cell(arguments) -> dict:
     scene, detector, strategy, seed = arguments
     scenario = scenario_from_dict({**SCENES[scene], "detector": {"kind": detector}})
-    episode = run_episode(scenario, POLICIES[strategy], seed)
+    episode = run_episode(scenario, strategy, seed)
     every_person = clear_metrics(
         episode.truth.positions_m, [tracks.ids for tracks in episode.tracks], [t.mean[:, :2] for t in episode.tracks]
     )

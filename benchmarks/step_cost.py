@@ -84,7 +84,7 @@ from ptztrack.types import DecisionContext, Detections, PeopleInView  # noqa: E4
 cv2.setNumThreads(1)
 
 PARTS = ("read", "warp", "detect", "track", "decide")
-POLICIES = ("fix", "patrol", "random", "intg", "smpl")
+POLICIES = ("fix", "patrol", "rnd", "intg", "smpl")
 # Per detector and view: people found, people (wholly in view, hidden at most occluded_above), detections
 # of somebody, detections; "sized": a match also needs the detection's height within SIZE_FACTOR of the person's.
 COUNTS = ("found", "found_sized", "people", "true", "true_sized", "detections")

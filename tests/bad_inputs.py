@@ -4,9 +4,10 @@ Each case is the files it needs (written into a scratch directory), the command 
 (``{dir}`` is the scratch directory, ``{data}`` the built-in PETS folder) and the exit status
 expected: 2 for a clean one-line error, 0 where the input is legitimate.
 The cases are gathered by subject: :mod:`bad_run_inputs` (``ptztrack run``'s files),
-:mod:`bad_option_inputs` (the command line's options) and :mod:`bad_dataset_inputs` (dataset files), each made
-of :mod:`bad_input_files`. Used by tests/test_bad_inputs.py: every case in-process (:func:`run_case_in_process`),
-a few also in a fresh process (:func:`run_case`).
+:mod:`bad_option_inputs` (the command line's options), :mod:`bad_dataset_inputs` (dataset files) and
+:mod:`bad_command_inputs` (the command line's own mistakes), each made of :mod:`bad_input_files`.
+Used by tests/test_bad_inputs.py: every case in-process (:func:`run_case_in_process`), a few also in a
+fresh process (:func:`run_case`).
 """
 
 import os
@@ -18,6 +19,7 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
+from bad_command_inputs import command_cases
 from bad_dataset_inputs import dataset_cases
 from bad_input_files import Case
 from bad_option_inputs import option_cases
@@ -26,7 +28,7 @@ from bad_run_inputs import run_cases
 
 def cases(scratch: Path | None) -> list[Case]:
     """Every case; ``scratch`` is where video files are made (None: a temporary folder)."""
-    return [*run_cases(scratch), *option_cases(), *dataset_cases(scratch)]
+    return [*run_cases(scratch), *option_cases(), *dataset_cases(scratch), *command_cases()]
 
 
 @dataclass(frozen=True)

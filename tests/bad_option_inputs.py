@@ -99,21 +99,23 @@ def option_cases() -> list[Case]:
             says=("{dir}/missing.csv: no such truth log file",),
         ),
         Case(
-            "live: --time-scale 0", ("live", "--camera", "127.0.0.1", "--calibration", "virtual", "--time-scale", "0")
+            "live: --time-scale 0",
+            ("live", "--camera", "onvif://127.0.0.1", "--calibration", "virtual", "--time-scale", "0"),
         ),
         Case(
             "live: a zoom curve that falls",
-            ("live", "--camera", "127.0.0.1:9", "--calibration", "{dir}/c.yaml"),
+            ("live", "--camera", "onvif://127.0.0.1:9", "--calibration", "{dir}/c.yaml"),
             {"c.yaml": "pan_deg: [-90, 90]\ntilt_deg: [-45, 45]\nzoom_curve: [[0, 4], [1, 1]]\n"},
         ),
         Case(
             "live: two cameras, three calibrations",
-            ("live", "--camera", "127.0.0.1:9", "--camera", "127.0.0.1:10", *("--calibration", "virtual") * 3),
+            ("live", "--camera", "onvif://127.0.0.1:9", "--camera", "onvif://127.0.0.1:10")
+            + ("--calibration", "virtual") * 3,
             says=("3 --calibration for 2 --camera",),
         ),
         Case(
             "live: a network deciding by fix",
-            ("live", "--camera", "127.0.0.1:9", "--camera", "127.0.0.1:10", "--calibration", "virtual")
+            ("live", "--camera", "onvif://127.0.0.1:9", "--camera", "onvif://127.0.0.1:10", "--calibration", "virtual")
             + ("--policy", "fix"),
             says=("intg or smpl", "fix"),
         ),

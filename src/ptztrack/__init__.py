@@ -15,17 +15,13 @@ Roles (protocols a new implementation follows): ``CameraBackend``, ``Detector``,
 
 import os
 from importlib import import_module
-from importlib.metadata import PackageNotFoundError, version
 from typing import TYPE_CHECKING
+
+from ptztrack.names import VERSION as __version__
 
 # FFmpeg's decoders print several lines of their own for each damaged frame (a truncated video's last);
 # every bad video gets one line of ptztrack's. OpenCV reads this once, when it first uses FFmpeg.
 os.environ.setdefault("OPENCV_FFMPEG_LOGLEVEL", "-8")
-
-try:
-    __version__ = version("ptztrack")
-except PackageNotFoundError:  # a source tree that was not installed
-    __version__ = "0+unknown"
 
 _HOME = {
     # configuration

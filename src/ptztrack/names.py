@@ -5,6 +5,14 @@ Plain Python values, and frozen dataclasses of them whose fields carry their one
 """
 
 from dataclasses import dataclass, field
+from importlib.metadata import PackageNotFoundError, version
+
+# The installed distribution's version: ``ptztrack --version``, ``ptztrack.__version__``, the virtual
+# camera's firmware.
+try:
+    VERSION = version("ptztrack")
+except PackageNotFoundError:  # a source tree that was not installed
+    VERSION = "0+unknown"
 
 RUN_FILES = (
     "metrics.json",
@@ -20,7 +28,7 @@ RUN_FILES = (
 VIEW_STATES_FILE = "view_states.jsonl"
 """The web view's states of a run, beside its files (:mod:`ptztrack.view.view_state`)."""
 STRATEGIES = ("fix", "patrol", "rnd", "intg", "smpl")
-"""The PTZ paper's strategies, as its tables name them ('rnd' is the 'random' policy)."""
+"""The PTZ paper's strategies, as its tables name them: the built-in policies' names."""
 POSE_SOURCES = ("oracle", "commanded", "registered")
 """Where the tracker takes the camera's pose from (:mod:`ptztrack.camera.pose_feedback`)."""
 DETECTOR_MODELS = ("a-priori", "online", "true")

@@ -12,11 +12,15 @@ Four kinds: ``policies``, ``detectors``, ``cameras`` (camera backends) and
 Names come from three places, in this order of precedence: ptztrack's own
 (imported only when used), the entry points of installed packages in the
 groups ``ptztrack.policies``, ``ptztrack.detectors``, ``ptztrack.cameras``
-and ``ptztrack.trackers``, and :func:`register` at run time::
+and ``ptztrack.trackers``, and :func:`register` at run time (in that process only: the ``ptztrack``
+command finds another package's names through its entry points)::
 
     # pyproject.toml of another package
     [project.entry-points."ptztrack.policies"]
     greedy = "my_package.policies:make_greedy"
+
+A name that ptztrack has replaced (:data:`RENAMED`) is still taken wherever a
+name is, with one warning line naming the current one (:func:`current_name`).
 
 This module imports nothing else of ptztrack: the built-in factories are
 named by their import paths.
@@ -24,6 +28,7 @@ named by their import paths.
 
 import functools
 import importlib
+import logging
 from collections.abc import Callable
 from importlib.metadata import entry_points
 from typing import Any
@@ -36,7 +41,9 @@ _FACTORIES = "ptztrack.builders.factories"
 _FOLLOW = "ptztrack.builders.follow"
 _BUILT_IN: dict[str, dict[str, str]] = {
     "policies": {
-        **{name: f"{_FACTORIES}:{name}_policy" for name in ("fix", "patrol", "random", "intg", "smpl")},
+        **{name: f"{_FACTORIES}:{name}_policy" for name in ("fix", "patrol")},
+        "rnd": f"{_FACTORIES}:random_policy",
+        **{name: f"{_FACTORIES}:{name}_policy" for name in ("intg", "smpl")},
         "follow": f"{_FOLLOW}:follow_policy",
     },
     "detectors": {name: f"{_FACTORIES}:{name}_detector" for name in ("ideal", "realistic", "hog", "detections")},
@@ -47,6 +54,11 @@ _BUILT_IN: dict[str, dict[str, str]] = {
     },
 }
 _registered: dict[str, dict[str, Callable[..., Any]]] = {kind: {} for kind in KINDS}
+RENAMED: dict[str, dict[str, str]] = {"policies": {"random": "rnd"}, "detectors": {}, "cameras": {}, "trackers": {}}
+"""Former names of built-in implementations, by kind: {former: current}. One spelling per policy, the one
+the PTZ paper's tables print and ``experiment`` took ('rnd'), for every command and file."""
+_warned: set[tuple[str, str]] = set()
+log = logging.getLogger(__name__)
 
 
 class UnknownName(ValueError):
@@ -69,9 +81,25 @@ def names(kind: str) -> list[str]:
     return list(dict.fromkeys([*_BUILT_IN[kind], *_entry_points(kind), *_registered[kind]]))
 
 
-def factory(kind: str, name: str) -> Callable[..., Any]:
-    """The factory registered for ``name``; raises :class:`UnknownName` naming the choices."""
+def current_name(kind: str, name: str) -> str:
+    """``name``, or the current name of a former one (:data:`RENAMED`), said once per process in a warning
+    line."""
     _check_kind(kind)
+    current = RENAMED[kind].get(name)
+    if current is None:
+        return name
+    if (kind, name) not in _warned:
+        _warned.add((kind, name))
+        log.warning(
+            f"the {_SINGULAR[kind]} {name!r} is now called {current!r} (the old name will go in a later release)"
+        )
+    return current
+
+
+def factory(kind: str, name: str) -> Callable[..., Any]:
+    """The factory registered for ``name`` (or for the current name of a former one); raises
+    :class:`UnknownName` naming the choices."""
+    name = current_name(kind, name)
     if name in _BUILT_IN[kind]:
         module, _, attribute = _BUILT_IN[kind][name].partition(":")
         return getattr(importlib.import_module(module), attribute)
@@ -83,14 +111,15 @@ def factory(kind: str, name: str) -> Callable[..., Any]:
 
 
 def register(kind: str, name: str, make: Callable[..., Any] | None = None):
-    """Register ``make`` as the factory of ``name``; without ``make``, a decorator that does so.
+    """Register ``make`` as the factory of ``name`` in this process (the ``ptztrack`` command, a process of its
+    own, finds another package's names through its entry points); without ``make``, a decorator that does so.
 
-    A name that is taken (built in, installed, or registered before) is refused.
+    A name that is taken (built in, a former built-in name, installed, or registered before) is refused.
     """
     _check_kind(kind)
 
     def add(make: Callable[..., Any]) -> Callable[..., Any]:
-        if name in names(kind):
+        if name in names(kind) or name in RENAMED[kind]:
             raise ValueError(f"{kind}: the name {name!r} is taken")
         _registered[kind][name] = make
         return make

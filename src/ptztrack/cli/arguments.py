@@ -17,6 +17,7 @@ from ptztrack.cli.camera_arguments import add_camera_commands
 from ptztrack.cli.follow_arguments import add_follow_commands
 from ptztrack.cli.multicamera_arguments import add_network_parser, add_occupancy_parser, add_render_parser
 from ptztrack.cli.options import (
+    POLICY_HELP,
     RUN_FOLDER_FILES,
     add_association_argument,
     add_detector_model_arguments,
@@ -27,35 +28,73 @@ from ptztrack.cli.options import (
     add_view_argument,
     non_negative_float,
     non_negative_int,
+    policy_name,
     port_number,
     positive_float,
     positive_int,
     protocol_field,
-    strategies,
 )
 from ptztrack.cli.score_arguments import add_score_parser
-from ptztrack.names import POSE_SOURCES, PROTOCOLS, PetsProtocol, SyntheticProtocol
+from ptztrack.names import POSE_SOURCES, PROTOCOLS, VERSION, PetsProtocol, SyntheticProtocol
+
+
+class DefaultsShown(argparse.HelpFormatter):
+    """Every option's help ends in its default, as it is typed, unless the help already tells it or there
+    is none (None, or an unset flag)."""
+
+    def _get_help_string(self, action: argparse.Action) -> str:
+        text, default = action.help or "", action.default
+        unset = default is None or default is False or default == argparse.SUPPRESS
+        if not action.option_strings or unset or "default" in text:
+            return text
+        words = default if isinstance(default, list | tuple) else [default]
+        shown = " ".join(f"{word:g}" if isinstance(word, float) else str(word) for word in words)
+        return f"{text} (default {shown.replace('%', '%%')})"
 
 
 class OneLineParser(argparse.ArgumentParser):
-    """Command-line mistakes end in one line on stderr and exit status 2, like every other bad input."""
+    """Command-line mistakes end in one line on stderr and exit status 2, like every other bad input, naming
+    the help of the command they were made in."""
+
+    def __init__(self, *args, **kwargs) -> None:
+        kwargs.setdefault("formatter_class", DefaultsShown)
+        super().__init__(*args, **kwargs)
 
     def error(self, message: str):
         self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
 
+    def parse_args(self, args=None, namespace=None):
+        """As argparse's, but words left over are an error of the innermost command given (its help tells
+        what it takes), not of ``ptztrack`` itself."""
+        parsed, extras = self.parse_known_args(args, namespace)
+        if extras:
+            command: argparse.ArgumentParser = self
+            while (choose := _subcommands(command)) is not None:
+                command = choose.choices[getattr(parsed, choose.dest)]
+            command.error(f"unrecognized arguments: {' '.join(extras)}")
+        return parsed
+
+
+def _subcommands(command: argparse.ArgumentParser) -> argparse._SubParsersAction | None:
+    """The action that picks ``command``'s subcommand, if it has subcommands."""
+    return next((each for each in command._actions if isinstance(each, argparse._SubParsersAction)), None)
+
 
 def parser() -> argparse.ArgumentParser:
     root = OneLineParser(prog="ptztrack", description="Multi-person tracking with a PTZ camera.")
+    root.add_argument("--version", action="version", version=f"ptztrack {VERSION}")
     commands = root.add_subparsers(dest="command", required=True)
     policies, detectors = registry.names("policies"), registry.names("detectors")
     run = commands.add_parser("run", help="run one closed-loop episode and print its metrics")
     run.add_argument(
         "--scenario", default="synthetic", help="'synthetic' or 'pets' (built in), or a scenario YAML file"
     )
-    run.add_argument("--policy", choices=policies, default="smpl")
+    run.add_argument("--policy", type=policy_name, choices=policies, default="smpl", help=POLICY_HELP)
     run.add_argument("--detector", choices=detectors, help="overrides the scenario's detector")
     add_detector_model_arguments(run, prior_shift=True)
-    run.add_argument("--seed", type=non_negative_int, default=0)
+    run.add_argument(
+        "--seed", type=non_negative_int, default=0, help="fixes the run's random draws: the same seed, the same run"
+    )
     run.add_argument("--frames", type=positive_int, help="overrides the scenario's number of frames")
     add_tracker_arguments(run)
     run.add_argument(
@@ -87,7 +126,11 @@ def parser() -> argparse.ArgumentParser:
     synthetic.add_argument("--sequences", type=positive_int, **protocol_field(SyntheticProtocol, "sequences"))
     synthetic.add_argument("--frames", type=positive_int, help="overrides the scenario's number of frames")
     synthetic.add_argument(
-        "--strategies", nargs="+", choices=strategies(policies), **protocol_field(SyntheticProtocol, "strategies")
+        "--strategies",
+        nargs="+",
+        type=policy_name,
+        choices=policies,
+        **protocol_field(SyntheticProtocol, "strategies"),
     )
     add_association_argument(synthetic)
     add_executor_arguments(synthetic, "one row per strategy")
@@ -102,7 +145,7 @@ def parser() -> argparse.ArgumentParser:
         "--beta", type=non_negative_float, action="append", **protocol_field(PetsProtocol, "betas", repeatable=True)
     )
     pets.add_argument(
-        "--strategies", nargs="+", choices=strategies(policies), **protocol_field(PetsProtocol, "strategies")
+        "--strategies", nargs="+", type=policy_name, choices=policies, **protocol_field(PetsProtocol, "strategies")
     )
     pets.add_argument("--frames", type=positive_int, help="overrides the scenario's number of steps")
     pets.add_argument("--protocol", choices=PROTOCOLS, **protocol_field(PetsProtocol, "protocol"))
@@ -135,7 +178,9 @@ def parser() -> argparse.ArgumentParser:
     )
     registration.add_argument("--detector", choices=detectors, default="hog", help="closed-loop detector")
     add_detector_model_arguments(registration)
-    registration.add_argument("--policy", choices=policies, default="smpl", help="closed-loop policy")
+    registration.add_argument(
+        "--policy", type=policy_name, choices=policies, default="smpl", help="the closed loop's policy"
+    )
     registration.add_argument(
         "--pose-sources", nargs="+", choices=POSE_SOURCES, default=list(POSE_SOURCES), help="closed-loop pose sources"
     )

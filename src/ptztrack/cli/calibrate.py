@@ -87,6 +87,17 @@ def calibrate_geometry_command(args: argparse.Namespace, credentials: dict | Non
     return 0
 
 
+def calibration_to_time(path: Path) -> CameraCalibrationFile:
+    """The calibration file that ``camera calibrate`` (without ``--geometry``) times a camera's moves into;
+    a missing one is refused naming the command that starts one."""
+    if not Path(path).exists():
+        raise ScenarioError(
+            f"--calibration {path}: no such file; start one with ptztrack camera calibrate --geometry --snapshot "
+            "PICTURE.png (docs: Real cameras), then time the moves into it"
+        )
+    return load_camera_calibration(path)
+
+
 def _first_picture(latest: LatestFrame, camera: str) -> np.ndarray:
     frame = latest.newer(0, FIRST_PICTURE_S)
     if frame is None:

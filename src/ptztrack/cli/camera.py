@@ -7,6 +7,7 @@ import os
 import sys
 import time
 from pathlib import Path
+from urllib.parse import urlsplit
 
 import numpy as np
 
@@ -32,7 +33,7 @@ from ptztrack.config import (
     MoveTimesSection,
     ScenarioError,
     load_camera_calibration,
-    read_yaml,
+    load_credentials,
     write_camera_calibration,
 )
 from ptztrack.evaluate.metrics import episode_metrics
@@ -44,13 +45,14 @@ from ptztrack.view.view_state import NetworkViewState, ViewState
 
 
 def _credentials(args: argparse.Namespace) -> dict | None:
-    """The ``--credentials`` file's {username, password}, if given (a YAML or JSON mapping)."""
+    """The ``--credentials`` file's {username, password}, if given, checked before any camera is called; its
+    username may be left to ``--user`` or to every ``--camera`` URL's user."""
     if args.credentials is None:
         return None
-    data = read_yaml(args.credentials, "credentials", ScenarioError)
-    if not isinstance(data, dict) or not set(data) <= {"username", "password"}:
-        raise ScenarioError(f"{args.credentials}: expected a mapping with username and password")
-    return {key: str(value) for key, value in data.items()}
+    cameras = getattr(args, "camera", None) or []  # serve-camera has none
+    urls = cameras if isinstance(cameras, list) else [cameras]
+    users_in_urls = bool(urls) and all(urlsplit(url).username for url in urls)
+    return load_credentials(args.credentials, getattr(args, "user", None) is not None or users_in_urls)
 
 
 def live_command(args: argparse.Namespace) -> int:
@@ -178,13 +180,13 @@ def read_truth_log(path: Path) -> np.ndarray:
 
 
 def calibrate_camera_command(args: argparse.Namespace) -> int:
-    if args.geometry:
-        from ptztrack.cli.calibrate import calibrate_geometry_command
+    from ptztrack.cli.calibrate import calibrate_geometry_command, calibration_to_time
 
+    if args.geometry:
         return calibrate_geometry_command(args, _credentials(args))
     if args.snapshot is not None or args.ground_points is not None:
         raise ScenarioError("camera calibrate: --snapshot and --ground-points go with --geometry")
-    calibration = load_camera_calibration(args.calibration)
+    calibration = calibration_to_time(args.calibration)
     check_output_file(args.calibration, "--calibration")  # rewritten after minutes of timed moves
     client = ONVIFClient(camera_address(args.camera, _credentials(args)), args.timeout_s)
     stream = None

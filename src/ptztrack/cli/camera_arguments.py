@@ -5,11 +5,14 @@ calibrate``, ``ptztrack serve-camera`` and ``ptztrack serve``.
 from pathlib import Path
 
 from ptztrack.cli.options import (
+    POLICY_HELP,
     RUN_FOLDER_FILES,
     add_detector_model_arguments,
     add_recording_arguments,
     add_view_argument,
     non_negative_int,
+    onvif_url,
+    policy_name,
     port_number,
     positive_float,
     positive_int,
@@ -22,6 +25,7 @@ def add_camera_commands(commands, policies: list[str]) -> None:
     live = commands.add_parser("live", help="drive an ONVIF PTZ camera in real time: capture, detect, track, decide")
     live.add_argument(
         "--camera",
+        type=onvif_url,
         required=True,
         action="append",
         help="onvif://[user[:password]@]host[:port]; repeated: a network of cameras with one ground belief",
@@ -40,7 +44,7 @@ def add_camera_commands(commands, policies: list[str]) -> None:
         default="joint",
         help="a network's decisions: joint (greedy, each camera on the views before it) or each camera alone",
     )
-    live.add_argument("--policy", choices=policies, default="smpl")
+    live.add_argument("--policy", type=policy_name, choices=policies, default="smpl", help=POLICY_HELP)
     live.add_argument("--scenario", default="pets", help="'pets' (built in) or a scenario YAML file")
     add_recording_arguments(live, files=False)
     live.add_argument("--detector", default="hog", help="the scenario's detector (default hog)")
@@ -63,7 +67,9 @@ def add_camera_commands(commands, policies: list[str]) -> None:
     live.add_argument(
         "--truth", type=Path, help="score against a virtual camera's truth log (serve-camera --truth-log)"
     )
-    live.add_argument("--seed", type=non_negative_int, default=0)
+    live.add_argument(
+        "--seed", type=non_negative_int, default=0, help="fixes the run's random draws (rnd's and smpl's, say)"
+    )
     live.add_argument(
         "--out", type=Path, help=f"directory for {', '.join(RUN_FOLDER_FILES)}; written whole, Ctrl-C too"
     )
@@ -77,7 +83,7 @@ def add_camera_commands(commands, policies: list[str]) -> None:
         help="time the camera's moves, or (--geometry) measure its focal lengths, pan and tilt mapping and "
         "place on the ground from its pictures, and write them into its calibration",
     )
-    calibrate.add_argument("--camera", required=True, help="onvif://[user[:password]@]host[:port]")
+    calibrate.add_argument("--camera", type=onvif_url, required=True, help="onvif://[user[:password]@]host[:port]")
     calibrate.add_argument("--credentials", type=Path, help="a YAML file with username and password")
     calibrate.add_argument(
         "--calibration", type=Path, required=True, help="the camera's calibration YAML (updated; --geometry: created)"

@@ -6,7 +6,7 @@ from pathlib import Path
 
 from ptztrack.builders.recording import FOLLOW_PROTOCOL, pets_follow_scenario
 from ptztrack.cli.options import RUN_FOLDER_FILES
-from ptztrack.cli.scenario import build_scenario, recording_overrides, recording_paths
+from ptztrack.cli.scenario import build_scenario, recording_overrides, recording_paths, scenario_file
 from ptztrack.cli.watch import Watch
 from ptztrack.config import Scenario, load_scenario
 from ptztrack.evaluate.report import write_outputs
@@ -45,7 +45,7 @@ def _follow_scenario(args: argparse.Namespace, tracker: str = "particle") -> Sce
         )
     if args.scenario == "pets":
         return pets_follow_scenario(tracker, **overrides)
-    return load_scenario(args.scenario, **overrides, **{"tracker.kind": tracker})
+    return load_scenario(scenario_file(args.scenario, ("pets",)), **overrides, **{"tracker.kind": tracker})
 
 
 def follow_command(args: argparse.Namespace) -> int:

@@ -17,13 +17,16 @@ from ptztrack.cli.options import (
 )
 from ptztrack.names import FOLLOW_TRACKERS, OTB_TRACKS
 
+TRACKER_HELP = "what follows the person in the picture: the paper's particle filter, or OpenCV's CSRT or MIL"
+SEED_HELP = "fixes the run's random draws (the particle filter's): the same seed, the same run"
+
 
 def add_follow_commands(commands, experiments) -> None:
     """``ptztrack follow`` and ``ptztrack experiment follow``: the robot-cameraman paper's follow camera."""
     follow = commands.add_parser("follow", help="follow one annotated PETS person with the virtual PTZ camera")
     follow.add_argument("--target", type=non_negative_int, required=True, help="the annotated person's id")
-    follow.add_argument("--tracker", choices=FOLLOW_TRACKERS, default="particle")
-    follow.add_argument("--seed", type=non_negative_int, default=0)
+    follow.add_argument("--tracker", choices=FOLLOW_TRACKERS, default="particle", help=TRACKER_HELP)
+    follow.add_argument("--seed", type=non_negative_int, default=0, help=SEED_HELP)
     follow.add_argument("--frames", type=positive_int, help="at most this many steps")
     follow.add_argument(
         "--target-point-px",
@@ -46,12 +49,14 @@ def add_follow_commands(commands, experiments) -> None:
     experiment = experiments.add_parser(
         "follow", help="the robot-cameraman paper: every PETS person followed, and the one-pass benchmark"
     )
-    experiment.add_argument("--trackers", nargs="+", choices=FOLLOW_TRACKERS, default=list(FOLLOW_TRACKERS))
+    experiment.add_argument(
+        "--trackers", nargs="+", choices=FOLLOW_TRACKERS, default=list(FOLLOW_TRACKERS), help=TRACKER_HELP
+    )
     experiment.add_argument("--targets", type=non_negative_int, nargs="+", help="people to follow (default: all)")
     experiment.add_argument(
         "--otb-tracks", type=non_negative_int, default=OTB_TRACKS, help="longest tracks of the one-pass benchmark"
     )
-    experiment.add_argument("--seed", type=non_negative_int, default=0)
+    experiment.add_argument("--seed", type=non_negative_int, default=0, help=SEED_HELP)
     _add_follow_scenario_arguments(experiment)
     add_executor_arguments(experiment, '{"closed_loop": [...], "otb": [...]} and the rows per person')
     experiment.set_defaults(handler="ptztrack.cli.follow:follow_experiment_command")

@@ -3,10 +3,11 @@
 Shared: the run folder's files (``RUN_FOLDER_FILES``), the executor, ``--quiet``, ``--view``, the detector's
 model, the tracker's overrides and the recording (a dataset file's view, or single files). A type turns the
 text of an option into its value or raises :class:`argparse.ArgumentTypeError`, whose message argparse puts
-after "argument --option: ": finite numbers, whole numbers, ports (0 to 65535) and frame counts (at most
-``MAX_FRAMES``).
+after "argument --option: ": finite numbers, whole numbers, ports (0 to 65535), frame counts (at most
+``MAX_FRAMES``), policy names and ONVIF addresses.
 
-It imports argparse and :mod:`ptztrack.names` only, so that ``ptztrack --help`` stays quick.
+It imports argparse, the registry's names and :mod:`ptztrack.names` only, so that ``ptztrack --help`` stays
+quick.
 """
 
 import argparse
@@ -15,14 +16,14 @@ from dataclasses import fields
 from pathlib import Path
 from typing import Any
 
-from ptztrack.names import EXECUTORS, MAX_FRAMES, RUN_FILES, STRATEGIES, VIEW_STATES_FILE
+from ptztrack import registry
+from ptztrack.names import EXECUTORS, MAX_FRAMES, RUN_FILES, VIEW_STATES_FILE
 
 RUN_FOLDER_FILES = (*RUN_FILES, VIEW_STATES_FILE)
-
-
-def strategies(policies: list[str]) -> list[str]:
-    """The tables' strategy names ('rnd' for the 'random' policy) and every other registered policy."""
-    return list(dict.fromkeys([*STRATEGIES, *(name for name in policies if name != "random")]))
+POLICY_HELP = (
+    "how the camera picks its next view: the PTZ paper's fix, patrol, rnd (at random), intg or smpl, or a "
+    "registered policy"
+)
 
 
 def protocol_field(protocol: type, name: str, repeatable: bool = False) -> dict[str, Any]:
@@ -45,7 +46,12 @@ def protocol_field(protocol: type, name: str, repeatable: bool = False) -> dict[
 
 
 def add_executor_arguments(command: argparse.ArgumentParser, rows: str) -> None:
-    command.add_argument("--executor", choices=EXECUTORS, default="local")
+    command.add_argument(
+        "--executor",
+        choices=EXECUTORS,
+        default="local",
+        help="where the runs go: processes on this machine, a Ray cluster, or one after another in this process",
+    )
     command.add_argument("--workers", type=positive_int, help="processes of the local executor (default: all cores)")
     command.add_argument("--json", type=Path, help=f"write {rows} here")
     add_quiet_argument(command)
@@ -150,6 +156,25 @@ def non_negative_int(text: str) -> int:
 
 def positive_int(text: str) -> int:
     return _whole_number(text, 1)
+
+
+def policy_name(text: str) -> str:
+    """A policy's name as typed; a former name is its current one, with a line on stderr saying so."""
+    return registry.current_name("policies", text)
+
+
+def onvif_url(text: str) -> str:
+    """A camera's address ``onvif://[user[:password]@]host[:port]``, its scheme required; an error never
+    shows the password."""
+    scheme, separator, rest = text.partition("://")
+    if separator and scheme == "onvif":
+        return text
+    if separator:
+        raise argparse.ArgumentTypeError(f"expected onvif://[user[:password]@]host[:port], not {scheme}://")
+    host = text.rpartition("@")[2]
+    raise argparse.ArgumentTypeError(
+        f"{host!r} has no scheme; expected onvif://[user[:password]@]host[:port], as onvif://{host}"
+    )
 
 
 def port_number(text: str) -> int:

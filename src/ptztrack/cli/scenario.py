@@ -1,9 +1,21 @@
 """The scenario a command runs: a built-in one or a YAML file, with the command line's overrides."""
 
 import argparse
+import difflib
+from pathlib import Path
 
 from ptztrack.builders.recording import dataset_scenario, pets_scenario
-from ptztrack.config import PETS_DATASET_FILE, Scenario, load_dataset, load_scenario, pets_dataset, scenario_from_dict
+from ptztrack.config import (
+    PETS_DATASET_FILE,
+    Scenario,
+    ScenarioError,
+    load_dataset,
+    load_scenario,
+    pets_dataset,
+    scenario_from_dict,
+)
+
+BUILT_IN_SCENARIOS = ("synthetic", "pets")
 
 
 def build_scenario(
@@ -47,7 +59,7 @@ def build_scenario(
         return scenario_from_dict({}, "synthetic", **overrides)
     if name_or_path == "pets":
         return pets_scenario(str(overrides.pop("detector.kind", "ideal")), **overrides)
-    return load_scenario(name_or_path, **overrides)
+    return load_scenario(scenario_file(name_or_path), **overrides)
 
 
 def _dataset_scenario(
@@ -59,9 +71,22 @@ def _dataset_scenario(
         loaded, path = pets_dataset(), str(PETS_DATASET_FILE)
     else:
         loaded, path = load_dataset(dataset), dataset
-    if name_or_path not in ("synthetic", "pets"):
-        protocol = load_scenario(name_or_path).model_dump(exclude_unset=True, exclude={"recording"})
+    if name_or_path not in BUILT_IN_SCENARIOS:
+        protocol = load_scenario(scenario_file(name_or_path)).model_dump(exclude_unset=True, exclude={"recording"})
     return dataset_scenario(loaded, view, protocol, path, **overrides)
+
+
+def scenario_file(name: str, built_in: tuple[str, ...] = BUILT_IN_SCENARIOS) -> str:
+    """``name``, a ``--scenario`` other than the ``built_in`` names, if there is such a file (or folder, which
+    the reader refuses as such); else refused suggesting the closest built-in name or YAML file beside it."""
+    path = Path(name)
+    if path.exists():
+        return name
+    folder = path.parent
+    files = [str(folder / each.name) for each in sorted(folder.glob("*.y*ml"))] if folder.is_dir() else []
+    close = difflib.get_close_matches(name, [*built_in, *files], n=1)
+    hint = f"did you mean {close[0]!r}?" if close else f"expected {', '.join(built_in)} (built in) or a YAML file"
+    raise ScenarioError(f"--scenario {name}: no such scenario file; {hint}")
 
 
 def command_scenario(args: argparse.Namespace, name_or_path: str) -> Scenario:

@@ -3,9 +3,9 @@
 :mod:`~ptztrack.config.scenario` (the scenario and its sections, with those of
 :mod:`~ptztrack.config.camera` and :mod:`~ptztrack.config.follow`), :mod:`~ptztrack.config.dataset`
 (multi-view datasets and the occupancy map), :mod:`~ptztrack.config.camera_calibration` (a real
-camera's calibration file), :mod:`~ptztrack.config.reading` (YAML files and one-line errors) and
-:mod:`~ptztrack.config.fields` (the models' building blocks). Every public name of these modules
-is importable from here.
+camera's calibration file), :mod:`~ptztrack.config.reading` (YAML files, credentials files and
+one-line errors) and :mod:`~ptztrack.config.fields` (the models' building blocks). Every public name of
+these modules is importable from here.
 """
 
 from ptztrack.config.camera import Actions, AxisRange, Camera, LiveView, PoseError, PoseFeedback
@@ -41,7 +41,7 @@ from ptztrack.config.fields import (
     at_most_items,
 )
 from ptztrack.config.follow import Follow, Fraction, Patch
-from ptztrack.config.reading import SCENARIO_MAX_BYTES, YAML_MAX_VALUES, ScenarioError, read_yaml
+from ptztrack.config.reading import SCENARIO_MAX_BYTES, YAML_MAX_VALUES, ScenarioError, load_credentials, read_yaml
 from ptztrack.config.scenario import (
     DETECTOR_MODELS,
     Control,
@@ -98,6 +98,7 @@ __all__ = [
     "at_most_items",
     "dataset_from_dict",
     "load_camera_calibration",
+    "load_credentials",
     "load_dataset",
     "load_scenario",
     "pets_dataset",

@@ -19,7 +19,7 @@ from ptztrack.config.fields import (
     at_most,
     at_most_items,
 )
-from ptztrack.config.reading import ScenarioError, _first_error_line, read_yaml
+from ptztrack.config.reading import FILE_KINDS, ScenarioError, _first_error_line, read_yaml, refuse_another_kind
 from ptztrack.files import write_atomically
 
 _MoveTime = tuple[
@@ -99,11 +99,15 @@ class CameraCalibrationFile(_Strict):
         return self
 
 
+FILE_KINDS["camera calibration"] = CameraCalibrationFile
+
+
 def load_camera_calibration(path: str | Path) -> CameraCalibrationFile:
     """Read and validate a camera calibration YAML file; a :class:`ScenarioError` of one line if it is not one."""
     data = read_yaml(path, "camera calibration", ScenarioError)
     if not isinstance(data, dict):
         raise ScenarioError(f"{path}: expected a mapping of camera calibration fields (got {type(data).__name__})")
+    refuse_another_kind(path, data, "camera calibration")
     try:
         return CameraCalibrationFile.model_validate(data)
     except pydantic.ValidationError as error:

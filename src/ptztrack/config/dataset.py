@@ -10,7 +10,7 @@ import pydantic
 from pydantic import Field, model_validator
 
 from ptztrack.config.fields import _MAX_FRAMES, NonNegativeFloat, Pixels, PositiveFloat, _Strict, at_most, at_most_items
-from ptztrack.config.reading import ScenarioError, _first_error_line, read_yaml
+from ptztrack.config.reading import FILE_KINDS, ScenarioError, _first_error_line, read_yaml, refuse_another_kind
 from ptztrack.config.scenario import Tracker
 from ptztrack.occupancy.parameters import OccupancyParameters
 
@@ -167,6 +167,9 @@ class MultiViewDataset(_Strict):
 DATASET_PATH_FIELDS = ("calibration", "video", "images", "detections", "ground_truth")
 
 
+FILE_KINDS["dataset"] = MultiViewDataset
+
+
 def dataset_from_dict(data: Any, source: str = "dataset") -> MultiViewDataset:
     """Validate a multi-view dataset mapping; a :class:`ScenarioError` of one line naming the field."""
     if not isinstance(data, dict):
@@ -182,6 +185,7 @@ def load_dataset(path: str | Path) -> MultiViewDataset:
     path = Path(path)
     data = read_yaml(path, "dataset", ScenarioError)
     if isinstance(data, dict):
+        refuse_another_kind(path, data, "dataset")
         base = path.parent
         if isinstance(data.get("ground_truth"), str):
             data = {**data, "ground_truth": str(base / data["ground_truth"])}

@@ -40,10 +40,14 @@ Degrees = Annotated[float, Field(ge=-360), at_most(360, "an angle in degrees")]
 
 
 def _registered(kind: str):
-    """A field that names an implementation registered under ``kind`` (:mod:`ptztrack.registry`)."""
+    """A field that names an implementation registered under ``kind`` (:mod:`ptztrack.registry`); a former
+    name becomes the current one."""
 
     def check(name: str | None) -> str | None:
-        if name is not None and name not in registry.names(kind):
+        if name is None:
+            return None
+        name = registry.current_name(kind, name)
+        if name not in registry.names(kind):
             raise ValueError(f"expected one of {', '.join(registry.names(kind))}")
         return name
 

@@ -1,5 +1,5 @@
-"""Reading a user's configuration: YAML files read safely, and a validation error told in one line
-naming the file, the field and the value (:class:`ScenarioError`)."""
+"""Reading a user's configuration: YAML files read safely, a camera's credentials file, and a validation
+error told in one line naming the file, the field and the value (:class:`ScenarioError`)."""
 
 from collections.abc import Hashable
 from pathlib import Path
@@ -16,6 +16,24 @@ YAML_MAX_VALUES = 100_000
 
 class ScenarioError(InputError):
     """A scenario that cannot be run; the message is one line naming the field and value."""
+
+
+FILE_KINDS: dict[str, type[pydantic.BaseModel]] = {}
+"""The kinds of configuration file by name ('scenario', 'dataset', 'camera calibration'), each added by the
+module of its model, so that a file of one kind given as another is told as that mix-up."""
+
+
+def refuse_another_kind(path: str | Path, data: dict, kind: str) -> None:
+    """Refuse, naming the mix-up, a file of another kind of :data:`FILE_KINDS` given as a ``kind`` file: every
+    key that ``kind``'s model lacks is a field of the other's, and the file has each field that the other
+    requires and ``kind``'s lacks."""
+    own = set(FILE_KINDS[kind].model_fields)
+    strange = set(data) - own
+    for other_kind, other in FILE_KINDS.items():
+        required = {name for name, field in other.model_fields.items() if field.is_required()} - own
+        if other_kind != kind and strange and strange <= set(other.model_fields) and required <= set(data):
+            keys = ", ".join(sorted(strange))
+            raise ScenarioError(f"{path}: a {other_kind} file (it has {keys}), not a {kind} file")
 
 
 def _first_error_line(error: pydantic.ValidationError, source: str) -> str:
@@ -107,3 +125,17 @@ def read_yaml(path: str | Path, what: str, error_type: type[InputError]) -> obje
         raise error_type(f"{path}: YAML nested too deeply for a {what} file") from None
     finally:
         loader.dispose()
+
+
+def load_credentials(path: str | Path, username_elsewhere: bool = False) -> dict[str, str]:
+    """A camera's credentials file: a YAML (or JSON) mapping of a non-empty ``username`` and ``password``;
+    with ``username_elsewhere`` (the user given in the camera's URL, or by ``--user``) the username may be
+    left out. Any problem is a :class:`ScenarioError` naming the file and the field, never the password."""
+    data = read_yaml(path, "credentials", ScenarioError)
+    expected = "expected a mapping with username and password"
+    if not isinstance(data, dict) or not set(data) <= {"username", "password"}:
+        raise ScenarioError(f"{path}: {expected}")
+    for field in ("password",) if username_elsewhere else ("username", "password"):
+        if data.get(field) in (None, ""):
+            raise ScenarioError(f"{path}: {field}: missing or empty; {expected}")
+    return {key: str(value) for key, value in data.items()}

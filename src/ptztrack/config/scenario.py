@@ -25,7 +25,7 @@ from ptztrack.config.fields import (
     at_most_items,
 )
 from ptztrack.config.follow import Follow
-from ptztrack.config.reading import ScenarioError, _first_error_line, read_yaml
+from ptztrack.config.reading import FILE_KINDS, ScenarioError, _first_error_line, read_yaml, refuse_another_kind
 from ptztrack.control.parameters import ControlParameters
 from ptztrack.detect.parameters import BoxDetectorParameters, DetectorPriorParameters, HogParameters
 from ptztrack.names import DETECTOR_MODELS
@@ -413,6 +413,9 @@ class Scenario(_Strict):
         return video
 
 
+FILE_KINDS["scenario"] = Scenario
+
+
 def scenario_from_dict(data: dict, source: str = "scenario", **overrides) -> Scenario:
     """Validate a scenario mapping, with top-level ``overrides`` applied on top.
 
@@ -441,6 +444,7 @@ def load_scenario(path: str | Path, **overrides) -> Scenario:
         data = {}
     if not isinstance(data, dict):
         raise ScenarioError(f"{path}: expected a mapping of scenario fields (got {type(data).__name__})")
+    refuse_another_kind(path, data, "scenario")
     recording = data.get("recording")
     if isinstance(recording, dict):
         data = {**data, "recording": {**recording, **_resolved_paths(recording, path.parent)}}

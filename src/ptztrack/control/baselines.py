@@ -1,4 +1,4 @@
-"""The paper's comparison strategies: 'fix', 'patrol' and 'random' (section 5)."""
+"""The paper's comparison strategies: 'fix', 'patrol' and 'rnd', the random one (section 5)."""
 
 from dataclasses import dataclass, field
 

@@ -15,8 +15,6 @@ from ptztrack.evaluate.metrics import episode_metrics
 from ptztrack.loop.executors import Progress, execute_cells
 from ptztrack.loop.steps import Episode
 
-# The paper's column names; 'rnd' is the 'random' policy.
-POLICY_OF_STRATEGY = {"rnd": "random"}
 INFORMATION_STRATEGIES = ("intg", "smpl")
 
 
@@ -32,8 +30,8 @@ def strategy_name(strategy: PolicySpec) -> str:
 class Cell:
     """One episode of an experiment: a scenario run with one strategy and one sequence seed.
 
-    strategy : a table name (``STRATEGIES``, 'rnd' for the 'random' policy), a registered policy,
-        a policy object (each cell runs a fresh copy) or a policy factory.
+    strategy : a registered policy's name (the paper's ``STRATEGIES`` among them), a policy object (each
+        cell runs a fresh copy) or a policy factory.
     label : the table column it belongs to (the strategy, with beta where the table has several).
     camera, detector : in place of the scenario's (see :func:`ptztrack.builders.world.build_world`).
     fold : which scoring of a table under a protocol with several
@@ -56,7 +54,7 @@ class Cell:
 def cell_policy(cell: Cell) -> PolicySpec:
     """The policy spec a cell runs: its registered name, or a fresh copy of its object."""
     if isinstance(cell.strategy, str):
-        return POLICY_OF_STRATEGY.get(cell.strategy, cell.strategy)
+        return cell.strategy
     return copy.deepcopy(cell.strategy)
 
 

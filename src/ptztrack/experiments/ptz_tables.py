@@ -38,7 +38,7 @@ from ptztrack.evaluate.metrics import DISPLAY, standard_error
 from ptztrack.experiments.cells import INFORMATION_STRATEGIES, Cell, Execution, cell_metrics, run_experiment_cells
 from ptztrack.loop.steps import Episode
 from ptztrack.loop.streams import episode_streams
-from ptztrack.names import KEPT_DETECTOR_MODELS, PROTOCOLS, STRATEGIES, PetsProtocol, SyntheticProtocol
+from ptztrack.names import KEPT_DETECTOR_MODELS, PROTOCOLS, PetsProtocol, SyntheticProtocol
 from ptztrack.scene.pets import load_mot_ground_truth
 
 # The strategies that draw from their random stream (the others are deterministic given the detections).
@@ -49,11 +49,15 @@ DETERMINISTIC_DETECTORS = ("hog", "detections")
 SUMMARY_KEYS = ("mota", "motp_m", "height_px", "detections", "zoom")
 
 
-def _check_strategies(strategies: Sequence[PolicySpec]) -> None:
-    known = set(STRATEGIES) | set(registry.names("policies"))
-    unknown = sorted(s for s in strategies if isinstance(s, str) and s not in known)
+def _checked_strategies(strategies: Sequence[PolicySpec]) -> list[PolicySpec]:
+    """The strategies with their current names (a former name: with a warning line); raises naming any
+    unknown one."""
+    current = [registry.current_name("policies", s) if isinstance(s, str) else s for s in strategies]
+    known = registry.names("policies")
+    unknown = sorted(s for s in current if isinstance(s, str) and s not in known)
     if unknown:
         raise ValueError(f"unknown strategies {unknown}; expected some of {', '.join(sorted(known))}")
+    return current
 
 
 def synthetic_cells(
@@ -64,7 +68,7 @@ def synthetic_cells(
     detector: DetectorSpec | None = None,
 ) -> list[Cell]:
     """The paper's synthetic protocol: every strategy on the same ``sequences`` sequences (seeds 0..n-1)."""
-    _check_strategies(strategies)
+    strategies = _checked_strategies(strategies)
     return [
         Cell(scenario, strategy, seed, camera=camera, detector=detector)
         for strategy in strategies
@@ -94,7 +98,7 @@ def recording_cells(
     """The paper's realistic protocol (section 5.2): each strategy over the recording, the
     information-gain ones once per ``beta`` of the patrolling term; with seeds 0..``seeds``-1 where the
     run depends on its seed (:func:`seed_matters`), else once."""
-    _check_strategies(strategies)
+    strategies = _checked_strategies(strategies)
     columns = [(scenario, strategy, "") for strategy in strategies if strategy not in INFORMATION_STRATEGIES]
     for beta in betas:
         with_beta = scenario.model_copy(update={"control": scenario.control.model_copy(update={"beta": beta})})

@@ -12,21 +12,17 @@ schemas shipped with onvif-zeep-async (onvif.xsd 2.4.2, devicemgmt.wsdl, media.w
 import uuid
 from dataclasses import dataclass, field
 from datetime import UTC, datetime
-from importlib.metadata import PackageNotFoundError, version
 from urllib.parse import quote
 from xml.etree.ElementTree import Element
 from xml.sax.saxutils import escape
 
+from ptztrack.names import VERSION
 from ptztrack.virtual_onvif import ptz as onvif_ptz
 from ptztrack.virtual_onvif.soap import TDS, TPTZ, TRT, TT, Fault, Operation, child_text, invalid, require_token
 
 # The ONVIF version whose schemas the answers follow (2.4, written 2.40 as devices report it).
 _VERSION = "<tt:Major>2</tt:Major><tt:Minor>40</tt:Minor>"
 _SOURCE, _SOURCE_CONFIGURATION, _ENCODER_CONFIGURATION = "VS_1", "VSC_1", "VEC_1"
-try:  # the firmware is ptztrack's release (not from ptztrack itself, which sits above the camera layer)
-    _FIRMWARE = version("ptztrack")
-except PackageNotFoundError:
-    _FIRMWARE = "0+unknown"
 # The RTSP session's timeout, as the RTSP server's SETUP answers give it.
 _SESSION_TIMEOUT = "PT60S"
 
@@ -104,7 +100,7 @@ class DeviceMediaService:
     def _get_device_information(self, operation: Element) -> str:
         return (
             "<tds:GetDeviceInformationResponse><tds:Manufacturer>ptztrack</tds:Manufacturer>"
-            f"<tds:Model>VirtualONVIFCamera</tds:Model><tds:FirmwareVersion>{escape(_FIRMWARE)}</tds:FirmwareVersion>"
+            f"<tds:Model>VirtualONVIFCamera</tds:Model><tds:FirmwareVersion>{escape(VERSION)}</tds:FirmwareVersion>"
             f"<tds:SerialNumber>{self.settings.serial_number}</tds:SerialNumber>"
             "<tds:HardwareId>virtual</tds:HardwareId></tds:GetDeviceInformationResponse>"
         )
