@@ -28,6 +28,7 @@ def option_cases() -> list[Case]:
         Case("--out ''", ("run", *A_FEW_STEPS, "--out", ""), says=("--out .: is the current folder",)),
         Case("--out ..", ("run", *A_FEW_STEPS, "--out", "..", "--overwrite"), says=("--out ..: is the current",)),
         Case("follow --out .", ("follow", "--target", "1", "--out", "."), says=("--out .: is the current folder",)),
+        Case("--view-wait alone", ("run", *A_FEW_STEPS, "--view-wait"), says=("--view-wait: goes with --view",)),
         Case(
             "--out where nothing can be written",
             ("run", *A_FEW_STEPS, "--out", "/proc/x"),

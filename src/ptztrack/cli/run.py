@@ -31,7 +31,8 @@ def run_command(args: argparse.Namespace) -> int:
     refuse_if_too_large(scenario, (args.policy,))
     world = episode_world(scenario, args.seed)
     policy = make_policy(args.policy, scenario, world)
-    watch = Watch(args.view, args.out is not None, partial(run_view, label=args.policy), Progress("step", args.quiet))
+    view = partial(run_view, label=args.policy)
+    watch = Watch(args.view, args.out is not None, view, Progress("step", args.quiet), args.view_wait)
     with watch:
         episode = run_episode(scenario, policy, args.seed, world, observer=watch.observe(world, policy))
     metrics = episode_metrics(episode)
