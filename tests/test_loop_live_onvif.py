@@ -177,6 +177,26 @@ def test_one_live_run_drives_two_virtual_cameras_of_one_serve_camera_with_one_be
     assert all(camera["image_jpeg"] and len(camera["footprint_m"]) > 2 for camera in last["cameras"])
 
 
+def test_a_live_run_without_truth_leaves_the_scores_out_and_keeps_what_needs_none(tmp_path, capsys):
+    """A real camera has no ground truth: the run prints and writes no MOTA, IDF1, false positives or
+    misses (not zeros, nor a claim that nobody was in view), and no truth_mot.txt, while its pictures,
+    decisions, pace, tracks and detections are printed and written."""
+    out = tmp_path / "live"
+    camera, _ = virtual_onvif_camera(pets_scenario("hog"), 1.0, 0)
+    with camera:
+        url = f"onvif://127.0.0.1:{camera.onvif_port}"
+        assert main(["live", "--camera", url, "--calibration", "virtual", "--steps", "5", "--out", str(out)]) == 0
+    printed = capsys.readouterr().out
+    metrics = json.loads((out / "metrics.json").read_text())
+    scores = {"mota", "motp_m", "idf1", "switches", "false_positives", "misses", "matches", "objects"}
+    assert not scores & set(metrics) and "no person" not in json.dumps(metrics)
+    assert metrics["pictures"] == 5 and metrics["decisions"] >= 1
+    assert {"decisions_per_s", "frames_used_per_s", "tracks_reported", "detections", "zoom"} <= set(metrics)
+    assert "MOTA" not in printed and "IDF1" not in printed and "5 pictures used" in printed
+    assert not (out / "truth_mot.txt").exists() and "truth_mot.txt" not in printed
+    assert (out / "tracks_mot.txt").exists()
+
+
 def test_a_refused_connection_exits_2_with_one_line(capsys):
     with socket.socket() as probe:  # a port nobody listens on
         probe.bind(("127.0.0.1", 0))

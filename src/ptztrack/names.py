@@ -6,13 +6,15 @@ Plain Python values, and frozen dataclasses of them whose fields carry their one
 
 from dataclasses import dataclass, field
 
+TRUTH_MOT_FILE = "truth_mot.txt"
+"""The truth of a run's ``--out`` folder in the MOTChallenge layout (none for a run without ground truth)."""
 RUN_FILES = (
     "metrics.json",
     "steps.csv",
     "detections.csv",
     "tracks.csv",
     "tracks_mot.txt",
-    "truth_mot.txt",
+    TRUTH_MOT_FILE,
     "episode.png",
     "episode.mp4",
 )

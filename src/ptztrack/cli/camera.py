@@ -35,11 +35,12 @@ from ptztrack.config import (
     read_yaml,
     write_camera_calibration,
 )
-from ptztrack.evaluate.metrics import episode_metrics
+from ptztrack.evaluate.metrics import episode_metrics, live_metrics
 from ptztrack.evaluate.report import write_outputs
 from ptztrack.files import check_output_file, read_text, run_folder
 from ptztrack.loop.live import LiveEpisode
-from ptztrack.names import PASSWORD_VARIABLE, VIEW_STATES_FILE
+from ptztrack.loop.steps import Episode
+from ptztrack.names import PASSWORD_VARIABLE, TRUTH_MOT_FILE, VIEW_STATES_FILE
 from ptztrack.view.view_state import NetworkViewState, ViewState
 
 
@@ -70,8 +71,7 @@ def live_command(args: argparse.Namespace) -> int:
     def view(worlds, policy) -> ViewState:
         return ViewState(worlds[0], policy, steps, label, truth=False)
 
-    # A camera's run never waits for a page: pages join and leave as they like.
-    with Watch(args.view, args.out is not None, view, hold=False) as watch:
+    with Watch(args.view, args.out is not None, view) as watch:
         (world,), (live,) = run_live_episode(
             scenario, calibrations, addresses, args.policy, steps, args.time_scale, args.seed,
             timeout_s=args.timeout_s, transport=args.transport, keep_images=args.out is not None,
@@ -80,16 +80,13 @@ def live_command(args: argparse.Namespace) -> int:
     if args.truth is not None:  # read again: the camera logged the run's pictures since the start
         truth_log = read_truth_log(args.truth)
     episode = live_as_episode(world, live, truth_log)
-    _print_rates(live)
-    metrics = episode_metrics(episode)
-    if truth_log is not None:
-        print(format_metrics(metrics))
+    metrics = _print_metrics(episode, live, truth_log is not None)
     if args.out is not None:
         title = f"live {args.policy}, {scenario.detector.kind} detector: {len(live.capture_time_s)} pictures"
         with run_folder(args.out, args.overwrite) as folder:
-            write_outputs(folder, episode, metrics, title, live_pictures(live))
+            write_outputs(folder, episode, metrics, title, live_pictures(live), truth_log is not None)
             watch.write(folder)
-        print(f"wrote {', '.join(RUN_FOLDER_FILES)} into {args.out}")
+        print(f"wrote {', '.join(_run_folder_files(truth_log is not None))} into {args.out}")
     return 0
 
 
@@ -124,7 +121,7 @@ def _live_network(args, scenario, calibrations, addresses, truth_log, steps: int
             ]
         )
 
-    with Watch(args.view, args.out is not None, view, hold=False) as watch:
+    with Watch(args.view, args.out is not None, view) as watch:
         worlds, lives = run_live_episode(
             scenario, calibrations, addresses, args.policy, steps, args.time_scale, args.seed, args.coordination,
             args.timeout_s, args.transport, keep_images=args.out is not None, observe=watch.observe,
@@ -138,13 +135,12 @@ def _live_network(args, scenario, calibrations, addresses, truth_log, steps: int
         folder = None if args.out is None else stack.enter_context(run_folder(args.out, args.overwrite))
         for number, (episode, live) in enumerate(zip(episodes, lives, strict=True), start=1):
             print(f"camera {number}: ", end="")
-            _print_rates(live)
-            metrics = episode_metrics(episode)
-            if truth_log is not None:
-                print(format_metrics(metrics))
+            metrics = _print_metrics(episode, live, truth_log is not None)
             if folder is not None:
                 title = f"live {args.policy}, camera {number} of {len(lives)}: {len(live.capture_time_s)} pictures"
-                write_outputs(folder / f"camera-{number}", episode, metrics, title, live_pictures(live))
+                write_outputs(
+                    folder / f"camera-{number}", episode, metrics, title, live_pictures(live), truth_log is not None
+                )
         if folder is not None:
             watch.write(folder)
     if args.out is not None:
@@ -152,15 +148,25 @@ def _live_network(args, scenario, calibrations, addresses, truth_log, steps: int
     return 0
 
 
-def _print_rates(live: LiveEpisode) -> None:
-    """One line of a live run's pictures, decisions and their pace."""
-    rates = live.rates()
+def _print_metrics(episode: Episode, live: LiveEpisode, with_truth: bool) -> dict:
+    """A live run's figures, printed and returned: its pace (:func:`live_metrics`) and what the camera saw,
+    and ``with_truth`` (a virtual camera's truth log) its scores; without, no score (a real camera's run
+    has no truth)."""
+    metrics = {**episode_metrics(episode, with_truth), **live_metrics(live)}
     print(
-        f"{len(live.capture_time_s)} pictures used ({rates['frames_used_per_s']:.2f} per second) of "
-        f"{live.frames_received} received, {int(np.isfinite(live.decided_s).sum())} decisions "
-        f"({rates['decisions_per_s']:.2f} per second, median {1e3 * rates['median_decision_s']:.1f} ms, "
-        f"95 % on a picture at most {rates['frame_age_s_p95']:.2f} s old), {int(live.sent.sum())} new targets sent"
+        f"{metrics['pictures']} pictures used ({metrics['frames_used_per_s']:.2f} per second) of "
+        f"{metrics['frames_received']} received, {metrics['decisions']} decisions "
+        f"({metrics['decisions_per_s']:.2f} per second, median {1e3 * metrics['median_decision_s']:.1f} ms, "
+        f"95 % on a picture at most {metrics['frame_age_s_p95']:.2f} s old), {metrics['targets_sent']} new targets "
+        f"sent, {metrics['tracks_reported']} tracks reported"
     )
+    print(format_metrics(metrics))
+    return metrics
+
+
+def _run_folder_files(with_truth: bool) -> list[str]:
+    """The files a live run writes into ``--out``: without truth, no truth_mot.txt."""
+    return [name for name in RUN_FOLDER_FILES if with_truth or name != TRUTH_MOT_FILE]
 
 
 def read_truth_log(path: Path) -> np.ndarray:

@@ -21,9 +21,11 @@ RUN_FIGURES = ("mota", "motp_m", "idf1", "height_px", "detections", "zoom", "swi
 
 
 def format_metrics(metrics: dict) -> str:
-    """The run's figures (RUN_FIGURES), one a line, named and formatted as ``DISPLAY`` says."""
-    width = max(len(DISPLAY[key][0]) for key in RUN_FIGURES)
-    return "\n".join(f"{DISPLAY[key][0]:<{width}}  {DISPLAY[key][1].format(metrics[key])}" for key in RUN_FIGURES)
+    """The run's figures of RUN_FIGURES that ``metrics`` has (a run without ground truth has no scores), one
+    a line, named and formatted as ``DISPLAY`` says."""
+    shown = [key for key in RUN_FIGURES if key in metrics]
+    width = max(len(DISPLAY[key][0]) for key in shown)
+    return "\n".join(f"{DISPLAY[key][0]:<{width}}  {DISPLAY[key][1].format(metrics[key])}" for key in shown)
 
 
 def run_command(args: argparse.Namespace) -> int:
