@@ -23,6 +23,12 @@ def option_cases() -> list[Case]:
         Case("--out names a file", ("run", *A_FEW_STEPS, "--out", "{dir}/file"), {"file": "keep me\n"}),
         Case("--out in a missing folder", ("run", *A_FEW_STEPS, "--out", "{dir}/missing/out")),
         Case("--out not empty", ("run", *A_FEW_STEPS, "--out", "{dir}/out"), {"out/metrics.json": "{}\n"}),
+        # The folder the command runs in, or one that holds it, cannot be replaced by the run's folder.
+        Case("--out .", ("run", *A_FEW_STEPS, "--out", ".", "--overwrite"), says=("--out .: is the current folder",)),
+        Case("--out ''", ("run", *A_FEW_STEPS, "--out", ""), says=("--out .: is the current folder",)),
+        Case("--out ..", ("run", *A_FEW_STEPS, "--out", "..", "--overwrite"), says=("--out ..: is the current",)),
+        Case("follow --out .", ("follow", "--target", "1", "--out", "."), says=("--out .: is the current folder",)),
+        Case("--view-wait alone", ("run", *A_FEW_STEPS, "--view-wait"), says=("--view-wait: goes with --view",)),
         Case(
             "--out where nothing can be written",
             ("run", *A_FEW_STEPS, "--out", "/proc/x"),

@@ -1,5 +1,6 @@
 """`ptztrack serve` and its virtual cameras as processes on 127.0.0.1, as an integrator runs them: start,
-read /healthz, wait for a camera's report, stop by SIGTERM."""
+read /healthz, wait for a camera's report, stop by SIGTERM; `ptztrack serve-camera` as a user runs it,
+stopped by Ctrl-C."""
 
 import json
 import re
@@ -31,6 +32,36 @@ def virtual_cameras_up(ports: list[int]) -> list[subprocess.Popen]:
     for camera, port in zip(cameras, ports, strict=True):
         assert f"onvif://127.0.0.1:{port}" in camera.stdout.readline()
     return cameras
+
+
+@contextmanager
+def serve_camera(options: list[str], environment: dict | None = None) -> Iterator[tuple[subprocess.Popen, list[str]]]:
+    """`ptztrack serve-camera --port 0 OPTIONS` in a process of its own, as a camera is a machine of its own:
+    the process and its cameras' onvif:// addresses once every one is up; stopped by Ctrl-C at the end of
+    the block, as a user stops it (its return code then tells whether it stopped cleanly)."""
+    command = [sys.executable, "-m", "ptztrack.cli", "serve-camera", "--port", "0", *options]
+    server = subprocess.Popen(
+        command,
+        stdout=subprocess.PIPE,
+        text=True,
+        env=environment,
+        # A test run in the background of a non-interactive shell inherits SIGINT ignored: give the
+        # server the disposition a terminal gives, so that the Ctrl-C at the end stops it.
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
+    )
+    try:
+        assert server.stdout is not None
+        addresses: list[str] = []
+        while True:
+            line = server.stdout.readline()
+            assert line, "serve-camera ended before its cameras were up"
+            addresses += re.findall(r"onvif://127\.0\.0\.1:\d+", line)
+            if line.startswith("the recording plays"):  # printed once every camera is up
+                break
+        yield server, addresses
+    finally:
+        server.send_signal(signal.SIGINT)
+        server.communicate(timeout=30)
 
 
 @contextmanager

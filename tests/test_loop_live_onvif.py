@@ -5,7 +5,6 @@ that stops answering)."""
 import http.server
 import json
 import os
-import re
 import signal
 import socket
 import subprocess
@@ -26,9 +25,10 @@ from ptztrack.camera.onvif_client import CameraAddress, CameraError, ONVIFClient
 from ptztrack.camera.stream import open_rtsp
 from ptztrack.cli import main
 from ptztrack.cli.camera import read_truth_log
-from ptztrack.config import load_camera_calibration, write_camera_calibration
+from ptztrack.config import ScenarioError, load_camera_calibration, write_camera_calibration
 from ptztrack.evaluate.metrics import episode_metrics
 from ptztrack.virtual_onvif.head import MOVE_LATENCY_S
+from serve_process import serve_camera
 
 pytest.importorskip("ipycam", reason="the virtual ONVIF camera needs ipycam (pip install --no-deps ipycam==1.3.0)")
 # The live runs go one at a time (one xdist worker): two live loops at once would each be a machine busier
@@ -56,26 +56,11 @@ def test_a_live_smpl_run_with_hog_at_half_the_recordings_pace_scores_near_the_of
     checked here is where the pictures are placed; the pace and the score at the recording's own pace
     are measured by benchmarks/live_loop.py."""
     log = tmp_path / "truth.csv"
-    command = [sys.executable, "-m", "ptztrack.cli", "serve-camera", "--port", "0", "--truth-log", str(log)]
-    command += ["--user", USER, "--time-scale", str(HALF_PACE)]
-    environment = {**os.environ, "PTZTRACK_CAMERA_PASSWORD": PASSWORD}
-    server = subprocess.Popen(
-        command,
-        stdout=subprocess.PIPE,
-        text=True,
-        env=environment,
-        # A test run in the background of a non-interactive shell inherits SIGINT ignored: give the
-        # server the disposition a terminal gives, so that the Ctrl-C below stops it.
-        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
-    )
-    try:
-        port = int(re.search(r"onvif://127\.0\.0\.1:(\d+)", server.stdout.readline()).group(1))
+    options = ["--truth-log", str(log), "--user", USER, "--time-scale", str(HALF_PACE)]
+    with serve_camera(options, {**os.environ, "PTZTRACK_CAMERA_PASSWORD": PASSWORD}) as (_, (url,)):
         scenario = pets_scenario("hog")
-        address = CameraAddress("127.0.0.1", port, USER, PASSWORD)
+        address = CameraAddress("127.0.0.1", int(url.rsplit(":", 1)[1]), USER, PASSWORD)
         (world,), (live,) = run_live_episode(scenario, [virtual_calibration()], [address], "smpl", 300, HALF_PACE, 0)
-    finally:
-        server.send_signal(signal.SIGINT)
-        server.communicate(timeout=30)
     truth_log = read_truth_log(log)
     live_mota = episode_metrics(live_as_episode(world, live, truth_log))["mota"]
     offline = offline_counterpart(scenario, world, live, truth_log)
@@ -133,20 +118,8 @@ def test_one_live_run_drives_two_virtual_cameras_of_one_serve_camera_with_one_be
     pictures show, and staying is a choice it may make), the tracks each camera's pictures report are
     the one belief's (the same ids), each camera's files are written, and the view's states show both
     cameras' pictures."""
-    command = [sys.executable, "-m", "ptztrack.cli", "serve-camera", "--port", "0", "--cameras", "2"]
-    server = subprocess.Popen(
-        command,
-        stdout=subprocess.PIPE,
-        text=True,
-        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),  # as in the first test
-    )
     out = tmp_path / "out"
-    try:
-        urls: list[str] = []
-        while len(urls) < 2:
-            line = server.stdout.readline()
-            assert line, "serve-camera ended before both cameras were up"
-            urls += re.findall(r"onvif://127\.0\.0\.1:\d+", line)
+    with serve_camera(["--cameras", "2"]) as (server, urls):
         # Each camera is put where the run does not start, so that the run must move both.
         spaces = camera_spaces(virtual_calibration())
         for url in urls:
@@ -157,9 +130,6 @@ def test_one_live_run_drives_two_virtual_cameras_of_one_serve_camera_with_one_be
             client.close()
         cameras = [argument for url in urls for argument in ("--camera", url)]
         status = main(["live", *cameras, "--calibration", "virtual", "--steps", "30", "--out", str(out)])
-    finally:
-        server.send_signal(signal.SIGINT)
-        server.communicate(timeout=30)
     assert status == 0 and server.returncode == 0
     ids = []
     for number in (1, 2):
@@ -175,6 +145,41 @@ def test_one_live_run_drives_two_virtual_cameras_of_one_serve_camera_with_one_be
     last = json.loads((out / "view_states.jsonl").read_text().splitlines()[-1])
     assert [camera["camera"] for camera in last["cameras"]] == [0, 1]
     assert all(camera["image_jpeg"] and len(camera["footprint_m"]) > 2 for camera in last["cameras"])
+
+
+def test_a_live_run_without_truth_leaves_the_scores_out_and_keeps_what_needs_none(tmp_path, capsys):
+    """A real camera has no ground truth: the run prints and writes no MOTA, IDF1, false positives or
+    misses (not zeros, nor a claim that nobody was in view), and no truth_mot.txt, while its pictures,
+    decisions, pace, tracks and detections are printed and written."""
+    out = tmp_path / "live"
+    camera, _ = virtual_onvif_camera(pets_scenario("hog"), 1.0, 0)
+    with camera:
+        url = f"onvif://127.0.0.1:{camera.onvif_port}"
+        assert main(["live", "--camera", url, "--calibration", "virtual", "--steps", "5", "--out", str(out)]) == 0
+    printed = capsys.readouterr().out
+    metrics = json.loads((out / "metrics.json").read_text())
+    scores = {"mota", "motp_m", "idf1", "switches", "false_positives", "misses", "matches", "objects"}
+    assert not scores & set(metrics) and "no person" not in json.dumps(metrics)
+    assert metrics["pictures"] == 5 and metrics["decisions"] >= 1
+    assert {"decisions_per_s", "frames_used_per_s", "tracks_reported", "detections", "zoom"} <= set(metrics)
+    assert "MOTA" not in printed and "IDF1" not in printed and "5 pictures used" in printed
+    assert not (out / "truth_mot.txt").exists() and "truth_mot.txt" not in printed
+    assert (out / "tracks_mot.txt").exists()
+
+
+def test_a_truth_log_is_read_as_serve_camera_writes_it(tmp_path):
+    """Read while serve-camera writes it: a file it has just opened is empty, and its last line may not be
+    ended yet; another file is refused."""
+    log = tmp_path / "truth.csv"
+    log.write_text("")
+    assert read_truth_log(log).shape == (0, 5)
+    log.write_text("time_s,step,pan_deg,tilt_deg,zoom\n")
+    assert read_truth_log(log).shape == (0, 5)
+    log.write_text("time_s,step,pan_deg,tilt_deg,zoom\n1.5,3,10.0,5.0,1.0\n2.0,4,10.0,5.0")
+    np.testing.assert_array_equal(read_truth_log(log), [[1.5, 3, 10.0, 5.0, 1.0]])
+    log.write_text("frame,id,x,y\n1,2,3,4\n")
+    with pytest.raises(ScenarioError, match="expected a truth log starting with the line time_s,step"):
+        read_truth_log(log)
 
 
 def test_a_refused_connection_exits_2_with_one_line(capsys):

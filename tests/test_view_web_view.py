@@ -87,9 +87,28 @@ def test_view_of_a_folder_without_view_states_exits_2_with_one_line(tmp_path, ca
     assert error.count("\n") == 1 and "line 2 is not a step's state" in error
 
 
+def test_run_with_view_goes_to_its_end_with_no_page_and_its_help_says_so(capsys):
+    """A headless server's run is not held by its view: with no page, `run --view` ends as without one;
+    waiting for the first page is what --view-wait asks, as --help says."""
+    command = [sys.executable, "-m", "ptztrack.cli", "run", "--frames", "3", "--policy", "fix", "--view"]
+    with _served(command) as (_, run):
+        try:
+            rest, _ = run.communicate(timeout=120)
+        except subprocess.TimeoutExpired:
+            run.kill()
+            raise
+    assert run.returncode == 0 and "MOTA" in rest
+    for command in ("run", "follow"):
+        with pytest.raises(SystemExit):
+            main([command, "--help"])
+        shown = " ".join(capsys.readouterr().out.split())
+        assert "the run does not wait for a page" in shown and "--view-wait with --view: the run waits" in shown
+
+
 @pytest.mark.slow
-def test_run_with_view_prints_the_address_starts_when_a_page_connects_and_sends_the_final_state():
-    command = [sys.executable, "-m", "ptztrack.cli", "run", "--frames", "12", "--policy", "intg", "--view"]
+def test_run_with_view_wait_prints_the_address_starts_when_a_page_connects_and_sends_the_final_state():
+    command = [sys.executable, "-m", "ptztrack.cli", "run", "--frames", "12", "--policy", "intg"]
+    command += ["--view", "--view-wait"]
     with _served(command) as (address, run):
         with connect(address.replace("http://", "ws://") + "ws", max_size=None) as socket:
             messages = [json.loads(message) for message in socket]
@@ -279,7 +298,7 @@ def test_a_browser_replays_a_run_folder_with_pause_step_and_resume(chromium, tmp
 def test_a_browser_follows_the_follow_camera(chromium, tmp_path):
     frames = 8
     command = [sys.executable, "-m", "ptztrack.cli", "follow", "--target", "19", "--frames", str(frames)]
-    command += ["--out", str(tmp_path / "follow"), "--view", *RECORDING]
+    command += ["--out", str(tmp_path / "follow"), "--view", "--view-wait", *RECORDING]
     with _served(command) as (address, follow), _page(chromium) as (page, problems):
         # The steps of the states the page receives (two may come within one animation frame, so the
         # counter is read from the socket, not polled)

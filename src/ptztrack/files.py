@@ -213,6 +213,13 @@ def check_output_file(path: Path, option: str) -> None:
 def check_output_folder(path: Path, option: str, overwrite: bool) -> None:
     """Refuse, before any work, a run folder that could not be written whole (see :func:`run_folder`)."""
     path = Path(path)
+    here = Path.cwd().resolve()
+    if path.resolve() in (here, *here.parents):
+        # Replaced whole at the end, the folder a shell stands in (or one that holds it) cannot be.
+        raise InputError(
+            f"{option} {path}: is the current folder or holds it; expected a new folder for the run's files "
+            f"(say {option} run1)"
+        )
     if path.exists() and not path.is_dir():
         raise InputError(f"{option} {path}: is a file, expected a folder")
     if path.is_dir() and any(path.iterdir()) and not overwrite:
@@ -248,7 +255,11 @@ def run_folder(path: Path, overwrite: bool = False) -> Iterator[Path]:
         yield temporary
         if path.exists():
             retired = _folder_beside(path, ".old")
-            os.replace(path, retired / path.name)
+            try:
+                os.replace(path, retired / path.name)
+            except BaseException:
+                retired.rmdir()
+                raise
             os.replace(temporary, path)
             shutil.rmtree(retired)
         else:

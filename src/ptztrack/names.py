@@ -14,13 +14,15 @@ try:
 except PackageNotFoundError:  # a source tree that was not installed
     VERSION = "0+unknown"
 
+TRUTH_MOT_FILE = "truth_mot.txt"
+"""The truth of a run's ``--out`` folder in the MOTChallenge layout (none for a run without ground truth)."""
 RUN_FILES = (
     "metrics.json",
     "steps.csv",
     "detections.csv",
     "tracks.csv",
     "tracks_mot.txt",
-    "truth_mot.txt",
+    TRUTH_MOT_FILE,
     "episode.png",
     "episode.mp4",
 )

@@ -262,14 +262,26 @@ def connected_cameras(
 
 
 def offline_counterpart(scenario: Scenario, world: World, live: LiveEpisode, truth_log) -> Scenario:
-    """``scenario`` narrowed to the recording's steps a live run against the virtual camera saw, from the
-    first its pictures showed to the last (within one play of the recording), with the live run's
-    detector (:func:`streamed`): the offline run to compare it with."""
+    """``scenario`` narrowed to the recording's steps a live run against the virtual camera saw
+    (:func:`shown_span`), with the live run's detector (:func:`streamed`): the offline run to compare it
+    with."""
+    return recording_steps_scenario(scenario, world, *shown_span(truth_log, live.capture_time_s))
+
+
+def shown_span(truth_log, times_s) -> tuple[int, int]:
+    """The first and the last recording step a virtual camera showed at the epoch times (T,) of a run's
+    pictures, from its truth log (n, 5): the step of the first picture and the latest step of any (within
+    one play of the recording)."""
+    shown = np.maximum(shown_steps(truth_log, times_s), 0)
+    return int(shown[0]), int(shown.max())
+
+
+def recording_steps_scenario(scenario: Scenario, world: World, first_step: int, last_step: int) -> Scenario:
+    """``scenario`` narrowed to the recording's steps ``first_step`` to ``last_step`` (those of ``world``,
+    built from it), with a live run's detector (:func:`streamed`)."""
     recording = scenario.required_recording("the offline counterpart of a live run")
     backend = world.backend
     assert isinstance(backend, RecordedPTZ)
-    shown = np.maximum(shown_steps(truth_log, live.capture_time_s), 0)
-    first_step, last_step = int(shown[0]), int(shown.max())
     first = int(backend.scene.video_frame[first_step])
     steps = last_step - first_step + 1
     frame_range = (first, first + steps * recording.frame_step)

@@ -24,7 +24,10 @@ __all__ = ["main", "parser", "check_outputs", "check_ports"]
 
 
 def check_ports(args: argparse.Namespace) -> None:
-    """Refuse, before any work, a port of ``--port`` or ``--view`` that another program listens on."""
+    """Refuse, before any work, a port of ``--port`` or ``--view`` that another program listens on, and
+    ``--view-wait`` without ``--view``."""
+    if getattr(args, "view_wait", False) and args.view is None:
+        raise InputError("--view-wait: goes with --view (the run waits until a page of its view opens it)")
     for name in ("port", "view"):
         port = getattr(args, name, None)
         if not port:  # none, or 0: any free one

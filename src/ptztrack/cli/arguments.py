@@ -101,7 +101,7 @@ def parser() -> argparse.ArgumentParser:
         "--out", type=Path, help=f"directory for {', '.join(RUN_FOLDER_FILES)}; written whole or not at all"
     )
     run.add_argument("--overwrite", action="store_true", help="replace a non-empty --out folder")
-    add_view_argument(run)
+    add_view_argument(run, wait=True)
     add_quiet_argument(run)
     add_recording_arguments(run)
     run.set_defaults(handler="ptztrack.cli.run:run_command")

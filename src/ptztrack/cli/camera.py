@@ -3,16 +3,18 @@ times one's moves, ``ptztrack serve-camera`` serves the PETS virtual camera over
 
 import argparse
 import contextlib
+import logging
 import os
 import sys
 import time
+from collections.abc import Sequence
 from pathlib import Path
 from urllib.parse import urlsplit
 
 import numpy as np
 
 from ptztrack.builders.camera_calibration import camera_spaces
-from ptztrack.builders.live import live_as_episode, live_pictures, run_live_episode
+from ptztrack.builders.live import live_as_episode, live_pictures, run_live_episode, shown_span
 from ptztrack.builders.live_registered import check_pose_source
 from ptztrack.builders.virtual_camera import (
     TRUTH_LOG_HEADER,
@@ -36,12 +38,17 @@ from ptztrack.config import (
     load_credentials,
     write_camera_calibration,
 )
-from ptztrack.evaluate.metrics import episode_metrics
+from ptztrack.evaluate.metrics import episode_metrics, live_metrics
 from ptztrack.evaluate.report import write_outputs
 from ptztrack.files import check_output_file, read_text, run_folder
 from ptztrack.loop.live import LiveEpisode
-from ptztrack.names import PASSWORD_VARIABLE, VIEW_STATES_FILE
+from ptztrack.loop.steps import Episode
+from ptztrack.names import PASSWORD_VARIABLE, TRUTH_MOT_FILE, VIEW_STATES_FILE
 from ptztrack.view.view_state import NetworkViewState, ViewState
+
+log = logging.getLogger(__name__)
+# How long a live run's end waits for serve-camera's truth log (written every half second) to hold its last picture.
+TRUTH_LOG_WAIT_S = 5.0
 
 
 def _credentials(args: argparse.Namespace) -> dict | None:
@@ -62,36 +69,32 @@ def live_command(args: argparse.Namespace) -> int:
     calibrations = _calibrations(args)
     check_pose_source(calibrations, args.pose)
     addresses = [camera_address(url, _credentials(args)) for url in args.camera]
-    truth_log = None if args.truth is None else read_truth_log(args.truth)
+    if args.truth is not None:
+        read_truth_log(args.truth)  # refused now if it is not a truth log; read for the scores when the run ends
     steps = args.steps or scenario.frames
     if len(addresses) > 1:
-        return _live_network(args, scenario, calibrations, addresses, truth_log, steps)
+        return _live_network(args, scenario, calibrations, addresses, steps)
     print(f"live: {args.policy} on {addresses[0]}, up to {steps} pictures, RTSP over {args.transport}")
     label = f"live {args.policy}"
 
     def view(worlds, policy) -> ViewState:
         return ViewState(worlds[0], policy, steps, label, truth=False)
 
-    # A camera's run never waits for a page: pages join and leave as they like.
-    with Watch(args.view, args.out is not None, view, hold=False) as watch:
+    with Watch(args.view, args.out is not None, view) as watch:
         (world,), (live,) = run_live_episode(
             scenario, calibrations, addresses, args.policy, steps, args.time_scale, args.seed,
             timeout_s=args.timeout_s, transport=args.transport, keep_images=args.out is not None,
             observe=watch.observe, pose_source=args.pose,
         )  # fmt: skip
-    if args.truth is not None:  # read again: the camera logged the run's pictures since the start
-        truth_log = read_truth_log(args.truth)
+    truth_log = _truth_log_after(args.truth, [live])
     episode = live_as_episode(world, live, truth_log)
-    _print_rates(live)
-    metrics = episode_metrics(episode)
-    if truth_log is not None:
-        print(format_metrics(metrics))
+    metrics = _print_metrics(episode, live, truth_log, args.truth)
     if args.out is not None:
         title = f"live {args.policy}, {scenario.detector.kind} detector: {len(live.capture_time_s)} pictures"
         with run_folder(args.out, args.overwrite) as folder:
-            write_outputs(folder, episode, metrics, title, live_pictures(live))
+            write_outputs(folder, episode, metrics, title, live_pictures(live), truth_log is not None)
             watch.write(folder)
-        print(f"wrote {', '.join(RUN_FOLDER_FILES)} into {args.out}")
+        print(f"wrote {', '.join(_run_folder_files(truth_log is not None))} into {args.out}")
     return 0
 
 
@@ -106,7 +109,7 @@ def _calibrations(args: argparse.Namespace) -> list[CameraCalibrationFile]:
     return [virtual_calibration() if name == "virtual" else load_camera_calibration(name) for name in names]
 
 
-def _live_network(args, scenario, calibrations, addresses, truth_log, steps: int) -> int:
+def _live_network(args, scenario, calibrations, addresses, steps: int) -> int:
     """``ptztrack live`` with several cameras: one belief, the network's decisions; each camera's files
     into ``--out``'s camera-K folder (K from 1, in the order of ``--camera``), and the network's view
     states (every camera's picture beside the one map) into ``--out`` itself."""
@@ -126,27 +129,25 @@ def _live_network(args, scenario, calibrations, addresses, truth_log, steps: int
             ]
         )
 
-    with Watch(args.view, args.out is not None, view, hold=False) as watch:
+    with Watch(args.view, args.out is not None, view) as watch:
         worlds, lives = run_live_episode(
             scenario, calibrations, addresses, args.policy, steps, args.time_scale, args.seed, args.coordination,
             args.timeout_s, args.transport, keep_images=args.out is not None, observe=watch.observe,
             pose_source=args.pose,
         )  # fmt: skip
     # The cameras share the recording's clock: a virtual camera's truth log places every camera's pictures.
-    if args.truth is not None:  # read again: the camera logged the run's pictures since the start
-        truth_log = read_truth_log(args.truth)
+    truth_log = _truth_log_after(args.truth, lives)
     episodes = [live_as_episode(world, live, truth_log) for world, live in zip(worlds, lives, strict=True)]
     with contextlib.ExitStack() as stack:
         folder = None if args.out is None else stack.enter_context(run_folder(args.out, args.overwrite))
         for number, (episode, live) in enumerate(zip(episodes, lives, strict=True), start=1):
             print(f"camera {number}: ", end="")
-            _print_rates(live)
-            metrics = episode_metrics(episode)
-            if truth_log is not None:
-                print(format_metrics(metrics))
+            metrics = _print_metrics(episode, live, truth_log, args.truth)
             if folder is not None:
                 title = f"live {args.policy}, camera {number} of {len(lives)}: {len(live.capture_time_s)} pictures"
-                write_outputs(folder / f"camera-{number}", episode, metrics, title, live_pictures(live))
+                write_outputs(
+                    folder / f"camera-{number}", episode, metrics, title, live_pictures(live), truth_log is not None
+                )
         if folder is not None:
             watch.write(folder)
     if args.out is not None:
@@ -154,22 +155,64 @@ def _live_network(args, scenario, calibrations, addresses, truth_log, steps: int
     return 0
 
 
-def _print_rates(live: LiveEpisode) -> None:
-    """One line of a live run's pictures, decisions and their pace."""
-    rates = live.rates()
+def _truth_log_after(path: Path | None, lives: Sequence[LiveEpisode]) -> np.ndarray | None:
+    """``--truth``'s log once it holds the run's last picture (serve-camera appends to it every half
+    second), waiting at most ``TRUTH_LOG_WAIT_S``; None without ``--truth``, or where the log holds no
+    picture (the run is then not scored, with a warning). A log that ends before the run's last picture
+    is used with a warning: the pictures after its end are scored against its last step."""
+    if path is None:
+        return None
+    last_capture_s = max((float(live.capture_time_s.max()) for live in lives if len(live.capture_time_s)), default=0.0)
+    deadline_s = time.monotonic() + TRUTH_LOG_WAIT_S
+    truth_log = read_truth_log(path)
+    while (not len(truth_log) or truth_log[-1, 0] < last_capture_s) and time.monotonic() < deadline_s:
+        time.sleep(0.25)
+        truth_log = read_truth_log(path)
+    if not len(truth_log):
+        log.warning(f"{path}: the truth log holds no picture; the run is not scored (is serve-camera writing it?)")
+        return None
+    if truth_log[-1, 0] < last_capture_s:
+        log.warning(
+            f"{path}: the truth log ends {last_capture_s - truth_log[-1, 0]:.1f} s before the run's last picture; "
+            "the pictures after its end are scored against its last step"
+        )
+    return truth_log
+
+
+def _print_metrics(episode: Episode, live: LiveEpisode, truth_log: np.ndarray | None, truth_path: Path | None) -> dict:
+    """A live run's figures, printed and returned: its pace (:func:`live_metrics`) and what the camera saw,
+    and with a truth log the scores and the recording's steps its pictures were scored against (those of
+    the offline run to compare it with); without, no score (a real camera's run has no truth)."""
+    metrics = {**episode_metrics(episode, with_truth=truth_log is not None), **live_metrics(live)}
     print(
-        f"{len(live.capture_time_s)} pictures used ({rates['frames_used_per_s']:.2f} per second) of "
-        f"{live.frames_received} received, {int(np.isfinite(live.decided_s).sum())} decisions "
-        f"({rates['decisions_per_s']:.2f} per second, median {1e3 * rates['median_decision_s']:.1f} ms, "
-        f"95 % on a picture at most {rates['frame_age_s_p95']:.2f} s old), {int(live.sent.sum())} new targets sent"
+        f"{metrics['pictures']} pictures used ({metrics['frames_used_per_s']:.2f} per second) of "
+        f"{metrics['frames_received']} received, {metrics['decisions']} decisions "
+        f"({metrics['decisions_per_s']:.2f} per second, median {1e3 * metrics['median_decision_s']:.1f} ms, "
+        f"95 % on a picture at most {metrics['frame_age_s_p95']:.2f} s old), {metrics['targets_sent']} new targets "
+        f"sent, {metrics['tracks_reported']} tracks reported"
     )
+    if truth_log is not None and len(live.capture_time_s):
+        first_step, last_step = shown_span(truth_log, live.capture_time_s)
+        print(f"scored against the recording's steps {first_step} to {last_step} (truth log {truth_path})")
+    print(format_metrics(metrics))
+    return metrics
+
+
+def _run_folder_files(with_truth: bool) -> list[str]:
+    """The files a live run writes into ``--out``: without truth, no truth_mot.txt."""
+    return [name for name in RUN_FOLDER_FILES if with_truth or name != TRUTH_MOT_FILE]
 
 
 def read_truth_log(path: Path) -> np.ndarray:
-    """A virtual camera's truth log (``ptztrack serve-camera --truth-log``), (n, 5)."""
-    lines = read_text(path, "truth log", 1_000_000_000, ScenarioError).splitlines()
-    if not lines or lines[0] != TRUTH_LOG_HEADER:
+    """A virtual camera's truth log (``ptztrack serve-camera --truth-log``), (n, 5); read while the camera
+    writes it, so an empty file (one it has just opened) has no rows and a last line not yet ended is
+    left for the next read."""
+    text = read_text(path, "truth log", 1_000_000_000, ScenarioError)
+    lines = text.splitlines()[: None if text.endswith("\n") else -1]
+    if lines and lines[0] != TRUTH_LOG_HEADER:
         raise ScenarioError(f"{path}: expected a truth log starting with the line {TRUTH_LOG_HEADER}")
+    if len(lines) <= 1:  # nothing, or the header only: the camera has logged no picture yet
+        return np.empty((0, 5))
     try:
         rows = np.array([[float(value) for value in line.split(",")] for line in lines[1:] if line], dtype=float)
     except ValueError:

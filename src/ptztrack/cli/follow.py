@@ -61,7 +61,7 @@ def follow_command(args: argparse.Namespace) -> int:
         steps = world.truth.positions_m.shape[0]
         return ViewState(world, policy, steps, label, view_renderer(world), grid=False, target_point_px=target_point_px)
 
-    with Watch(args.view, True, view, Progress("step", args.quiet)) as watch:
+    with Watch(args.view, True, view, Progress("step", args.quiet), args.view_wait) as watch:
         narrowed, world, episode = follow_run(FollowCell(scenario, args.tracker, args.target, args.seed), watch.observe)
     row = follow_row(narrowed, world, episode)
     frame_range = narrowed.required_recording("the follow camera").frame_range

@@ -41,7 +41,7 @@ def add_follow_commands(commands, experiments) -> None:
         help=f"directory for {', '.join(RUN_FOLDER_FILES)} (default follow-TARGET); written whole or not at all",
     )
     follow.add_argument("--overwrite", action="store_true", help="replace a non-empty --out folder")
-    add_view_argument(follow)
+    add_view_argument(follow, wait=True)
     add_quiet_argument(follow)
     _add_follow_scenario_arguments(follow)
     follow.set_defaults(handler="ptztrack.cli.follow:follow_command")

@@ -63,15 +63,23 @@ def add_quiet_argument(command: argparse.ArgumentParser) -> None:
     )
 
 
-def add_view_argument(command: argparse.ArgumentParser) -> None:
+def add_view_argument(command: argparse.ArgumentParser, wait: bool = False) -> None:
+    """``--view``, and with ``wait`` ``--view-wait`` (a simulated run, which can wait for its first page)."""
     command.add_argument(
         "--view",
         type=port_number,
         nargs="?",
         const=0,
         metavar="PORT",
-        help="serve a live view of the run on http://127.0.0.1:PORT/ (no PORT or 0: any free one)",
+        help="serve a live view of the run on http://127.0.0.1:PORT/ (no PORT or 0: any free one); the run does "
+        f"not wait for a page: pages join and leave at any time{' (see --view-wait)' if wait else ''}",
     )
+    if wait:
+        command.add_argument(
+            "--view-wait",
+            action="store_true",
+            help="with --view: the run waits after its first step until a page opens it (to watch it from its start)",
+        )
 
 
 def add_detector_model_arguments(command: argparse.ArgumentParser, prior_shift: bool = False) -> None:

@@ -21,8 +21,9 @@ RUN_FIGURES = ("mota", "motp_m", "idf1", "height_px", "detections", "zoom", "swi
 
 
 def format_metrics(metrics: dict) -> str:
-    """The run's figures (RUN_FIGURES), one a line (:func:`~ptztrack.evaluate.metrics.format_figures`)."""
-    return format_figures(metrics, RUN_FIGURES)
+    """The run's figures of RUN_FIGURES that ``metrics`` has (a run without ground truth has no scores), one
+    a line (:func:`~ptztrack.evaluate.metrics.format_figures`)."""
+    return format_figures(metrics, [key for key in RUN_FIGURES if key in metrics])
 
 
 def run_command(args: argparse.Namespace) -> int:
@@ -30,7 +31,8 @@ def run_command(args: argparse.Namespace) -> int:
     refuse_if_too_large(scenario, (args.policy,))
     world = episode_world(scenario, args.seed)
     policy = make_policy(args.policy, scenario, world)
-    watch = Watch(args.view, args.out is not None, partial(run_view, label=args.policy), Progress("step", args.quiet))
+    view = partial(run_view, label=args.policy)
+    watch = Watch(args.view, args.out is not None, view, Progress("step", args.quiet), args.view_wait)
     with watch:
         episode = run_episode(scenario, policy, args.seed, world, observer=watch.observe(world, policy))
     metrics = episode_metrics(episode)

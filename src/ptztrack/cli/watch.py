@@ -19,11 +19,11 @@ class Watch:
     (what ``ptztrack view`` replays), and a progress bar of the steps (``progress``; None: none).
 
     view : ``view(world, policy)`` gives the run's :class:`ViewState`.
-    hold : the run waits after its first step for a page to open it (a simulated run, to be watched from
-    its start); without, pages join and leave a run that never waits for them (a live camera's).
+    hold : the run waits after its first step for a page to open it (``--view-wait`` of a simulated run, to
+    be watched from its start); without, pages join and leave a run that never waits for them.
     """
 
-    def __init__(self, port: int | None, keep: bool, view, progress: Progress | None = None, hold: bool = True):
+    def __init__(self, port: int | None, keep: bool, view, progress: Progress | None = None, hold: bool = False):
         self.view, self.port, self.keep, self.progress, self.hold = view, port, keep, progress, hold
         self.views: deque[StepView] = deque(maxlen=VIDEO_MAX_STEPS)
         self.view_state: ViewState | None = None

@@ -13,6 +13,7 @@ import motmetrics as mm
 import numpy as np
 
 from ptztrack.geometry.area import inside
+from ptztrack.loop.live import LiveEpisode
 from ptztrack.loop.simulated import NetworkEpisode
 from ptztrack.loop.steps import Episode
 from ptztrack.names import GATE_M
@@ -41,6 +42,11 @@ UNDEFINED_BECAUSE = {
     "idf1": "there was neither a person nor a track: IDF1 divides by their number",
     "height_px": "no detection had a known height",
     "zoom": "the episode has no steps",
+    "frames_used_per_s": "fewer than two pictures were used",
+    "frames_detected_per_s": "the detector took fewer than two pictures",
+    "decisions_per_s": "fewer than two decisions were made",
+    "frame_age_s_p95": "no decision was made",
+    "median_decision_s": "no decision was made",
 }
 
 
@@ -122,14 +128,30 @@ def accumulator_metrics(accumulator: mm.MOTAccumulator, motp_key: str = "motp_m"
     }
 
 
-def episode_metrics(episode: Episode) -> dict:
+def episode_metrics(episode: Episode, with_truth: bool = True) -> dict:
     """The paper's figures for one episode.
 
     Besides :func:`clear_metrics`: ``height_px``, the mean pixel height of the
     detections whose height is known (a simulated false positive has none); ``detections``, the number of detections the
-    detector reported (false positives included); ``zoom``, the mean zoom.
+    detector reported (false positives included); ``zoom``, the mean zoom. Without ``with_truth`` (a real
+    camera's run, which has no ground truth) the figures of :func:`clear_metrics` are left out, not zero.
     """
-    return {**tracking_metrics(episode.truth, episode.tracks), **looking_metrics([episode])}
+    scores = tracking_metrics(episode.truth, episode.tracks) if with_truth else {}
+    return {**scores, **looking_metrics([episode])}
+
+
+def live_metrics(live: LiveEpisode) -> dict:
+    """A live run's figures that need no truth: ``pictures`` used of ``frames_received``, ``decisions``,
+    ``targets_sent`` (new poses sent to the camera), ``tracks_reported`` (distinct track ids) and the pace
+    (:meth:`LiveEpisode.rates`)."""
+    return {
+        "pictures": len(live.capture_time_s),
+        "frames_received": live.frames_received,
+        "decisions": int(np.isfinite(live.decided_s).sum()),
+        "targets_sent": int(live.sent.sum()),
+        "tracks_reported": len(set().union(*(tracks.ids.tolist() for tracks in live.tracks))),
+        **live.rates(),
+    }
 
 
 def network_metrics(episode: NetworkEpisode) -> dict:

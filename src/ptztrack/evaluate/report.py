@@ -7,7 +7,7 @@
 * ``tracks_mot.txt`` and ``truth_mot.txt``: the tracks and the truth in the MOTChallenge layout
   ``frame,id,left,top,width,height,conf,x,y,z`` (frames from 1, one per step; x and y on the ground
   in metres, printed so that they read back exactly; no boxes: -1), so that a run can be re-scored
-  by any MOT tool;
+  by any MOT tool (no truth_mot.txt for a run without ground truth);
 * ``episode.png`` and ``episode.mp4``: pictures.
 """
 
@@ -26,6 +26,7 @@ from ptztrack.files import strict_json, write_atomically
 from ptztrack.geometry.area import bounds_m
 from ptztrack.geometry.ptz import ground_footprint
 from ptztrack.loop.steps import Episode
+from ptztrack.names import TRUTH_MOT_FILE
 from ptztrack.track.observation import ground_points
 from ptztrack.types import Tracks
 from ptztrack.view.video import VIDEO_MAX_STEPS, RenderView, write_episode_video
@@ -204,10 +205,16 @@ def write_figure(path: Path, figure: Figure) -> None:
 
 
 def write_outputs(
-    directory: Path, episode: Episode, metrics: dict, title: str = "", render_view: RenderView | None = None
+    directory: Path,
+    episode: Episode,
+    metrics: dict,
+    title: str = "",
+    render_view: RenderView | None = None,
+    with_truth: bool = True,
 ) -> None:
     """Write the files of ``RUN_FILES`` into ``directory`` (created if needed): episode.mp4 only with
-    ``render_view`` (see :mod:`ptztrack.view.video`); the pictures captioned with ``title``."""
+    ``render_view`` (see :mod:`ptztrack.view.video`), truth_mot.txt only ``with_truth`` (a real camera's
+    run has none); the pictures captioned with ``title``."""
     directory = Path(directory)
     directory.mkdir(parents=True, exist_ok=True)
     write_atomically(directory / "metrics.json", metrics_json(metrics))
@@ -216,7 +223,7 @@ def write_outputs(
         ("detections.csv", detections_csv),
         ("tracks.csv", tracks_csv),
         ("tracks_mot.txt", tracks_mot),
-        ("truth_mot.txt", truth_mot),
+        *([(TRUTH_MOT_FILE, truth_mot)] if with_truth else []),
     ):
         write_atomically(directory / name, contents(episode))
     write_figure(directory / "episode.png", episode_figure(episode, title))
