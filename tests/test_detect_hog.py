@@ -9,6 +9,7 @@ from ptztrack.builders.live import live_world, offline_counterpart
 from ptztrack.builders.virtual_camera import virtual_calibration
 from ptztrack.builders.world import build_world
 from ptztrack.camera.virtual import virtual_ptz
+from ptztrack.detect import hog
 from ptztrack.detect.hog import (
     SCALE_TOLERANCE,
     GroundSearch,
@@ -269,6 +270,24 @@ def test_a_view_seen_before_gives_the_boxes_found_then_without_searching_again(h
     other = CountingDetector(nms_iou=0.3, search=search)
     other.detect(backend, 3, pose, np.random.default_rng(0))
     assert (second.searched, other.searched) == (2, 1)
+
+
+def test_a_live_worlds_hog_searches_every_picture_and_keeps_no_memo_of_them(
+    hog_world, tmp_path, excerpt_scenario, monkeypatch
+):
+    """A camera's pictures never repeat: a live run's detector finds in a picture seen again what it found
+    the first time, by searching it again, and leaves the memo of views empty however long it runs."""
+    monkeypatch.setattr("ptztrack.detect.hog._BOXES_SEEN", {})
+    scenario = excerpt_scenario(tmp_path, **{"detector.kind": "hog", "recording.video": str(EXCERPT / "View_001.avi")})
+    live = live_world(scenario, virtual_calibration(), seed=0).detector
+    assert not live.remember_views
+    detector = CountingDetector(search=live.search, luma=live.luma, remember_views=live.remember_views)
+    pose = whole_frame_at_zoom(hog_world, 0)
+    found = detector.detect(hog_world.backend, 3, pose, np.random.default_rng(0))
+    again = detector.detect(hog_world.backend, 3, pose, np.random.default_rng(0))
+    assert detector.searched == 2 and len(found) >= 1
+    np.testing.assert_array_equal(again.feet_px, found.feet_px)
+    assert hog._BOXES_SEEN == {}
 
 
 def test_scanning_the_levels_on_threads_finds_the_same_windows(hog_world):

@@ -23,6 +23,7 @@ from ptztrack.config import (
     Scenario,
 )
 from ptztrack.control.information_policy import InformationMethod
+from ptztrack.detect.hog import HogPeopleDetector
 from ptztrack.loop.alone import AlonePolicy, AloneTracker
 from ptztrack.loop.live import LiveEpisode, PlanAhead, run_live_network, warm_up
 from ptztrack.loop.steps import Episode, StepObserver, World
@@ -91,7 +92,7 @@ def live_world(
     """The world a live run decides in: the scenario's grid, detector and area, with the calibration's
     camera position and focal length where it gives them; its detector model draws from ``model_seed``
     (default: the one-camera episode's stream); its HOG reads the luma unless the scenario says otherwise
-    (:func:`streamed`)."""
+    (:func:`streamed`) and keeps no memo of the views it has seen (a camera's pictures never repeat)."""
     world = episode_world(streamed(scenario), seed)
     camera = world.camera
     if calibration.position_m is not None:
@@ -99,7 +100,10 @@ def live_world(
     if calibration.f_min_px is not None:
         camera = replace(camera, f_min_px=calibration.f_min_px)
     model_seed = episode_streams(seed).detector_model if model_seed is None else model_seed
-    return replace(world, camera=camera, detector_model=detector_model(scenario, camera, model_seed))
+    detector = world.detector
+    if isinstance(detector, HogPeopleDetector):
+        detector = replace(detector, remember_views=False)
+    return replace(world, camera=camera, detector=detector, detector_model=detector_model(scenario, camera, model_seed))
 
 
 def streamed(scenario: Scenario) -> Scenario:

@@ -159,6 +159,8 @@ class HogPeopleDetector:
     luma : read only an image's luma, ``Y = 0.299 R + 0.587 G + 0.114 B`` (OpenCV's grey), instead of the
         strongest gradient of its three colours: what a video stream keeps at full resolution (its
         colour is at half the resolution each way).
+    remember_views : keep the boxes found in each view (``MEMO_VIEWS``), for runs that see a recording's
+        views again; a camera's pictures never repeat, and their boxes would only fill the memo.
     """
 
     upsample: float = HogParameters.upsample
@@ -166,6 +168,7 @@ class HogPeopleDetector:
     nms_iou: float = HogParameters.nms_iou
     search: GroundSearch | None = None
     luma: bool = False
+    remember_views: bool = True
     _hog: cv2.HOGDescriptor = field(init=False, repr=False)
 
     def __post_init__(self):
@@ -185,6 +188,8 @@ class HogPeopleDetector:
             raise RuntimeError("the HOG detector needs a camera backend that renders images")
         planned_at = pose if believed_pose is None else believed_pose
         image = np.ascontiguousarray(image)
+        if not self.remember_views:
+            return detections_of(*self.boxes(image, planned_at))
         digest = hashlib.blake2b(image.data, digest_size=16).digest()
         key = (self._settings, np.asarray(planned_at, dtype=float).tobytes(), image.shape, digest)
         found = _BOXES_SEEN.get(key)
@@ -194,8 +199,7 @@ class HogPeopleDetector:
                 del _BOXES_SEEN[next(iter(_BOXES_SEEN))]
             _BOXES_SEEN[key] = found
         boxes, scores = found
-        feet_px, height_px = feet_and_height_px(boxes)
-        return Detections(feet_px, height_px, np.full(len(feet_px), -1), scores.copy())
+        return detections_of(boxes, scores.copy())
 
     def boxes(self, image, pose=None) -> tuple[np.ndarray, np.ndarray]:
         """People in a BGR image taken at ``pose`` (needed with a search): boxes (K, 4) as (left, top,
@@ -420,3 +424,10 @@ def feet_and_height_px(boxes) -> tuple[np.ndarray, np.ndarray]:
     boxes = np.asarray(boxes, dtype=float).reshape(-1, 4)
     feet_px = np.stack([boxes[:, 0] + boxes[:, 2] / 2, boxes[:, 1] + (1 - FEET_ABOVE_BOTTOM) * boxes[:, 3]], axis=-1)
     return feet_px, PERSON_IN_WINDOW * boxes[:, 3]
+
+
+def detections_of(boxes: np.ndarray, scores: np.ndarray) -> Detections:
+    """The detections of HOG's boxes (K, 4) px (left, top, width, height) and SVM scores (K,): feet and
+    heights from the boxes, no known person."""
+    feet_px, height_px = feet_and_height_px(boxes)
+    return Detections(feet_px, height_px, np.full(len(feet_px), -1), scores)
