@@ -127,7 +127,8 @@ def lost_steps(times_s: np.ndarray, away_s: list[tuple[float, float]]) -> int:
     gaps_s = np.diff(times_s)
     interval_s = float(np.median(gaps_s))
     lost = 0
-    for start_s, gap_s in zip(times_s[:-1], gaps_s, strict=True):
+    long = gaps_s > GAP_S  # a gap no longer than GAP_S loses nothing, whatever it shares
+    for start_s, gap_s in zip(times_s[:-1][long], gaps_s[long], strict=True):
         shared_s = sum(max(0.0, min(start_s + gap_s, end_s) - max(start_s, begin_s)) for begin_s, end_s in away_s)
         if gap_s - shared_s > GAP_S:
             lost += int(round((gap_s - shared_s) / interval_s)) - 1
