@@ -23,9 +23,8 @@ def test_live_scored_by_serve_cameras_truth_log_scores_each_picture_at_its_own_s
     scored against, which span the seconds the run took. Scored against the log as it stood before the run,
     every picture met the one step logged last before it began, and the run printed about -50 %.
 
-    The issue's bound, the printed MOTA within 10 points of the offline run of those steps, is not asserted:
-    a 60-picture live run on 2 cores shared with other tests was 3.5-22 points from its offline run in eight
-    runs on the development machine and 52 points in one clean CI run."""
+    The printed MOTA is not compared with the offline run of those steps: a 60-picture live run on cores
+    shared with other tests does not keep near it (docs: Real cameras)."""
     log = tmp_path / "truth.csv"
     with serve_camera(["--truth-log", str(log)]) as (_, (url,)):
         argv = ["live", "--camera", url, "--calibration", "virtual", "--truth", str(log), "--steps", str(PICTURES)]
