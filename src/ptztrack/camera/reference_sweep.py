@@ -34,11 +34,11 @@ log = logging.getLogger("ptztrack.loop.live")
 
 # The sweep's zooms from the action grid's widest to its longest, each at most this factor from the one
 # before: at a 160 x 120 stream a view 2x as zoomed shares too few features with the one before it to be
-# tied to it, one sqrt(2)x as zoomed does (docs/decisions.md).
+# tied to it, one sqrt(2)x as zoomed does (docs/decisions/0067-reference-sweep-grid.md).
 SWEEP_ZOOM_RATIO = 2.0**0.5
 # Neighbouring views of the sweep at most this fraction of their field of view apart, in pan and in tilt:
 # a pair of views is tied in the index by 30 RANSAC inliers, which a 160 x 120 stream's views share only
-# when they overlap by half (docs/decisions.md).
+# when they overlap by half (docs/decisions/0067-reference-sweep-grid.md).
 SWEEP_STEP_FRACTION = 0.5
 # A picture shows the camera still once the thumbnails (:func:`ptztrack.camera.stream.thumbnail`) of it
 # and the picture before differ by at most this many grey levels on average: a priori, between a still
@@ -56,12 +56,12 @@ STOP_MARGIN_S = 0.05
 # Pictures are smoothed by a Gaussian of this standard deviation (px, a 3 x 3 kernel) before SIFT, the
 # reference views and the live pictures alike: a video stream's compression leaves blocks and ringing at
 # the finest scale, where SIFT's keypoints then differ from picture to picture of one view
-# (docs/decisions.md).
+# (docs/decisions/0067-reference-sweep-grid.md).
 SMOOTHING_SIGMA_PX = 0.8
 # An index of fewer views than this does not cover the action grid.
 MIN_REFERENCE_VIEWS = 4
 # A registered pose's standard deviation: pan and tilt in degrees, zoom as a fraction of the zoom; chosen
-# from the errors of the PETS views registered at 160 x 120 (docs/decisions.md).
+# from the errors of the PETS views registered at 160 x 120 (docs/decisions/0067-reference-sweep-grid.md).
 REGISTERED_SD_DEG = 0.1
 REGISTERED_SD_ZOOM_FRACTION = 0.01
 

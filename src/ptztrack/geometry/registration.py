@@ -81,7 +81,8 @@ CANDIDATE_VIEWS = 2
 # a sharp view can have, and the least-squares cost grows with them.
 REFINE_POINTS = 100
 # Leaves the FLANN search visits, and SIFT features of a live view: as many views register, as
-# accurately, with half the features and checks, in two thirds of the time (docs/decisions.md).
+# accurately, with half the features and checks, in two thirds of the time
+# (docs/decisions/0002-registration-search-effort.md).
 # Reference views keep 1000 features: they are extracted once.
 FLANN_CHECKS = 16
 LIVE_FEATURES = 500
