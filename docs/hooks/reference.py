@@ -10,7 +10,10 @@ A line ``<!-- generated: NAME -->`` of a page is replaced by:
   section by section: type, default, bounds and the field's description from its model's docstring;
 - ``dataset``: the same for a dataset file (:class:`ptztrack.config.MultiViewDataset`);
 - ``calibration``: the same for a real camera's calibration file
-  (:class:`ptztrack.config.CameraCalibrationFile`).
+  (:class:`ptztrack.config.CameraCalibrationFile`);
+- ``service``: the same for ``ptztrack serve``'s configuration file
+  (:class:`ptztrack.service.config.ServiceConfig`);
+- ``service-example``: ``examples/serve.yaml`` as it is, in a ``yaml`` fence.
 """
 
 import argparse
@@ -26,7 +29,8 @@ import pydantic
 from pydantic.fields import FieldInfo
 
 # The reference describes the code beside these pages, whichever ptztrack is installed.
-sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "src"))
+ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT / "src"))
 
 MARKER = re.compile(r"^<!-- generated: ([a-z-]+) -->$", re.MULTILINE)
 
@@ -101,6 +105,16 @@ def calibration() -> str:
     from ptztrack.config import CameraCalibrationFile
 
     return _model_sections(CameraCalibrationFile, "top level")
+
+
+def service() -> str:
+    from ptztrack.service.config import ServiceConfig
+
+    return _model_sections(ServiceConfig, "top level")
+
+
+def service_example() -> str:
+    return "```yaml\n" + (ROOT / "examples" / "serve.yaml").read_text(encoding="utf-8").rstrip("\n") + "\n```"
 
 
 def _model_sections(model: type[pydantic.BaseModel], title: str) -> str:
@@ -259,4 +273,6 @@ GENERATORS: dict[str, Callable[[], str]] = {
     "scenario": scenario,
     "dataset": dataset,
     "calibration": calibration,
+    "service": service,
+    "service-example": service_example,
 }
