@@ -128,7 +128,8 @@ def _model_sections(model: type[pydantic.BaseModel], title: str) -> str:
             continue
         seen.add(current)
         heading = f"### {path}" if path == title else f"### `{path}`"
-        lines = [heading, "", _first_paragraph(current), "", "| field | type | default | bounds | meaning |", "|---|---|---|---|---|"]
+        header = ["| field | type | default | bounds | meaning |", "|---|---|---|---|---|"]
+        lines = [heading, "", _first_paragraph(current), "", *header]
         descriptions = _field_descriptions(current)
         for name, info in current.model_fields.items():
             lines.append(
@@ -261,7 +262,7 @@ def _at_most_limit(constraint: object) -> str | None:
     function = getattr(constraint, "func", None)
     if not isinstance(constraint, pydantic.AfterValidator) or function is None or function.__closure__ is None:
         return None
-    cells = dict(zip(function.__code__.co_freevars, (cell.cell_contents for cell in function.__closure__)))
+    cells = dict(zip(function.__code__.co_freevars, (cell.cell_contents for cell in function.__closure__), strict=True))
     limit = cells.get("limit")
     if isinstance(limit, int | float) and function.__qualname__.startswith("at_most."):
         return f"{limit:g}"
