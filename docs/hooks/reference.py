@@ -162,18 +162,31 @@ def _first_paragraph(model: type) -> str:
 
 def _field_descriptions(model: type[pydantic.BaseModel]) -> dict[str, str]:
     """What a field means, from the ``name : text`` entries of the model's docstring and of the
-    docstrings of the parameter classes its defaults come from (``a, b : text`` describes both)."""
-    described: dict[str, str] = {}
+    docstrings of the parameter classes its defaults come from (``a, b : text`` describes both); a field
+    named with a parameter class's prefix takes that class's entry (``hog_upsample``, HogParameters's
+    ``upsample``)."""
+    found: dict[str, str] = {}
     for each in _docstring_sources(model):
-        for paragraph in _own_doc(each).split("\n\n"):
-            text = " ".join(paragraph.split())
-            found = list(_DESCRIBED.finditer(text))
-            for index, entry in enumerate(found):
-                end = found[index + 1].start() if index + 1 < len(found) else len(text)
-                meaning = text[entry.end() : end].strip().removesuffix(";").removesuffix(", and").strip()
-                for name in entry.group(1).split(", "):
-                    described.setdefault(name, meaning)
-    return {name: text for name, text in described.items() if name in model.model_fields}
+        prefix = each.__name__.removesuffix("Parameters").lower() + "_" if each is not model else ""
+        for name, meaning in _entries(each).items():
+            for field in (name, prefix + name):
+                if field in model.model_fields:
+                    found.setdefault(field, meaning)
+    return found
+
+
+def _entries(documented: type) -> dict[str, str]:
+    """The ``name : text`` entries of a class's docstring."""
+    entries: dict[str, str] = {}
+    for paragraph in _own_doc(documented).split("\n\n"):
+        text = " ".join(paragraph.split())
+        found = list(_DESCRIBED.finditer(text))
+        for index, entry in enumerate(found):
+            end = found[index + 1].start() if index + 1 < len(found) else len(text)
+            meaning = text[entry.end() : end].strip().removesuffix(";").removesuffix(", and").strip()
+            for name in entry.group(1).split(", "):
+                entries.setdefault(name, meaning)
+    return entries
 
 
 def _docstring_sources(model: type[pydantic.BaseModel]) -> list[type]:
