@@ -83,7 +83,7 @@ def pytest_terminal_summary(terminalreporter):
     of those not run with their counts; from the pages' reports, so also when xdist's workers ran them."""
     from collections import Counter
 
-    from test_docs_code_blocks import COUNTS_PROPERTY
+    from docs_blocks import COUNTS_PROPERTY
 
     ran, reasons, pages = 0, Counter(), 0
     for reports in terminalreporter.stats.values():
@@ -96,6 +96,6 @@ def pytest_terminal_summary(terminalreporter):
                     ran += value[0]
                     reasons.update(reason for _, reason in value[1])
     if pages:
-        terminalreporter.write_line(f"docs code blocks: {ran} run, {sum(reasons.values())} skipped ({pages} pages)")
+        terminalreporter.write_line(f"docs code blocks: {ran} run, {sum(reasons.values())} skipped")
         for reason, count in reasons.most_common():
             terminalreporter.write_line(f"  {count} x {reason}")

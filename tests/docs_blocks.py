@@ -4,7 +4,9 @@ The conventions every page follows:
 
 - every fence names its language; ``bash`` and ``python`` blocks are run, every other language
   (``text``, ``yaml``, ``toml``, ``json``, ``ini``, ...) is read only;
-- ``<!-- not-run: REASON -->`` on the line directly above a fence: the block is not run, for REASON;
+- ``<!-- not-run: REASON -->`` on the line directly above a fence: the block is not run, for REASON; a
+  ``bash`` block that installs packages (``pip install``) must be so marked, since run it would change
+  the environment the tests run in;
 - ``<!-- background -->`` on the line directly above a ``bash`` fence: the block starts in the
   background, is taken as up once it has printed a line and then been quiet for a moment, and is
   stopped (its whole process group) when the page's blocks end.
@@ -21,8 +23,7 @@ import signal
 import subprocess
 import sys
 import time
-from collections.abc import Iterator
-from contextlib import contextmanager, suppress
+from contextlib import suppress
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -46,12 +47,16 @@ BACKGROUND_UP_TIMEOUT_S = 60.0
 BACKGROUND_QUIET_S = 1.0
 """A background block is taken as up once its first line is out and it has then printed nothing for this long."""
 STOP_TIMEOUT_S = 10.0
+COUNTS_PROPERTY = "docs_code_blocks"
+"""The user property a page's test records its counts under: (blocks run, [(where, reason) not run])."""
 OUTPUT_TAIL_LINES = 40
 
 _FENCE = re.compile(r"^(?P<indent> *)(?P<fence>`{3,}|~{3,})(?P<info>.*)$")
 _NOT_RUN = re.compile(r"^\s*<!--\s*not-run:(?P<reason>.*?)-->\s*$")
 _BACKGROUND = re.compile(r"^\s*<!--\s*background\s*-->\s*$")
-_MARKER = re.compile(r"^\s*<!--\s*(not-run|background)\b")
+_INSTALLS = re.compile(r"\bpip3? install\b")
+# What a misspelt marker looks like, so that it is refused rather than read as no marker.
+_MARKER = re.compile(r"^\s*<!--\s*(not[\s_-]*run|background)", re.IGNORECASE)
 
 
 class PageError(AssertionError):
@@ -128,6 +133,9 @@ def read_blocks(page: str, text: str) -> list[Block]:
             raise PageError(f"{page}:{number}: the fence is never closed")
         index += 1
         mode, reason = _marker(page, number - 1, lines[number - 2] if number >= 2 else "", language)
+        if mode == "run" and language == "bash" and any(_INSTALLS.search(line) for line in body):
+            # Run, it would change the environment the tests run in (CI installs as .ci/run says).
+            raise PageError(f"{page}:{number}: a block that installs packages: mark it <!-- not-run: REASON -->")
         blocks.append(Block(page, number, language, "\n".join(body) + "\n", mode, reason))
     return blocks
 
@@ -219,7 +227,7 @@ def start_background(block: Block, folder: Path, variables: dict[str, str]) -> B
             return started
         time.sleep(0.1)
     stop_background(started)
-    raise PageError(f"{block.where}: a background block printed nothing and went quiet within "
+    raise PageError(f"{block.where}: a background block not up (a line printed, then quiet) within "
                     f"{BACKGROUND_UP_TIMEOUT_S:.0f} s:\n{_tail(started.printed())}")  # fmt: skip
 
 
@@ -238,11 +246,10 @@ def stop_background(started: Background) -> None:
         os.killpg(started.process.pid, signal.SIGKILL)
 
 
-@contextmanager
-def page_folder(folder: Path) -> Iterator[Path]:
-    """``folder`` with the repository's examples reachable as ``examples/``."""
+def page_folder(folder: Path) -> Path:
+    """``folder``, made a page's: the repository's examples reachable in it as ``examples/``."""
     (folder / "examples").symlink_to(REPOSITORY / "examples", target_is_directory=True)
-    yield folder
+    return folder
 
 
 def run_page(blocks: list[Block], folder: Path, ran: list[Block]) -> None:
