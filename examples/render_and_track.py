@@ -7,8 +7,7 @@ into ``--out``: the video, its calibration, the ground truth and ``dataset.yaml`
 same as ``ptztrack render``). ``load_dataset`` reads that file as it would read a real recording's, and
 ``dataset_scenario`` puts the PTZ paper's virtual camera (160 x 120 px, 5 steps a second) inside the video;
 an episode of each policy then runs on it. The ``ideal`` detector finds the annotated people the virtual
-camera shows whole; ``--detector hog`` runs OpenCV's people detector on its pictures instead (slower, and
-at 160 px wide it finds few of these drawn people).
+camera shows whole; ``--detector hog`` runs OpenCV's people detector on its pictures instead.
 """
 
 import argparse

@@ -87,6 +87,11 @@ def pages() -> list[str]:
     return ["README.md", *docs]
 
 
+def serves_in_background(text: str) -> bool:
+    """Whether the Markdown ``text`` has a ``<!-- background -->`` block."""
+    return any(_BACKGROUND.match(line) for line in text.splitlines())
+
+
 def _marker(page: str, number: int, line: str, language: str) -> tuple[str, str]:
     """The block's mode and reason from the line above its fence (numbered ``number``)."""
     not_run = _NOT_RUN.match(line)

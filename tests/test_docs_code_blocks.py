@@ -16,13 +16,23 @@ from docs_blocks import (
     pages,
     read_blocks,
     run_page,
+    serves_in_background,
 )
 
 
-# The pages' servers take fixed ports (the virtual camera's 8080, say), and their live runs are live runs:
-# one page at a time, and none beside the live tests (tests/test_loop_live_onvif.py).
-@pytest.mark.xdist_group("live-loop")
-@pytest.mark.parametrize("page", pages())
+def page_parameters() -> list:
+    """Every page, those that serve something in the background in the live tests' xdist group: their
+    servers take fixed ports (the virtual camera's 8080, say) and their live runs are live runs, one at a
+    time and none beside the live tests (tests/test_loop_live_onvif.py). The others run anywhere."""
+    return [
+        pytest.param(page, marks=[pytest.mark.xdist_group("live-loop")])
+        if serves_in_background((REPOSITORY / page).read_text(encoding="utf-8"))
+        else page
+        for page in pages()
+    ]
+
+
+@pytest.mark.parametrize("page", page_parameters())
 def test_page_code_blocks_run_as_written(page, tmp_path, record_property):
     try:
         blocks = read_blocks(page, (REPOSITORY / page).read_text(encoding="utf-8"))
