@@ -1,6 +1,6 @@
 """A camera policy of one's own, run by ptztrack beside the paper's strategies.
 
-    python examples/custom_policy.py
+    python examples/custom_policy.py [--frames 25] [--sequences 3]
 
 The policy follows the most uncertain track: among the actions the mechanics
 allow, it takes the one whose view is centred nearest to that track, at the
@@ -8,6 +8,8 @@ widest zoom that still shows a person there at least 60 px tall. It is a
 plain class with a ``choose`` method (:class:`ptztrack.Policy`); a factory
 ``(scenario, world) -> policy`` gives it the camera model and the action grid.
 """
+
+import argparse
 
 import numpy as np
 
@@ -40,16 +42,21 @@ def follow_the_most_uncertain(scenario, world):
 
 
 def main() -> None:
-    scenario = ptztrack.scenario_from_dict({"detector": {"kind": "realistic"}})
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--frames", type=int, default=25)
+    parser.add_argument("--sequences", type=int, default=3)
+    args = parser.parse_args()
+    scenario = ptztrack.scenario_from_dict({"frames": args.frames, "detector": {"kind": "realistic"}})
 
     episode = ptztrack.run_episode(scenario, follow_the_most_uncertain, seed=0)
     metrics = ptztrack.episode_metrics(episode)
     print(f"one episode: MOTA {metrics['mota']:.1%}, mean zoom {metrics['zoom']:.2f}")
 
     strategies = ["fix", "smpl", follow_the_most_uncertain]
-    cells = ptztrack.synthetic_cells(scenario, sequences=3, strategies=strategies)
+    cells = ptztrack.synthetic_cells(scenario, sequences=args.sequences, strategies=strategies)
     rows = ptztrack.execute_cells(cells, ptztrack.cell_metrics, executor="serial")
-    print(ptztrack.format_table(ptztrack.summarise(rows), "3 synthetic sequences, realistic detector"))
+    title = f"{args.sequences} synthetic sequences of {args.frames} steps, realistic detector"
+    print(ptztrack.format_table(ptztrack.summarise(rows), title))
 
 
 if __name__ == "__main__":

@@ -76,3 +76,26 @@ def pytest_collection_modifyitems(config, items):
         }
         if "module" in scopes:
             item.add_marker(pytest.mark.xdist_group(item.module.__name__))
+
+
+def pytest_terminal_summary(terminalreporter):
+    """The docs' code blocks run and not run (tests/test_docs_code_blocks.py), one line, then the reasons
+    of those not run with their counts; from the pages' reports, so also when xdist's workers ran them."""
+    from collections import Counter
+
+    from docs_blocks import COUNTS_PROPERTY
+
+    ran, reasons, pages = 0, Counter(), 0
+    for reports in terminalreporter.stats.values():
+        for report in reports:
+            if getattr(report, "when", None) != "call":
+                continue
+            for name, value in getattr(report, "user_properties", ()):
+                if name == COUNTS_PROPERTY:
+                    pages += 1
+                    ran += value[0]
+                    reasons.update(reason for _, reason in value[1])
+    if pages:
+        terminalreporter.write_line(f"docs code blocks: {ran} run, {sum(reasons.values())} skipped")
+        for reason, count in reasons.most_common():
+            terminalreporter.write_line(f"  {count} x {reason}")
