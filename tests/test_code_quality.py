@@ -1,4 +1,4 @@
-"""The promises about the code itself that a tool can check: layers, lint, types, the example."""
+"""The promises about the code itself that a tool can check: layers, lint, types."""
 
 import shutil
 import subprocess
@@ -28,14 +28,6 @@ def test_the_code_keeps_its_contracts(command):
     assert executable is not None, f"{command[0]} is not installed: pip install '.[test]'"
     result = subprocess.run([executable, *command[1:]], cwd=ROOT, capture_output=True, text=True)
     assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
-
-
-def test_the_readme_example_runs_a_policy_defined_in_its_own_script(tmp_path):
-    result = subprocess.run(
-        [sys.executable, str(ROOT / "examples" / "custom_policy.py")], cwd=tmp_path, capture_output=True, text=True
-    )
-    assert result.returncode == 0, result.stderr
-    assert "follow_the_most_uncertain" in result.stdout and "one episode: MOTA" in result.stdout
 
 
 def test_no_module_is_over_500_lines_and_no_step_loop_lives_outside_the_loop_package():
