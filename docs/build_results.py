@@ -208,6 +208,16 @@ def information_gain_fields() -> dict[str, str]:
         if label in ("intg", "smpl")
     ]
     fields["synthetic_information_gain_zoom"] = f"{min(zooms):.1f}-{max(zooms):.1f}"
+    ratios = [
+        table_rows[label]["height_px"] / table_rows["fix"]["height_px"]
+        for table_rows in (ideal, realistic)
+        for label in ("intg", "smpl")
+    ]
+    fields["synthetic_height_ratio"] = f"{min(ratios):.1f}-{max(ratios):.1f}"
+    fields["synthetic_patrol_realistic"] = pct(realistic["patrol"]["mota"])
+    fields["synthetic_patrol_detections"] = fixed(realistic["patrol"]["detections"], 1)
+    fields["paper_patrol_realistic"] = paper_figure(paper["table_2"]["patrol"], "mota")
+    fields["paper_patrol_detections"] = paper_figure(paper["table_2"]["patrol"], "detections")
 
     for detector in ("ideal", "hog"):
         for protocol in ("a-priori", "two-fold"):
@@ -321,7 +331,8 @@ def face_capture_fields() -> dict[str, str]:
         return sum(row["captures"] for row in mine) / sum(row["zooms"] for row in mine)
 
     rates = ", ".join(f"{name} {capture_rate(name):.3f}" for name in schedulers)
-    high = [seed for seed in seeds if bin_of[seed] > 30]
+    nj_s_of = {row["seed"]: row["nj_s"] for row in rows}
+    high = [seed for seed in seeds if nj_s_of[seed] > 30]
     paper = load("paper")["msg"]
     return {
         "paper_key_msg": fixed(paper["key_bin_msg_above"], 2),
@@ -484,6 +495,15 @@ def occupancy_map_fields() -> dict[str, str]:
         "room_lpom_moda_crowd": pct(cell[people[-1], "lpom"]["moda"]),
         "room_clustering_moda_crowd": pct(cell[people[-1], "clustering"]["moda"]),
         "room_crowd": str(people[-1]),
+        "room_fitted": "; ".join(
+            f"{count} {'person' if count == 1 else 'people'}: LPOM's strength "
+            + " and ".join(f"{value:g}" for value in cell[count, "lpom"]["fitted_min_strength"])
+            + ", POM's person width "
+            + " and ".join(f"{value:g} m" for value in cell[count, "pom"]["fitted_width_m"])
+            + ", the baseline's views "
+            + " and ".join(str(value) for value in cell[count, "clustering"]["fitted_min_views"])
+            for count in people
+        ),
     }
 
 
