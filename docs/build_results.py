@@ -586,8 +586,9 @@ def registration_fields() -> dict[str, str]:
             row["pose_source"],
             pct(row["mota"]),
             fixed(row["motp_m"], 3),
-            f"{row['tracker_pan_err_deg']:.3g} deg, {row['tracker_tilt_err_deg']:.3g} deg, "
-            f"{row['tracker_zoom_err_pct']:.2g} %",
+            pct(row["pose_known"]),
+            f"{row['tracker_pan_err_deg']:.3f} deg, {row['tracker_tilt_err_deg']:.3f} deg, "
+            f"{row['tracker_zoom_err_pct']:.2f} %",
             str(row["matches"]),
             str(row["false_positives"]),
         ]
@@ -611,6 +612,7 @@ def registration_fields() -> dict[str, str]:
                 "pose source",
                 "MOTA",
                 "MOTP [m]",
+                "steps with a pose",
                 "tracker's pose error (median pan, tilt, zoom)",
                 "matches",
                 "false positives",
