@@ -100,13 +100,13 @@ PTZ_FIGURES = (
 )
 
 
-def ptz_cell(row: dict, key: str, spread_key: str, paper: dict | None) -> str:
+def ptz_cell(row: dict, key: str, spread_key: str, paper: dict | None, detection_digits: int) -> str:
     """One cell of a PTZ table: MOTA with its spread over the runs, the other figures plain; the
     paper's value in brackets where ``paper`` gives one."""
     if key == "mota":
         text = pct_pm(row["mota"], row[spread_key]) if row["sequences"] > 1 else pct(row["mota"])
     elif key == "detections":
-        text = fixed(row[key], 1 if row[key] < 1000 else 0)
+        text = fixed(row[key], detection_digits)
     else:
         text = fixed(row[key], {"motp_m": 3, "height_px": 1, "zoom": 2}[key])
     if paper is not None:
@@ -136,11 +136,12 @@ def ptz_table(
     paper: dict | None = None,
     figures: Sequence[tuple[str, str]] = PTZ_FIGURES,
     folds: bool = False,
+    detection_digits: int = 1,
 ) -> str:
     """The paper's layout: a column per strategy, a row per figure; ``paper`` maps a column's label to
     the paper's figures, shown in brackets; ``folds`` adds each fold's MOTA."""
     body = [
-        [name] + [ptz_cell(row, key, spread_key, paper and paper[row["label"]]) for row in rows]
+        [name] + [ptz_cell(row, key, spread_key, paper and paper[row["label"]], detection_digits) for row in rows]
         for name, key in figures
     ]
     if folds:
@@ -184,14 +185,14 @@ def information_gain_fields() -> dict[str, str]:
         "paper_scene_detected": fixed(paper["table_1"]["fix"]["detections"], 1),
         "paper_scene_height_px": fixed(paper["table_1"]["fix"]["height_px"], 1),
     }
-    for name, paper_table in (
+    for name, paper_columns in (
         ("synthetic-ideal", "table_1"),
         ("synthetic-realistic-true", "table_2"),
         ("synthetic-realistic-online", None),
     ):
         rows = load(name)
         key = name.replace("-", "_")
-        fields[f"{key}_table"] = ptz_table(rows, "mota_se", paper[paper_table] if paper_table else None)
+        fields[f"{key}_table"] = ptz_table(rows, "mota_se", paper[paper_columns] if paper_columns else None)
         columns = by_label(rows)
         difference, error = paired(columns["smpl"]["mota_per_sequence"], columns["intg"]["mota_per_sequence"])
         fields[f"{key}_smpl_minus_intg"] = points(difference, error)
@@ -224,7 +225,7 @@ def information_gain_fields() -> dict[str, str]:
             name = f"pets-{detector}-{protocol}"
             rows = load(name)
             key = name.replace("-", "_")
-            fields[f"{key}_table"] = ptz_table(rows, "mota_sd", folds=protocol == "two-fold")
+            fields[f"{key}_table"] = ptz_table(rows, "mota_sd", folds=protocol == "two-fold", detection_digits=0)
     fields["pets_ideal_paper_table"] = paper_table(paper["table_3"])
     fields["pets_hog_paper_table"] = paper_table(paper["table_4"])
     for detector in ("ideal", "hog"):
