@@ -401,7 +401,7 @@ def long_runs_fields() -> dict[str, str]:
     body = [[name, show(runs["default"]), show(runs["long_run"]), asked] for name, show, asked in figures]
     gaps = runs["long_run"]["switch_gaps"]
     return {
-        "soak_steps": f"{runs['default']['steps']:,}",
+        "soak_steps": str(runs["default"]["steps"]),
         "soak_people": str(runs["default"]["people"]),
         "soak_table": table(["figure", "default tracker", "`examples/long_run.yaml`", "asked"], body),
         "soak_person_unmatched": " / ".join(fixed(value, 0) for value in gaps["person_unmatched_steps"]),
