@@ -433,8 +433,15 @@ def camera_network_fields() -> dict[str, str]:
         return points(-row["mota_minus_joint"], row["mota_minus_joint_se"])
 
     ptz_over_fixed = [-row["mota_minus_joint"] for row in rows if "fixed" in row["config"] and "joint" in row]
+    ring = [configs[f"{count}ptz-independent"] for count in (2, 3, 4)]
+    resolved = [-row["mota_minus_joint"] > 2 * row["mota_minus_joint_se"] for row in ring]
     return {
         "network_sequences": str(rows[0]["sequences"]),
+        "network_ring_verdict": (
+            "ahead of independent ones by more than twice the paired standard error"
+            if all(resolved)
+            else "not ahead of independent ones by twice the paired standard error at every count"
+        ),
         "network_table": table(["config", "MOTA", "- joint [points]", "MOTP [m]", "IDF1", "# Dets", "Zoom [x]"], body),
         "network_joint_over_independent_2": lead("2ptz-independent"),
         "network_joint_over_independent_3": lead("3ptz-independent"),
@@ -680,7 +687,7 @@ def msg_speed_fields() -> dict[str, str]:
         [
             f"{row['vertices']:,}",
             f"{row['aux_ms']:.3f}",
-            f"{row['traversal_ms']:.3g}",
+            f"{row['traversal_ms']:,.1f}",
             f"{row['traversal_ms'] / row['aux_ms']:,.0f}x",
         ]
         for row in load("msg-speed")
@@ -724,12 +731,56 @@ def occupancy_speed_fields() -> dict[str, str]:
     }
 
 
+def step_cost_fields() -> dict[str, str]:
+    rows = load("step-cost")
+    body = [
+        [
+            row["policy"],
+            fixed(row["zoom"], 2),
+            fixed(row["read_ms"], 1),
+            fixed(row["warp_ms"], 1),
+            fixed(row["detect_ms"], 0),
+            fixed(row["track_ms"], 1),
+            fixed(row["decide_ms"], 2),
+            fixed(row["total_ms"], 0),
+            fixed(row["steps_per_s"], 1),
+            fixed(row["reference_detect_ms"], 0),
+            fixed(row["reference_steps_per_s"], 1),
+            f"{row['detect_speedup']:.1f}x",
+        ]
+        for row in rows
+    ]
+    shares = [row["detect_share"] for row in rows]
+    return {
+        "step_cost_steps": str(rows[0]["steps"]),
+        "step_cost_table": table(
+            [
+                "policy",
+                "zoom",
+                "read",
+                "warp",
+                "detect",
+                "track",
+                "decide",
+                "total",
+                "steps/s",
+                "every window: detect",
+                "steps/s",
+                "detect speed-up",
+            ],
+            body,
+        ),
+        "step_cost_detect_share": f"{100 * min(shares):.0f}-{100 * max(shares):.0f} %",
+    }
+
+
 SPEED_PARTS = {
     "decision-speed": decision_speed_fields,
     "follow-speed": follow_speed_fields,
     "msg-speed": msg_speed_fields,
     "registration-speed": registration_speed_fields,
     "occupancy-speed": occupancy_speed_fields,
+    "step-cost": step_cost_fields,
 }
 
 
@@ -813,12 +864,24 @@ def headline_long_runs() -> list[str]:
     ]
 
 
+def headline_network() -> list[str]:
+    configs = {row["config"]: row for row in load("network-synthetic")}
+    joint, independent, fixed_two = (configs[name] for name in ("2ptz-joint", "2ptz-independent", "2fixed"))
+    return [
+        "[The camera network](camera-network.md)",
+        f"two PTZ cameras deciding jointly: MOTA {pct_pm(joint['mota'], joint['mota_se'])}, independently "
+        f"{pct_pm(independent['mota'], independent['mota_se'])}, the same two fixed "
+        f"{pct_pm(fixed_two['mota'], fixed_two['mota_se'])}",
+    ]
+
+
 HEADLINES = (
     headline_information_gain,
     headline_face_capture,
     headline_registration,
     headline_follow,
     headline_occupancy,
+    headline_network,
     headline_long_runs,
 )
 
