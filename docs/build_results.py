@@ -267,6 +267,49 @@ def information_gain_fields() -> dict[str, str]:
     return fields
 
 
+def detections_fields() -> dict[str, str]:
+    """View_001's shipped boxes as the detector, under both protocols."""
+    a_priori, two_fold = load("pets-detections-a-priori"), load("pets-detections-two-fold")
+    labels = [row["label"] for row in a_priori]
+    first, second = by_label(a_priori), by_label(two_fold)
+    body = [
+        ["a priori MOTA"] + [pct_pm(first[label]["mota"], first[label]["mota_sd"]) for label in labels],
+        ["MOTP [m]"] + [fixed(first[label]["motp_m"], 3) for label in labels],
+        ["# Dets"] + [fixed(first[label]["detections"], 0) for label in labels],
+        ["Zoom [x]"] + [fixed(first[label]["zoom"], 2) for label in labels],
+        ["two-fold MOTA"] + [pct_pm(second[label]["mota"], second[label]["mota_sd"]) for label in labels],
+        ["MOTA folds"] + [" / ".join(pct(value) for value in second[label]["mota_folds"]) for label in labels],
+    ]
+    fitted = two_fold[0]["fitted"]
+    zooms = [first[label]["zoom"] for label in labels if label != "fix"]
+    return {
+        "detections_best": max(labels, key=lambda label: first[label]["mota"]),
+        "detections_table": table(["`detections`"] + labels, body),
+        "detections_fitted_recall": "; ".join(
+            f"Kd {fold['recall_kd']:.3g}, r0 {fold['recall_r0_px']:.3g} px" for fold in fitted
+        ),
+        "detections_zoom": f"{min(zooms):.1f}-{max(zooms):.1f}",
+    }
+
+
+PRIOR_SHIFTS = (("15", "15"), ("-10", "minus-10"), ("40", "40"), ("80", "80"))
+
+
+def prior_shift_fields() -> dict[str, str]:
+    """The online detector model against the a-priori one when the prior curve is shifted."""
+    truth = by_label(load("synthetic-realistic-true"))["smpl"]
+    body = []
+    for shift, name in PRIOR_SHIFTS:
+        online, a_priori = (load(f"prior-shift-{name}-{model}")[0] for model in ("online", "a-priori"))
+        body.append(
+            [f"{shift} px", pct_pm(online["mota"], online["mota_se"]), pct_pm(a_priori["mota"], a_priori["mota_se"])]
+        )
+    return {
+        "prior_shift_true": pct_pm(truth["mota"], truth["mota_se"]),
+        "prior_shift_table": table(["prior shifted by D", "online", "a-priori"], body),
+    }
+
+
 # Face capture on the MSG.
 
 MSG_BIN_WIDTH = 5  # N_j/s bins centred on its multiples, as ptztrack experiment msg prints them
@@ -635,6 +678,53 @@ def registration_fields() -> dict[str, str]:
     }
 
 
+# The live loop.
+
+
+def live_fields() -> dict[str, str]:
+    run = load("live-loop")
+    pace = [
+        ["pictures used", str(run["pictures_used"])],
+        ["decisions a second", fixed(run["decisions_per_s"], 2)],
+        ["pictures used a second", fixed(run["frames_used_per_s"], 2)],
+        ["95 % of the decisions on a picture at most", f"{run['frame_age_s_p95']:.3f} s"],
+        [
+            "first decision with tracks / median decision",
+            f"{1e3 * run['first_decision_s']:.1f} / {1e3 * run['median_decision_s']:.1f} ms",
+        ],
+        ["new targets sent a second", fixed(run["new_targets_per_s"], 2)],
+        ["the virtual camera's share of one core", fixed(run["camera_cpu_share"], 2)],
+    ]
+    score = [
+        ["MOTA live", pct(run["mota_live"])],
+        ["the live run's pictures rendered exactly", pct(run["mota_replay_rendered"])],
+        ["one such picture a recording step", pct(run["mota_replay_per_step"])],
+        ["the offline run of the same steps, seed 0", pct(run["mota_offline"])],
+        [
+            f"the offline run over {len(run['mota_offline_per_seed'])} seeds",
+            pct_pm(run["mota_offline_seeds_mean"], run["mota_offline_seeds_sd"]),
+        ],
+        ["IDF1 live / offline", f"{pct(run['idf1_live'])} / {pct(run['idf1_offline'])}"],
+        ["zoom live / offline", f"{run['zoom_live']:.2f} / {run['zoom_offline']:.2f}"],
+        ["pan error of pictures taken while moving, p95", f"{run['pan_error_deg_moving_p95']:.2f} deg"],
+    ]
+    stages = [[stage, fixed(1e3 * value, 1)] for stage, value in run["stages_s"].items()]
+    by_zoom = [
+        [band, fixed(figures["ms"], 1), fixed(figures["people_height_px"], 1), fixed(figures["recall"], 2)]
+        for band, figures in run["detection_by_zoom"].items()
+    ]
+    return {
+        "live_machine": f"{run['cpu_model']}, {run['cores']} cores",
+        "live_pace_table": table(["pace", ""], pace),
+        "live_score_table": table(["score", ""], score),
+        "live_stages_table": table(["where a decision's picture ages (medians)", "ms"], stages),
+        "live_zoom_table": table(
+            ["the picture's zoom", "detection [ms]", "people found [px tall]", "the learned recall there"], by_zoom
+        ),
+        "live_gap_offline": points(run["mota_live"] - run["mota_offline"]),
+    }
+
+
 # Speed.
 
 
@@ -847,7 +937,9 @@ def headline_occupancy() -> list[str]:
     return [
         "[The occupancy map (LPOM)](occupancy-map.md)",
         "in the rendered room, LPOM's MODA "
-        + " and ".join(f"{pct(cell[count, 'lpom']['moda'])} ({count} people)" for count in people)
+        + " and ".join(
+            f"{pct(cell[count, 'lpom']['moda'])} ({count} {'person' if count == 1 else 'people'})" for count in people
+        )
         + ", error "
         + " and ".join(f"{cell[count, 'lpom']['error_m']:.3f} m" for count in people),
     ]
