@@ -185,6 +185,7 @@ def information_gain_fields() -> dict[str, str]:
         "paper_scene_detected": fixed(paper["table_1"]["fix"]["detections"], 1),
         "paper_scene_height_px": fixed(paper["table_1"]["fix"]["height_px"], 1),
     }
+    resolved = []
     for name, paper_columns in (
         ("synthetic-ideal", "table_1"),
         ("synthetic-realistic-true", "table_2"),
@@ -196,6 +197,12 @@ def information_gain_fields() -> dict[str, str]:
         columns = by_label(rows)
         difference, error = paired(columns["smpl"]["mota_per_sequence"], columns["intg"]["mota_per_sequence"])
         fields[f"{key}_smpl_minus_intg"] = points(difference, error)
+        resolved.append(abs(difference) > 2 * error)
+    fields["synthetic_smpl_intg_verdict"] = (
+        "is within twice its paired standard error in every table"
+        if not any(resolved)
+        else "exceeds twice its paired standard error in at least one table"
+    )
     ideal = by_label(load("synthetic-ideal"))
     fields["synthetic_sequences"] = str(ideal["smpl"]["sequences"])
     fields["pets_seeds"] = str(max(row["seeds"] for row in load("pets-hog-a-priori")))
