@@ -271,7 +271,7 @@ def information_gain_fields() -> dict[str, str]:
     ideal_a_priori = by_label(load("pets-ideal-a-priori"))
     fields["pets_ideal_gap_b9"] = span(gaps_over(ideal_a_priori, "fix", ("intg b9", "smpl b9")))
     fields["pets_ideal_gap_b1"] = span(gaps_over(ideal_a_priori, "fix", ("intg b1", "smpl b1")), signed=True)
-    return fields
+    return fields | detections_fields() | prior_shift_fields() | pets_crowd_fields()
 
 
 def detections_fields() -> dict[str, str]:
@@ -296,6 +296,18 @@ def detections_fields() -> dict[str, str]:
             f"Kd {fold['recall_kd']:.3g}, r0 {fold['recall_r0_px']:.3g} px" for fold in fitted
         ),
         "detections_zoom": f"{min(zooms):.1f}-{max(zooms):.1f}",
+    }
+
+
+def pets_crowd_fields() -> dict[str, str]:
+    """The synthetic scene with PETS 2009 S2.L1's annotated people as its walkers."""
+    rows = by_label(load("pets-crowd"))
+    difference, error = paired(rows["smpl"]["mota_per_sequence"], rows["intg"]["mota_per_sequence"])
+    return {
+        "pets_crowd_sequences": str(rows["smpl"]["sequences"]),
+        "pets_crowd_mota": ", ".join(f"`{label}` {pct_pm(row['mota'], row['mota_se'])}" for label, row in rows.items()),
+        "pets_crowd_smpl_minus_intg": points(difference, error),
+        "pets_crowd_zoom": ", ".join(f"`{label}` {row['zoom']:.1f}" for label, row in rows.items() if label != "fix"),
     }
 
 
@@ -463,6 +475,10 @@ def long_runs_fields() -> dict[str, str]:
 
 
 def camera_network_fields() -> dict[str, str]:
+    return synthetic_network_fields()
+
+
+def synthetic_network_fields() -> dict[str, str]:
     rows = load("network-synthetic")
     configs = {row["config"]: row for row in rows}
     body = [
@@ -513,6 +529,60 @@ def camera_network_fields() -> dict[str, str]:
                 ("four", "4ptz-joint", "4ptz-joint+wide"),
             )
         ),
+    }
+
+
+def pets_network_fields() -> dict[str, str]:
+    rows = load("network-pets")
+    body = [
+        [
+            f"`{row['config']}`",
+            str(row["seeds"]),
+            pct_pm(row["mota"], row["mota_sd"]) if row["seeds"] > 1 else pct(row["mota"]),
+            fixed(row["motp_m"], 3),
+            pct(row["idf1"]),
+            fixed(row["false_positives"], 1),
+            fixed(row["misses"], 1),
+            fixed(row["switches"], 1),
+            pct(row["mota_all_tracks"]),
+            pct(row["mota_tracking_area"]),
+            pct(row["idf1_tracking_area"]),
+            fixed(row["detections"], 0),
+            fixed(row["zoom"], 2),
+        ]
+        for row in rows
+    ]
+    configs = {row["config"]: row for row in rows}
+
+    def paired_lead(other: str, key: str) -> str:
+        network = configs["ptz+6fixed"][key]
+        if len(configs[other][key]) != len(network):
+            return points(mean(network) - mean(configs[other][key]))
+        return points(*paired(network, configs[other][key]))
+
+    return {
+        "pets_network_table": table(
+            [
+                "config",
+                "seeds",
+                "MOTA",
+                "MOTP [m]",
+                "IDF1",
+                "FP",
+                "Misses",
+                "IDsw",
+                "MOTA all",
+                "MOTA TA",
+                "IDF1 TA",
+                "# Dets",
+                "Zoom [x]",
+            ],
+            body,
+        ),
+        "pets_network_over_ptz": paired_lead("ptz", "mota_per_seed"),
+        "pets_network_over_fixed": paired_lead("6fixed", "mota_per_seed"),
+        "pets_network_over_ptz_area": paired_lead("ptz", "mota_tracking_area_per_seed"),
+        "pets_network_objects": str(rows[0]["objects"]),
     }
 
 
