@@ -475,7 +475,7 @@ def long_runs_fields() -> dict[str, str]:
 
 
 def camera_network_fields() -> dict[str, str]:
-    return synthetic_network_fields()
+    return synthetic_network_fields() | pets_network_fields()
 
 
 def synthetic_network_fields() -> dict[str, str]:
