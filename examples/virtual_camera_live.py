@@ -50,7 +50,11 @@ def main() -> None:
         )  # fmt: skip
     finally:
         camera.send_signal(signal.SIGINT)
-        camera.communicate(timeout=30)
+        try:
+            camera.communicate(timeout=30)
+        except subprocess.TimeoutExpired:
+            camera.kill()  # a camera that does not stop is not left running
+            raise
     for picture, (pose, tracks) in enumerate(zip(live.poses, live.tracks, strict=True)):
         pan_deg, tilt_deg, zoom = pose
         print(f"picture {picture:2d}: pan {pan_deg:6.1f} deg, tilt {tilt_deg:5.1f} deg, zoom {zoom:4.2f}, "

@@ -18,14 +18,19 @@ TIMEOUT_S = 120.0
 
 def run_example(name: str, folder, *arguments: str) -> str:
     """What ``python examples/NAME.py ARGUMENTS`` prints, run in ``folder``; it must exit 0."""
-    done = subprocess.run(
-        [sys.executable, str(EXAMPLES / name), *arguments],
-        cwd=folder,
-        env=environment(),
-        capture_output=True,
-        text=True,
-        timeout=TIMEOUT_S,
-    )
+    try:
+        done = subprocess.run(
+            [sys.executable, str(EXAMPLES / name), *arguments],
+            cwd=folder,
+            env=environment(),
+            capture_output=True,
+            text=True,
+            timeout=TIMEOUT_S,
+        )
+    except subprocess.TimeoutExpired as timeout:
+        streams = (timeout.stdout, timeout.stderr)
+        printed = [text.decode() if isinstance(text, bytes) else text or "" for text in streams]
+        pytest.fail(f"examples/{name} ran over {TIMEOUT_S:.0f} s:\n" + "".join(printed)[-4000:], pytrace=False)
     assert done.returncode == 0, done.stdout + done.stderr
     return done.stdout
 
