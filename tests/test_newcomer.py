@@ -21,10 +21,10 @@ def test_live_scored_by_serve_cameras_truth_log_scores_each_picture_at_its_own_s
     """`ptztrack serve-camera --truth-log LOG`, then `ptztrack live --truth LOG` for 60 pictures (PETS, HOG,
     smpl, the recording at its own pace): the run prints its MOTA and the recording's steps its pictures were
     scored against, which span the seconds the run took. Scored against the log as it stood before the run,
-    every picture met the one step logged last before it began, and the run printed about -50 %.
+    every picture met the one step logged last before it began, and the run printed a MOTA far below zero.
 
     The printed MOTA is not compared with the offline run of those steps: a 60-picture live run on cores
-    shared with other tests does not keep near it (docs: Real cameras)."""
+    shared with other tests does not keep near it (decision record 0094)."""
     log = tmp_path / "truth.csv"
     with serve_camera(["--truth-log", str(log)]) as (_, (url,)):
         argv = ["live", "--camera", url, "--calibration", "virtual", "--truth", str(log), "--steps", str(PICTURES)]
