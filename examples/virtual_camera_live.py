@@ -25,7 +25,11 @@ from ptztrack.camera.onvif_client import camera_address
 def serve_camera() -> tuple[subprocess.Popen, str]:
     """``ptztrack serve-camera`` on any free port of 127.0.0.1, and its onvif:// address once it plays."""
     command = [sys.executable, "-m", "ptztrack.cli", "serve-camera", "--port", "0"]
-    camera = subprocess.Popen(command, stdout=subprocess.PIPE, text=True)
+    # A script started in the background by a non-interactive shell inherits SIGINT ignored: the camera
+    # gets a terminal's disposition, so that the Ctrl-C (SIGINT) at the end stops it.
+    camera = subprocess.Popen(
+        command, stdout=subprocess.PIPE, text=True, preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL)
+    )
     address = ""
     for line in camera.stdout:
         address = address or next(iter(re.findall(r"onvif://127\.0\.0\.1:\d+", line)), "")
