@@ -17,9 +17,11 @@ import argparse
 import json
 import math
 import re
+import statistics
 import sys
 from collections.abc import Callable, Sequence
 from pathlib import Path
+from statistics import mean
 
 RESULTS = Path(__file__).resolve().parent / "results"
 TEMPLATES = RESULTS / "templates"
@@ -69,14 +71,9 @@ def table(header: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
     return "\n".join(lines)
 
 
-def mean(values: Sequence[float]) -> float:
-    return sum(values) / len(values)
-
-
 def standard_error(values: Sequence[float]) -> float:
     """The standard error of the mean of ``values`` (sample standard deviation over sqrt(n))."""
-    centre = mean(values)
-    return math.sqrt(sum((value - centre) ** 2 for value in values) / (len(values) - 1) / len(values))
+    return statistics.stdev(values) / math.sqrt(len(values))
 
 
 def paired(first: Sequence[float], second: Sequence[float]) -> tuple[float, float]:

@@ -13,6 +13,7 @@ from pathlib import Path
 
 import pytest
 
+from docs_blocks import read_blocks
 from ptztrack import registry
 from ptztrack.cli import main, parser
 from ptztrack.service import load_service_config
@@ -125,7 +126,8 @@ def test_an_address_without_its_scheme_never_shows_its_password(capfd):
 
 
 def code_blocks(page: Path, language: str) -> list[str]:
-    return re.findall(rf"```{language}\n(.*?)```", page.read_text(), re.DOTALL)
+    """The text of ``page``'s fenced blocks in ``language``, read as the docs' block runner reads them."""
+    return [block.code for block in read_blocks(str(page), page.read_text()) if block.language == language]
 
 
 def test_the_extending_pages_policy_runs_as_pasted(tmp_path):
