@@ -367,7 +367,8 @@ class Scenario(_Strict):
     frames : how many steps the run takes (one picture per camera each).
     frame_rate_hz : steps per second of the scenario's clock: a step lasts 1 / frame_rate_hz seconds,
     the time the people's walk and the tracker's motion model advance by.
-    people : the synthetic crowd (section ``people``; with a ``recording``, only its ``width_m`` applies).
+    people : the synthetic crowd (section ``people``); with a ``recording``, its ``width_m`` applies, and its
+    ``height_m`` where a rendered recording leaves a person's height unknown.
     camera : the PTZ camera, its lens and its pose error (section ``camera``).
     actions : the grid of poses the policies choose from every step (section ``actions``).
     detector : the detector and what the policies know of it (section ``detector``).
