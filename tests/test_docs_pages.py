@@ -93,6 +93,25 @@ def test_a_file_reference_has_every_field_of_its_model_and_its_sections(name, mo
             models.extend(load_reference_hook()._nested_models(info.annotation))
 
 
+@pytest.mark.parametrize("model", [Scenario, MultiViewDataset, CameraCalibrationFile, ServiceConfig])
+def test_every_field_of_a_file_reference_has_a_meaning(model):
+    """Every field of the model and of its sections has a ``name : text`` entry in a docstring the
+    reference reads, so no row of its table has an empty meaning."""
+    hook = load_reference_hook()
+    missing, seen, models = [], set(), [model]
+    while models:
+        current = models.pop()
+        if current in seen:
+            continue
+        seen.add(current)
+        meanings = hook._field_descriptions(current)
+        for field, info in current.model_fields.items():
+            if not meanings.get(field, "").strip():
+                missing.append(f"{current.__name__}.{field}")
+            models.extend(hook._nested_models(info.annotation))
+    assert not missing, "fields without a meaning: " + ", ".join(missing)
+
+
 def test_a_marker_of_a_page_is_replaced_by_its_generated_reference():
     hook = load_reference_hook()
     page = "# Scenario files\n\n<!-- generated: scenario -->\n"

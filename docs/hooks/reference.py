@@ -161,13 +161,14 @@ def _first_paragraph(model: type) -> str:
 
 
 def _field_descriptions(model: type[pydantic.BaseModel]) -> dict[str, str]:
-    """What a field means, from the ``name : text`` entries of the model's docstring and of the
-    docstrings of the parameter classes its defaults come from (``a, b : text`` describes both); a field
-    named with a parameter class's prefix takes that class's entry (``hog_upsample``, HogParameters's
-    ``upsample``)."""
+    """What a field means, from the ``name : text`` entries of the model's docstring, of the models it
+    inherits from and of the docstrings of the parameter classes its defaults come from (``a, b : text``
+    describes both); a field named with a parameter class's prefix takes that class's entry
+    (``hog_upsample``, HogParameters's ``upsample``)."""
     found: dict[str, str] = {}
     for each in _docstring_sources(model):
-        prefix = each.__name__.removesuffix("Parameters").lower() + "_" if each is not model else ""
+        parameters = not issubclass(each, pydantic.BaseModel)
+        prefix = each.__name__.removesuffix("Parameters").lower() + "_" if parameters else ""
         for name, meaning in _entries(each).items():
             for field in (name, prefix + name):
                 if field in model.model_fields:
@@ -190,14 +191,22 @@ def _entries(documented: type) -> dict[str, str]:
 
 
 def _docstring_sources(model: type[pydantic.BaseModel]) -> list[type]:
-    """The model itself first, then the parameter dataclasses of :mod:`ptztrack` its module imports."""
-    module = inspect.getmodule(model)
+    """The model itself first, then the models of :mod:`ptztrack` it inherits from, nearest first, then the
+    parameter dataclasses of :mod:`ptztrack` their modules import."""
+    # A subclass (the dataset's OccupancyTracker, of the scenario's Tracker) keeps its base's meanings,
+    # which its base's docstring and the parameter classes of its base's module give.
+    models = [each for each in model.__mro__ if _is_ptztrack_model(each)]
     others = [
         value
+        for module in dict.fromkeys(inspect.getmodule(each) for each in models)
         for name, value in vars(module).items()
         if inspect.isclass(value) and name.endswith("Parameters") and value.__module__.startswith("ptztrack")
     ]
-    return [model, *others]
+    return [*models, *dict.fromkeys(others)]
+
+
+def _is_ptztrack_model(value: type) -> bool:
+    return issubclass(value, pydantic.BaseModel) and value.__module__.startswith("ptztrack")
 
 
 def _nested_models(annotation: object) -> Iterator[type[pydantic.BaseModel]]:

@@ -23,13 +23,14 @@ from ptztrack.config.fields import (
 
 
 class PoseError(_Strict):
-    """How far a real PTZ camera lands from the pose it was sent to (backlash, zoom curves).
+    """How far a real PTZ camera lands from the pose it was sent to (backlash, zoom curves): each time the
+    command changes, the camera lands at a pose drawn as below and stays there while the command does not
+    change. The defaults are :class:`~ptztrack.camera.parameters.LandingErrorParameters`'s: a perfect camera.
 
-    Each time the command changes, the camera lands at the commanded pan and tilt plus
-    ``pan_tilt_bias_deg`` plus independent Gaussian errors of ``pan_tilt_sigma_deg``, and at the
-    commanded zoom times ``zoom_bias`` times (1 + a Gaussian error of ``zoom_sigma``); it stays there
-    while the command does not change. The defaults are
-    :class:`~ptztrack.camera.parameters.LandingErrorParameters`'s: a perfect camera.
+    pan_tilt_bias_deg : (pan, tilt) degrees added to the commanded pan and tilt; pan_tilt_sigma_deg : the
+    standard deviation in degrees of the independent Gaussian errors added to them as well.
+    zoom_bias : the factor on the commanded zoom; zoom_sigma : the standard deviation of the relative
+    Gaussian error e of the zoom: the camera lands at zoom ``commanded x zoom_bias x (1 + e)``.
     """
 
     pan_tilt_sigma_deg: Annotated[NonNegativeFloat, at_most(90, "degrees")] = LandingErrorParameters.pan_tilt_sigma_deg
@@ -77,10 +78,19 @@ class LiveView(_Strict):
 
 
 class Camera(_Strict):
-    """The PTZ camera. backend : a registered camera backend; by default 'simulated' for the
+    """The PTZ camera.
+
+    position_m : its optical centre (x, y, z) in metres on the ground's axes, z its height above the
+    ground. image_size_px : (width, height) of its pictures in pixels (for a recording, of the virtual
+    camera's view). f_min_px : its focal length in pixels at zoom 1, the widest view (at zoom z:
+    ``z x f_min_px``). With a recording, the position and the focal length come from its calibration.
+    pose_error : how far it lands from the pose it is sent to (section ``camera.pose_error``).
+    backend : a registered camera backend; by default 'simulated' for the
     synthetic scene and 'virtual' (the virtual PTZ camera) for a recording. live_view : how a
     recording's views depart from the pinhole model (None: exact pinhole views); the detector, the
-    templates and registration all see the same views."""
+    templates and registration all see the same views. options : the parameters of another package's
+    camera backend, passed to its factory unread (ptztrack's own backends take none).
+    """
 
     position_m: tuple[_Coordinate, _Coordinate, Annotated[PositiveFloat, at_most(10_000, "metres")]] = (7.5, -6.0, 2.5)
     image_size_px: tuple[Pixels, Pixels] = (640, 480)
@@ -103,8 +113,10 @@ class PoseFeedback(_Strict):
     registered falls back to the commanded pose.
     image_size_px : the resolution of the image registered (the detector may see a smaller one).
     reference_zooms, reference_pan_steps, reference_tilt_steps : the reference views, a grid over the
-    action grid's pan and tilt range at each zoom; reference_pose_sigma_deg and
-    reference_zoom_spread : how roughly their poses are known before bundle adjustment.
+    action grid's pan and tilt range at each zoom. reference_pose_sigma_deg : how roughly the reference
+    views' poses are known before bundle adjustment: the standard deviation in degrees of the Gaussian
+    error on each one's pan and tilt (all but the first, the anchor). reference_zoom_spread : the same for
+    their zoom: each one's zoom is off by a factor uniform in [1 - spread, 1 + spread].
     index : a file caching the reference index: read when it exists, written when it does not.
     """
 
@@ -119,6 +131,12 @@ class PoseFeedback(_Strict):
 
 
 class AxisRange(_Strict):
+    """The values of one axis of the action grid: ``count`` evenly spaced angles from ``start`` to
+    ``stop``, both included.
+
+    start, stop : the first and the last value, degrees; count : how many values (1: ``start`` alone).
+    """
+
     start: Degrees
     stop: Degrees
     count: Annotated[int, Field(ge=1), at_most(1000, "time: the policies score every action")]
@@ -131,6 +149,17 @@ _GridSteps = Annotated[int, Field(ge=0), at_most(1000, "steps of the action grid
 
 
 class Actions(_Strict):
+    """The action grid (:class:`~ptztrack.camera.actions.ActionGrid`): every combination of a pan, a tilt
+    and a zoom is a pose the policies can choose, within ``max_steps`` of the current one.
+
+    pan_deg : the pan values in degrees (section ``actions.pan_deg``); 0 looks along the ground's +y axis and
+    a positive pan turns towards +x. For a recording, pan and tilt are offsets from the pose that shows the
+    whole recorded frame; for a network's camera, pan is an offset from the bearing of the area's centre.
+    tilt_deg : the tilt values in degrees below the horizon (positive looks down), increasing, within
+    (-90, 90). zoom : the zoom values (focal length over the widest one), increasing.
+    max_steps : (pan, tilt, zoom) how many grid values each axis may move in one step.
+    """
+
     pan_deg: AxisRange = AxisRange(start=-45.0, stop=45.0, count=7)
     tilt_deg: AxisRange = AxisRange(start=0.0, stop=24.0, count=10)
     zoom: Annotated[tuple[_Zoom, ...], at_most_items(100, "time: the policies score every action")] = (

@@ -28,8 +28,13 @@ _MoveTime = tuple[
 
 
 class MoveTimesSection(_Strict):
-    """``intercept_s + slope x distance`` per axis (Frigate's model), as [intercept_s, slope]: pan and tilt
-    per degree, zoom per unit of zoom factor; ``ptztrack camera calibrate`` measures them."""
+    """How long the camera's moves take, ``intercept_s + slope x distance`` per axis (Frigate's model); a
+    move takes its slowest axis's time, an axis that does not move none. ``ptztrack camera calibrate``
+    measures them.
+
+    pan, tilt : [intercept_s, slope] of the pan and of the tilt, seconds and seconds per degree.
+    zoom : [intercept_s, slope] of the zoom, seconds and seconds per unit of zoom factor.
+    """
 
     pan: _MoveTime = (0.0, 0.0)
     tilt: _MoveTime = (0.0, 0.0)
@@ -38,10 +43,14 @@ class MoveTimesSection(_Strict):
 
 class GroundViewSection(_Strict):
     """Where the camera saw the ground points (``camera calibrate --geometry``): a preset of the camera at
-    its widest zoom, and the world pose there (pan_deg, tilt_deg in the model's sense: the bearing from the
-    ground's +y axis towards +x, and the depression), found from the points; ``roll_deg`` is how far the
-    mount leans about the optical axis (the model takes a level mount), ``reprojection_error_px`` the points'
-    root-mean-square error through the fitted camera."""
+    its widest zoom, and the world pose there, found from the points.
+
+    preset : the token of the camera's ONVIF preset the points were seen from, at its widest zoom.
+    pan_deg, tilt_deg : the world pose there, degrees in the model's sense: the bearing from the ground's
+    +y axis towards +x, and the depression below the horizon. roll_deg : how far the mount leans about the
+    optical axis, degrees (the model takes a level mount). reprojection_error_px : the points'
+    root-mean-square error in pixels through the fitted camera.
+    """
 
     preset: Annotated[str, Field(min_length=1, max_length=64)]
     pan_deg: Degrees

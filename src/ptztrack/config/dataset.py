@@ -18,14 +18,20 @@ from ptztrack.occupancy.parameters import OccupancyParameters
 class DatasetView(_Strict):
     """One fixed camera of a multi-view dataset.
 
+    name : the view's name, different for every view: how a scenario's ``recording.dataset_view`` and
+    the command line's ``--dataset-view`` pick it, and its key in a pinhole JSON unless
+    ``calibration_view`` says otherwise.
     calibration : a Tsai XML (PETS 2009) or a pinhole JSON (``{view: {K, dist, R, t}}``, world in mm);
     calibration_view : the view's key in a pinhole JSON (default: ``name``).
     image_size_px : (width, height); read from a Tsai XML, checked against it when given; needed with
-    a pinhole JSON. video (a file) or images (a folder, frames in sorted name order) : the frames,
-    for motion edges; detections : a MOTChallenge detection file (``frame,-1,left,top,width,height,score,...``,
-    frames from 1), for views without frames, the clustering baseline and the PTZ camera's ``detections``
-    detector. ground_truth : the view's own annotations (MOTChallenge rows, boxes in its pixels, world x, y
-    in metres), where the dataset's boxes are another view's. weight : ``w_c``.
+    a pinhole JSON. video, images : the view's frames, a video file or a folder of images in the sorted
+    order of their names (one or the other, not both): the occupancy map's motion edges read either, the
+    virtual PTZ camera's pictures need a video; detections : a MOTChallenge detection file
+    (``frame,-1,left,top,width,height,score,...``, frames from 1), for views without frames, the
+    clustering baseline and the PTZ camera's ``detections`` detector. ground_truth : the view's own
+    annotations (MOTChallenge rows, boxes in its pixels, world x, y in metres), where the dataset's boxes
+    are another view's. weight : ``w_c``, the view's relative weight in the occupancy map (each view's
+    loci are scaled to total its weight, the weights normalised to sum to 1).
     """
 
     name: str
@@ -124,6 +130,11 @@ class MultiViewDataset(_Strict):
     a rectangle (the camera network's table scores there too, its TA columns);
     frames : how many frames to use (default: all that every view and the ground truth have);
     ground_truth : MOTChallenge rows with world x, y in metres in columns 8-9 (frames from 1).
+    name : the dataset's name in titles and messages. frame_rate_hz : frames per second of the recording
+    (its views' frames and the ground truth's frame numbers). views : the fixed cameras (section
+    ``views``; their names differ). occupancy : the occupancy-map detector and its clustering baseline
+    (section ``occupancy``). tracker : the ground tracker fed by the occupancy map's modes (section
+    ``tracker``; Hungarian association only).
     """
 
     name: str = "dataset"

@@ -96,14 +96,22 @@ class People(_Strict):
 
 
 class Detector(_Strict):
-    """The detector: simulated (ideal, realistic), OpenCV's HOG on a recording's virtual view, or any
-    detector registered by another package (``options`` are its parameters).
+    """The detector: simulated (ideal, realistic), OpenCV's HOG on a recording's virtual view, a recording's
+    precomputed boxes, or any detector registered by another package.
 
-    The policies plan with recall 1 for 'ideal'; for every other kind they start from the recall
-    curve ``recall_kd``, ``recall_r0_px`` (the paper's equation 13), its r0 shifted by
-    ``prior_shift_px``, and with ``model`` 'online' (the default) learn the curve as the camera runs
-    (:mod:`ptztrack.detect.detector_model`); 'a-priori' keeps the prior, 'true' plans with the
-    simulation's own curve, and a file path starts from what an earlier run learned.
+    kind : a registered detector: 'ideal' (simulated, recall 1; on a recording, every annotated person
+    wholly in view and hidden at most ``recording.occluded_above``), 'realistic' (simulated, the recall
+    curve ``recall_kd``, ``recall_r0_px``, with ``pixel_noise_px`` and ``false_positives_per_frame``), 'hog'
+    (OpenCV's HOG on the recording's views), 'detections' (the recording's precomputed boxes) or another
+    package's. options : the parameters of another package's detector, passed to its factory unread
+    (ptztrack's own detectors take none).
+    model : what the policies and the tracker know of the detector (:mod:`ptztrack.detect.detector_model`):
+    'online' (the default) starts from the recall curve ``recall_kd``, ``recall_r0_px`` (the paper's
+    equation 13), its r0 shifted by ``prior_shift_px``, and learns the curve as the camera runs; 'a-priori'
+    keeps that prior, 'true' plans with the simulation's own curve (a simulated detector only), and a file
+    path (an earlier run's ``detector_model.json``) starts from what that run learned. For 'ideal' the
+    model is recall 1, kept. prior_shift_px : pixels added to the prior curve's r0 (the person height in
+    pixels below which the recall is 0) with 'online' and 'a-priori'; positive: a more pessimistic prior.
 
     The recall curve's, the noise's and the HOG fields' defaults are those of
     :class:`~ptztrack.detect.parameters.DetectorPriorParameters` and :class:`~ptztrack.detect.parameters.HogParameters`.
@@ -111,6 +119,7 @@ class Detector(_Strict):
     hog_search : 'ground' scans only the windows where a standing person ``hog_person_height_m``
     (shortest, tallest) tall could be seen on the walkable area, at their sizes; 'image' scans every
     window of the pyramid, as OpenCV's ``detectMultiScale`` (:mod:`ptztrack.detect.hog`).
+    hog_person_height_m : (shortest, tallest) metres, the standing people the 'ground' search looks for.
     box_min_score : 'detections' (the recording's precomputed boxes, ``recording.detections``) reports the
     boxes scored at least this.
     hog_luma : HOG reads only the pictures' luma (true) or the strongest gradient of their three colours
@@ -183,7 +192,11 @@ class Tracker(_Strict):
     each detected track's colour spatiogram; in between, each track is measured by searching for
     its spatiogram around its prediction, at the scale the head/feet homology gives;
     :mod:`ptztrack.track.templates`). Needs a recording with a video.
-    kind : a registered tracker (another package's, with ``options`` its parameters).
+    kind : a registered tracker: 'ekf', or the follow camera's 'particle', 'csrt' and 'mil' (:class:`Follow`),
+    or another package's. options : the parameters of another package's tracker, passed to its factory
+    unread (ptztrack's own trackers take none).
+    detector_every_steps : with ``measurement_source`` 'spatiogram', the detector runs at the steps that are
+    multiples of this (0, n, 2n, ...) and the spatiograms measure the tracks in between; unused with 'detector'.
     existence_at_birth, existence_when_detected, existence_to_delete : the track lifecycle, by the
     probability that a track's person exists (:mod:`ptztrack.track.tracker`); existence_update 'bayes'
     weighs each detection against the clutter (the learned rate where the detector model learns,
@@ -269,6 +282,15 @@ class Recording(_Strict):
     calibration (``camera.image_size_px`` sets the virtual view), and the
     action grid's pan and tilt are offsets from the pose that shows the whole
     recorded frame. Relative paths in a scenario file are relative to it.
+    ground_truth : the recorded view's annotations, a MOTChallenge file with world x, y in metres in columns
+    8-9 (frames from 1): the people of the run, whom it is scored against.
+    calibration : the recorded view's calibration, a Tsai XML (PETS 2009) or a pinhole JSON (``view``
+    picks its view).
+    video : the recorded video, which the virtual camera's pictures are cut from (None: no pictures; the
+    'hog' detector, 'registered' pose feedback and 'spatiogram' measurements need it).
+    occluded_above : the fraction of a person's box (0 to 1) hidden by nearer people above which the
+    person counts as occluded: the 'ideal' detector of a recording does not report them and the recall
+    fit leaves them out.
     view : the view's key in a pinhole JSON calibration (None: its only view).
     recorded_size_px : the recorded frames' (width, height) (None: read from a Tsai calibration or the video).
     frame_step : the recorded frames between two steps (the scenario's ``frame_rate_hz`` is the step rate).
@@ -338,7 +360,27 @@ _Side = Annotated[PositiveFloat, at_most(1000, "metres: the ground a PTZ camera 
 
 
 class Scenario(_Strict):
-    """Everything a run needs besides the policy and the seed."""
+    """Everything a run needs besides the policy and the seed.
+
+    area_m : (width, depth) metres of the synthetic scene's walkable rectangle [0, width] x [0, depth]
+    on the ground's x and y axes (a recording's area is its own, ``recording.area_m``).
+    frames : how many steps the run takes (one picture per camera each).
+    frame_rate_hz : steps per second of the scenario's clock: a step lasts 1 / frame_rate_hz seconds,
+    the time the people's walk and the tracker's motion model advance by.
+    people : the synthetic crowd (section ``people``); with a ``recording``, its ``width_m`` applies, and its
+    ``height_m`` where a rendered recording leaves a person's height unknown.
+    camera : the PTZ camera, its lens and its pose error (section ``camera``).
+    actions : the grid of poses the policies choose from every step (section ``actions``).
+    detector : the detector and what the policies know of it (section ``detector``).
+    tracker : the tracker and its data association (section ``tracker``).
+    control : the information-gain policies' parameters (section ``control``).
+    pose_feedback : which pose the tracker maps detections with (section ``pose_feedback``).
+    follow : the follow camera's person, motion limits and particle filter (section ``follow``).
+    recording : the recorded view the virtual PTZ camera looks at (section ``recording``; None: the
+    synthetic scene).
+    cameras : a network of cameras over the synthetic scene, each mounted, detecting and deciding every
+    step, all updating one belief (section ``cameras``); empty: the one camera of ``camera``.
+    """
 
     area_m: tuple[_Side, _Side] = (15.0, 15.0)
     frames: Annotated[

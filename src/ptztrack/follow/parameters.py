@@ -15,8 +15,9 @@ class FollowParameters:
     target_id : the annotated person followed; the tracker starts from their first annotated box.
     target_point_px : (x*, y*) where the middle of the person should be; None: the image centre.
     target_height_px : the person's height wanted in the image.
-    max_speed_deg_s, max_acceleration_deg_s2 : of pan and of tilt; max_zoom_speed (per s),
-    max_zoom_acceleration (per s^2) : of the natural logarithm of the zoom; zoom_range : [lowest, highest].
+    max_speed_deg_s, max_acceleration_deg_s2 : the camera's largest speed and acceleration of pan and of
+    tilt; max_zoom_speed, max_zoom_acceleration : its largest speed (per second) and acceleration (per
+    second squared) of the natural logarithm of the zoom; zoom_range : [lowest, highest].
     smoothing_cutoff_hz : the tracker's output low-pass filter.
     particles, search_particles : tracking, and searching after a loss.
     patches : [left, top, width, height] in units of the person's box (default: the head, and the torso
@@ -43,6 +44,9 @@ class FollowParameters:
     when the person's velocity is not known (the first step, the diffuse prior after a loss).
     loss_fraction, adapt_fraction : the loss test (P < loss_fraction P_ref) and when P_ref adapts.
     reference_time_constant_s : how slowly P_ref adapts.
+    height_log_sigma : the spread of the height prior where the view is calibrated: a box h px tall weighs
+    ``exp(-z^2 / 2)``, ``z = ln(h / h_standing) / height_log_sigma``, h_standing the height in pixels of a
+    person standing on its bottom centre; None: no prior, the paper's.
     search_heights : spread of the diffuse prior after a loss, in box heights; search_scale : of its height.
     motion_threshold : grey levels; motion_memory_s : how long the motion history lasts;
     motion_scale : the motion image's resolution relative to the view's.

@@ -43,18 +43,38 @@ class ConeShapeParameters:
 class OccupancyParameters:
     """The occupancy-map detector (LPOM) and the clustering baseline (:mod:`ptztrack.occupancy.detectors`).
 
-    Person model (equation 4, Algorithm 1): heights from min_height_m up to max_height_m in steps of
-    height_step_m (at the steps' midpoints), width_m, samples_per_height tangent points per height.
-    Map: cell_m, kernel_sigma_m (the Gaussian kernel), block_px (locus tables per block of pixels).
-    Modes: separation_m (closest two people), window_m (their mean and covariance); the strength a
-    mode needs (a fraction of the frame's strongest) is fitted on the other half of the frames;
-    candidate_strength: modes weaker than this fraction of the strongest are not even candidates, well
-    below any threshold the fit may choose (its smallest is 0.05).
-    Motion edges (:class:`MotionEdgeParameters`): canny_low, canny_high, difference_threshold (grey
-    levels), dilation_px.
-    Boxes: outline_points_per_box, min_box_score. Baseline: linkage_m (complete-linkage cut),
-    blob_min_area_px (blob boxes of views without detections); the views a cluster needs are fitted
-    like the modes' strength.
+    The person model (equation 4, Algorithm 1). min_height_m, max_height_m, height_step_m : the heights of
+    the people the loci are drawn for, metres: from min_height_m up to max_height_m in steps of
+    height_step_m, each taken at its step's midpoint. width_m : the person model's widest diameter,
+    metres. samples_per_height : how many heights of the tangent point (where a ray touches the model)
+    are sampled per person height h: the midpoints of that many equal slices of [0, h].
+
+    The map. cell_m : the side of the ground grid's square cells, metres. kernel_sigma_m : the standard
+    deviation of the Gaussian kernel the map is smoothed by, metres. block_px : the side in pixels of the
+    square blocks of a view the locus tables are kept for (one table per block, not per pixel).
+
+    Its modes (the people found). separation_m : the closest two people stand, metres: a mode is the
+    largest cell within this distance. window_m : the radius in metres of the disc a mode's position
+    and covariance are the map's mean and covariance over. candidate_strength : modes weaker than this
+    fraction of the frame's strongest are not even candidates, well below any strength the fit may ask
+    for (the strength a mode needs, a fraction of the frame's strongest, is fitted on the other half of
+    the frames).
+
+    The motion edges (:class:`MotionEdgeParameters`). canny_low, canny_high : Canny's hysteresis
+    thresholds on the gradient's magnitude (an edge starts above canny_high and goes on above canny_low).
+    difference_threshold : the grey levels a pixel must change by between frames to count as motion.
+    dilation_px : the half-size in pixels of the square neighbourhood of a changed pixel within which an
+    edge still counts as moving.
+
+    The boxes of a view's detector. outline_points_per_box : in a view without frames, the points evenly
+    spaced along each box's outline whose loci stand in for the motion edges (the same number for every
+    box, so that a near person's large box weighs no more than a far one's small box). min_box_score :
+    boxes scored lower are ignored (by the baseline too).
+
+    The clustering baseline (the views a cluster needs are fitted like the modes' strength). linkage_m :
+    the complete-linkage clustering's cut, metres: the farthest apart two views' feet of one person may
+    lie. blob_min_area_px : the smallest moving region in pixels that makes a blob box, in views without
+    a detector's boxes.
     """
 
     min_height_m: float = 1.6

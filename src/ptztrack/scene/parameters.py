@@ -21,10 +21,12 @@ class CrowdParameters:
 
     count : people; speed_m_s, height_m : [low, high] of the uniform draws per person;
     width_m : everybody's width; turn_rate_sigma_deg_s : stationary spread of the turn rate;
-    enter_leave : people enter through the border and leave after ``stay_s`` [low, high] seconds;
-    else they are there from the first frame to the last.
+    enter_leave : people enter through the border and leave after a stay drawn from ``stay_s``;
+    else they are there from the first frame to the last. stay_s : [low, high] seconds of the uniform
+    draw of how long each person stays before walking out, with ``enter_leave``.
     paired_fraction : the share of the people who walk in pairs (:attr:`pairs`), the second of a pair
-    ``pair_spacing_m`` to the left of the first, who leads.
+    ``pair_spacing_m`` to the left of the first, who leads. pair_spacing_m : metres between the two people
+    of a pair, side by side.
     """
 
     count: int = 7

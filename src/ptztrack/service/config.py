@@ -47,8 +47,11 @@ class ServiceCamera(_Strict):
 
 
 class MQTTSection(_Strict):
-    """The MQTT broker the events are published to (QoS 1): host, port, ``topic_prefix`` (topics are
-    ``<prefix>/<camera>/events`` and ``<prefix>/<camera>/status``)."""
+    """The MQTT broker the events are published to (QoS 1).
+
+    host : the broker's host name or address; port : its TCP port; topic_prefix : the first levels of
+    every topic: topics are ``<prefix>/<camera>/events`` and ``<prefix>/<camera>/status``.
+    """
 
     host: Annotated[str, Field(min_length=1, max_length=253)] = "127.0.0.1"
     port: Annotated[int, Field(ge=1, le=65535)] = 1883
@@ -56,8 +59,10 @@ class MQTTSection(_Strict):
 
 
 class ServiceConfig(_Strict):
-    """The service: its ``cameras`` (each its own loop, tracker and detector model), and service-wide:
+    """The service: its cameras, and where their tracks and events go.
 
+    cameras : the cameras the service runs, each with its own loop, tracker and detector model (section
+    ``cameras``; their names differ).
     output : the folder of every camera's tracks (``<output>/<camera>/``) and learned detector model;
     events : 'stdout' or a file the events are appended to as JSON lines; mqtt : the broker (null: none);
     position_rate_hz : how often a track's ground position is published (an 'update' event), per track;
