@@ -180,7 +180,13 @@ def fields(load: Load) -> dict[str, str]:
     ideal_a_priori = by_label(load("pets-ideal-a-priori"))
     fields["pets_ideal_gap_b9"] = span(gaps_over(ideal_a_priori, "fix", ("intg b9", "smpl b9")))
     fields["pets_ideal_gap_b1"] = span(gaps_over(ideal_a_priori, "fix", ("intg b1", "smpl b1")), signed=True)
-    return fields | detections_fields(load) | prior_shift_fields(load) | pets_crowd_fields(load)
+    return (
+        fields
+        | detections_fields(load)
+        | prior_shift_fields(load)
+        | pets_crowd_fields(load)
+        | any_recording_fields(load)
+    )
 
 
 def detections_fields(load: Load) -> dict[str, str]:
@@ -217,6 +223,26 @@ def pets_crowd_fields(load: Load) -> dict[str, str]:
         "pets_crowd_mota": ", ".join(f"`{label}` {pct_pm(row['mota'], row['mota_se'])}" for label, row in rows.items()),
         "pets_crowd_smpl_minus_intg": points(difference, error),
         "pets_crowd_zoom": ", ".join(f"`{label}` {row['zoom']:.1f}" for label, row in rows.items() if label != "fix"),
+    }
+
+
+def any_recording_fields(load: Load) -> dict[str, str]:
+    """The PETS table's strategies on a recording of a geometry drawn at random."""
+    document = load("any-recording")
+    recording = document["recording"]
+    return {
+        "any_recording_seed": str(recording["seed"]),
+        "any_recording_size": " x ".join(str(size) for size in recording["image_size_px"]),
+        "any_recording_fps": f"{recording['frame_rate_hz']:g}",
+        "any_recording_area": " x ".join(f"{side:g}" for side in recording["area_m"]),
+        "any_recording_camera": ", ".join(f"{coordinate:g}" for coordinate in recording["camera_position_m"]),
+        "any_recording_f": f"{recording['f_px']:g}",
+        "any_recording_people": str(recording["people"]),
+        "any_recording_frames": str(recording["frames"]),
+        "any_recording_steps": str(recording["steps"]),
+        "any_recording_step_rate": f"{recording['step_rate_hz']:g}",
+        "any_recording_detector": recording["detector"],
+        "any_recording_table": ptz_table(document["rows"], "mota_sd", detection_digits=0),
     }
 
 
