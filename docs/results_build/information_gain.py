@@ -186,6 +186,7 @@ def fields(load: Load) -> dict[str, str]:
         | prior_shift_fields(load)
         | pets_crowd_fields(load)
         | any_recording_fields(load)
+        | detector_model_fields(load)
     )
 
 
@@ -243,6 +244,32 @@ def any_recording_fields(load: Load) -> dict[str, str]:
         "any_recording_step_rate": f"{recording['step_rate_hz']:g}",
         "any_recording_detector": recording["detector"],
         "any_recording_table": ptz_table(document["rows"], "mota_sd", detection_digits=0),
+    }
+
+
+def detector_model_fields(load: Load) -> dict[str, str]:
+    """The recall the online model learned in a PETS HOG run, bin by bin, beside the annotated one."""
+    document = load("detector-model")
+    compared = [row for row in document["bins"] if row["annotated_people"] >= document["min_people"]]
+    body = [
+        [
+            fixed(row["height_px"], 1),
+            str(row["annotated_people"]),
+            fixed(row["recall_annotated"], 2),
+            f"{row['recall_learned']:.2f} +- {row['recall_learned_sd']:.2f}",
+            fixed(row["trials"], 1),
+        ]
+        for row in compared
+    ]
+    curve = document["curve"]
+    return {
+        "detector_model_min_people": str(document["min_people"]),
+        "detector_model_table": table(
+            ["height [px]", "annotated people", "annotated recall", "learned recall", "trials"], body
+        ),
+        "detector_model_worst": fixed(document["max_abs_error"], 3),
+        "detector_model_curve": f"Kd {curve['kd_per_px']:.3g} per px, r0 {curve['r0_px']:.3g} px, "
+        f"plateau {curve['plateau']:.2f}",
     }
 
 
