@@ -187,6 +187,7 @@ def fields(load: Load) -> dict[str, str]:
         | pets_crowd_fields(load)
         | any_recording_fields(load)
         | detector_model_fields(load)
+        | patrol_gap_fields(load)
     )
 
 
@@ -270,6 +271,29 @@ def detector_model_fields(load: Load) -> dict[str, str]:
         "detector_model_worst": fixed(document["max_abs_error"], 3),
         "detector_model_curve": f"Kd {curve['kd_per_px']:.3g} per px, r0 {curve['r0_px']:.3g} px, "
         f"plateau {curve['plateau']:.2f}",
+    }
+
+
+def patrol_gap_fields(load: Load) -> dict[str, str]:
+    """The synthetic strategies' MOTA counting every person and only the people in view, in four scenes."""
+    rows = load("patrol-gap")
+    scenes = list(dict.fromkeys(row["scene"] for row in rows))
+    strategies = list(dict.fromkeys(row["strategy"] for row in rows))
+    cell = {(row["scene"], row["strategy"]): row for row in rows}
+    body = [
+        [scene]
+        + [
+            f"{100 * cell[scene, strategy]['mota']:.1f} / {100 * cell[scene, strategy]['mota_in_view']:.1f}"
+            for strategy in strategies
+        ]
+        for scene in scenes
+    ]
+    patrol = [cell[scene, "patrol"] for scene in scenes]
+    default = cell["default", "patrol"]
+    return {
+        "patrol_gap_table": table(["scene"] + [f"`{strategy}`" for strategy in strategies], body),
+        "patrol_gap_in_view_lift": points(default["mota_in_view"] - default["mota"]),
+        "patrol_gap_best_in_view": pct(max(row["mota_in_view"] for row in patrol)),
     }
 
 
