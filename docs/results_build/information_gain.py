@@ -188,6 +188,7 @@ def fields(load: Load) -> dict[str, str]:
         | any_recording_fields(load)
         | detector_model_fields(load)
         | patrol_gap_fields(load)
+        | rendered_people_fields(load)
     )
 
 
@@ -294,6 +295,43 @@ def patrol_gap_fields(load: Load) -> dict[str, str]:
         "patrol_gap_table": table(["scene"] + [f"`{strategy}`" for strategy in strategies], body),
         "patrol_gap_in_view_lift": points(default["mota_in_view"] - default["mota"]),
         "patrol_gap_best_in_view": pct(max(row["mota_in_view"] for row in patrol)),
+    }
+
+
+def rendered_people_fields(load: Load) -> dict[str, str]:
+    """HOG's recall per apparent height on rendered people (cone bodies, PETS cut-outs) and on PETS."""
+    cones, cutouts = load("rendered-people-cones"), load("rendered-people-pets-cutouts")
+    cutout_recall = {row["height_px"]: row["rendered_recall"] for row in cutouts["bins"]}
+
+    def recall(value: float | None) -> str:
+        return "-" if value is None else fixed(value, 2)
+
+    shown = [row for row in cones["bins"] if row["rendered_people"] and row["pets_people"]]
+    body = [
+        [
+            fixed(row["height_px"], 1),
+            f"{recall(row['rendered_recall'])} ({row['rendered_people']})",
+            recall(cutout_recall[row["height_px"]]),
+            f"{recall(row['pets_recall'])} ({row['pets_people']})",
+        ]
+        for row in shown
+    ]
+    compared = [row for row in cones["bins"] if row["difference"] is not None]
+    close = [row for row in compared if row["height_px"] not in cones["bins_apart_px"]]
+    below = [row["rendered_recall"] - cutout_recall[row["height_px"]] for row in compared]
+    return {
+        "rendered_people_min_people": str(cones["min_people"]),
+        "rendered_people_table": table(
+            ["height [px]", "cones (people)", "PETS cut-outs", "PETS 2009 View_001 (people)"], body
+        ),
+        "rendered_people_cones_close": fixed(max(abs(row["difference"]) for row in close), 2),
+        "rendered_people_cones_close_from": fixed(min(row["height_px"] for row in close), 1),
+        "rendered_people_cones_close_to": fixed(max(row["height_px"] for row in close), 1),
+        "rendered_people_cones_apart": ", ".join(f"{height:.1f} px" for height in cones["bins_apart_px"]),
+        "rendered_people_cones_apart_by": ", ".join(
+            fixed(abs(row["difference"]), 2) for row in compared if row["height_px"] in cones["bins_apart_px"]
+        ),
+        "rendered_people_cutouts_below": f"{min(below):.2f}-{max(below):.2f}",
     }
 
 
