@@ -9,7 +9,7 @@ from .formatting import fixed, paired, pct, pct_pm, points, span, table
 
 
 def fields(load: Load) -> dict[str, str]:
-    return synthetic_network_fields(load) | pets_network_fields(load)
+    return synthetic_network_fields(load) | pets_network_fields(load) | twin_fields(load)
 
 
 def synthetic_network_fields(load: Load) -> dict[str, str]:
@@ -117,6 +117,37 @@ def pets_network_fields(load: Load) -> dict[str, str]:
         "pets_network_over_fixed": paired_lead("6fixed", "mota_per_seed"),
         "pets_network_over_ptz_area": paired_lead("ptz", "mota_tracking_area_per_seed"),
         "pets_network_objects": str(rows[0]["objects"]),
+    }
+
+
+def twin_fields(load: Load) -> dict[str, str]:
+    """The PETS network's synthetic twin: MOTA per configuration and calibration error."""
+    document = load("pets-network-twin")
+    rows = document["rows"]
+    sigmas = list(dict.fromkeys(row["sigma_deg"] for row in rows))
+    configs = list(dict.fromkeys(row["config"] for row in rows))
+    cell = {(row["sigma_deg"], row["config"]): row for row in rows}
+    body = [
+        [f"{sigma:g} deg"]
+        + [pct(cell[sigma, config]["mota"]) for config in configs]
+        + [
+            fixed(cell[sigma, "ptz+6fixed"]["false_positives"], 1),
+            fixed(cell[sigma, "6fixed"]["false_positives"], 1),
+            points(*paired(cell[sigma, "ptz+6fixed"]["mota_per_seed"], cell[sigma, "6fixed"]["mota_per_seed"])),
+            points(*paired(cell[sigma, "ptz+6fixed"]["mota_per_seed"], cell[sigma, "ptz"]["mota_per_seed"])),
+        ]
+        for sigma in sigmas
+    ]
+    seeds = document["seeds"]
+    return {
+        "twin_seeds": str(len(seeds)),
+        "twin_first_seed": str(seeds[0]),
+        "twin_table": table(
+            ["sigma"]
+            + [f"`{config}`" for config in configs]
+            + ["FP `ptz+6fixed`", "FP `6fixed`", "`ptz+6fixed` - `6fixed`", "`ptz+6fixed` - `ptz`"],
+            body,
+        ),
     }
 
 
