@@ -9,7 +9,7 @@ from .formatting import fixed, paired, pct, pct_pm, points, span, table
 
 
 def fields(load: Load) -> dict[str, str]:
-    return synthetic_network_fields(load) | pets_network_fields(load) | twin_fields(load)
+    return synthetic_network_fields(load) | pets_network_fields(load) | twin_fields(load) | scale_fields(load)
 
 
 def synthetic_network_fields(load: Load) -> dict[str, str]:
@@ -146,6 +146,49 @@ def twin_fields(load: Load) -> dict[str, str]:
             ["sigma"]
             + [f"`{config}`" for config in configs]
             + ["FP `ptz+6fixed`", "FP `6fixed`", "`ptz+6fixed` - `6fixed`", "`ptz+6fixed` - `ptz`"],
+            body,
+        ),
+    }
+
+
+def scale_fields(load: Load) -> dict[str, str]:
+    """The network's closed loop timed at 1 to 64 cameras and two crowds: this machine's figures."""
+    document = load("network-scale")
+    body = [
+        [
+            str(row["cameras"]),
+            str(row["people"]),
+            f"{row['tracks']:.0f}",
+            f"{row['decisions_per_s']:.1f}",
+            f"{row['decisions_per_s_before']:.1f}",
+            f"{row['decisions_per_s_replayed']:.1f}",
+            fixed(row["belief_update_ms"], 1),
+            f"{row['step_ms']:.0f}",
+            "-" if row["cameras_per_actor"] is None else str(row["cameras_per_actor"]),
+        ]
+        for row in document["rows"]
+    ]
+    before, after = document["load_average"]
+    cameras = [row["cameras"] for row in document["rows"]]
+    return {
+        "scale_cameras": f"{min(cameras)} to {max(cameras)}",
+        "scale_executor": "in Ray actors" if document["executor"] == "ray" else "in the driver's process",
+        "scale_cpus": str(document["cpus"]),
+        "scale_steps": str(document["steps"]),
+        "scale_warmup": str(document["warmup"]),
+        "scale_load": f"{before:.2f} / {after:.2f}",
+        "scale_table": table(
+            [
+                "cameras",
+                "people",
+                "tracks",
+                "decisions/s",
+                "before",
+                "replayed",
+                "update [ms]",
+                "step [ms]",
+                "cameras per actor",
+            ],
             body,
         ),
     }
