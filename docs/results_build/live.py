@@ -38,7 +38,7 @@ def fields(load: Load) -> dict[str, str]:
         [band, fixed(figures["ms"], 1), fixed(figures["people_height_px"], 1), fixed(figures["recall"], 2)]
         for band, figures in run["detection_by_zoom"].items()
     ]
-    return {
+    return camera_from_the_box_fields(load) | {
         "live_machine": f"{run['cpu_model']}, {run['cores']} cores",
         "live_pace_table": table(["pace", ""], pace),
         "live_score_table": table(["score", ""], score),
@@ -47,6 +47,45 @@ def fields(load: Load) -> dict[str, str]:
             ["the picture's zoom", "detection [ms]", "people found [px tall]", "the learned recall there"], by_zoom
         ),
         "live_gap_offline": points(run["mota_live"] - run["mota_offline"]),
+    }
+
+
+def camera_from_the_box_fields(load: Load) -> dict[str, str]:
+    """``camera calibrate --geometry`` against virtual cameras of hidden geometries: the file's errors."""
+    document = load("camera-from-the-box")
+    body = [
+        [
+            str(run["geometry_seed"]),
+            f"{run['focal_err_max_pct']:.2f} %",
+            f"{run['pan_tilt_err_max_deg']:.2f} deg ({run['pan_tilt_err_scene_max_deg']:.2f})",
+            f"{run['position_err_m']:.3f} m",
+            f"{run['bearing_err_deg']:.3f} deg",
+            f"{run['calibrate_s']:.0f} s",
+        ]
+        for run in document["runs"]
+    ]
+    body.append(
+        [
+            "largest",
+            f"{document['focal_err_max_pct']:.2f} %",
+            f"{document['pan_tilt_err_max_deg']:.2f} deg ({document['pan_tilt_err_scene_max_deg']:.2f})",
+            f"{document['position_err_m']:.3f} m",
+            f"{document['bearing_err_deg']:.3f} deg",
+            "",
+        ]
+    )
+    return {
+        "box_table": table(
+            [
+                "geometry seed",
+                "focal length, largest error over the zoom steps",
+                "pan/tilt mapping over the whole range (over the scene's)",
+                "position",
+                "bearing",
+                "calibration",
+            ],
+            body,
+        )
     }
 
 
