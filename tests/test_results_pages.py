@@ -37,14 +37,14 @@ def test_a_changed_json_value_changes_its_page_and_the_check_names_the_page(buil
     rows = json.loads(data.read_text())
     fix = next(row for row in rows if row["label"] == "fix")
     before = builder_on_a_copy.render("information-gain")
-    assert builder_on_a_copy.pct_pm(fix["mota"], fix["mota_se"]) in before
+    assert builder_on_a_copy.formatting.pct_pm(fix["mota"], fix["mota_se"]) in before
     fix["mota"] = 0.123
     data.write_text(json.dumps(rows))
 
     after = builder_on_a_copy.render("information-gain")
 
     assert after != before
-    assert builder_on_a_copy.pct_pm(0.123, fix["mota_se"]) in after
+    assert builder_on_a_copy.formatting.pct_pm(0.123, fix["mota_se"]) in after
     assert builder_on_a_copy.main(["--check"]) == 1
     assert "information-gain.md" in capsys.readouterr().err
     assert builder_on_a_copy.main([]) == 0
