@@ -26,9 +26,9 @@ univariate one.
 ufuncs (they broadcast); compiled code calls their ``*_scalar`` cores.
 """
 
+import ctypes
 import math
 
-import llvmlite.binding
 import numba
 from numba.extending import get_cython_function_address
 
@@ -39,20 +39,18 @@ SHORTCUT_TOLERANCE = 1e-12
 FAR_SIGMA = 8.0
 SQRT_HALF = math.sqrt(0.5)
 
-# Called by its symbol, not through a ctypes pointer: compiled code that names a symbol can be cached
-# on disk (``cache=True``), code that holds a process's address cannot.
-_OWENS_T_SYMBOL = "ptztrack_scipy_owens_t"
-llvmlite.binding.add_symbol(_OWENS_T_SYMBOL, get_cython_function_address("scipy.special.cython_special", "owens_t"))
-_owens_t = numba.types.ExternalFunction(_OWENS_T_SYMBOL, numba.types.float64(numba.types.float64, numba.types.float64))
+_owens_t = ctypes.CFUNCTYPE(ctypes.c_double, ctypes.c_double, ctypes.c_double)(
+    get_cython_function_address("scipy.special.cython_special", "owens_t")
+)
 
 
-@numba.njit(cache=True)
+@numba.njit
 def _ndtr(x):
     """The standard normal CDF."""
     return 0.5 * math.erfc(-x * SQRT_HALF)
 
 
-@numba.njit(cache=True)
+@numba.njit
 def bivariate_normal_cdf_scalar(h, k, rho):
     """P(X <= h, Y <= k) for standard normals with correlation ``rho``."""
     if h <= -FAR_SIGMA or k <= -FAR_SIGMA:
@@ -76,7 +74,7 @@ def bivariate_normal_cdf_scalar(h, k, rho):
     return min(max(value, 0.0), 1.0)
 
 
-@numba.njit(cache=True)
+@numba.njit
 def _marginal(lower, upper):
     """Phi(upper) - Phi(lower), without calling Phi for bounds beyond FAR_SIGMA."""
     if lower <= -FAR_SIGMA and upper >= FAR_SIGMA:
@@ -84,7 +82,7 @@ def _marginal(lower, upper):
     return (1.0 if upper >= FAR_SIGMA else _ndtr(upper)) - (0.0 if lower <= -FAR_SIGMA else _ndtr(lower))
 
 
-@numba.njit(cache=True)
+@numba.njit
 def rectangle_probability_scalar(mean_u, mean_v, var_u, cov_uv, var_v, low_u, high_u, low_v, high_v):
     """P(low_u <= U <= high_u, low_v <= V <= high_v) for (U, V) Gaussian.
 
@@ -116,9 +114,9 @@ def rectangle_probability_scalar(mean_u, mean_v, var_u, cov_uv, var_v, low_u, hi
     return min(max(value, 0.0), 1.0)
 
 
-bivariate_normal_cdf = numba.vectorize(["float64(float64, float64, float64)"], cache=True)(bivariate_normal_cdf_scalar)
+bivariate_normal_cdf = numba.vectorize(["float64(float64, float64, float64)"])(bivariate_normal_cdf_scalar)
 bivariate_normal_cdf.__doc__ = bivariate_normal_cdf_scalar.__doc__
-gaussian_rectangle_probability = numba.vectorize(["float64(" + ", ".join(["float64"] * 9) + ")"], cache=True)(
+gaussian_rectangle_probability = numba.vectorize(["float64(" + ", ".join(["float64"] * 9) + ")"])(
     rectangle_probability_scalar
 )
 gaussian_rectangle_probability.__doc__ = rectangle_probability_scalar.__doc__

@@ -68,7 +68,7 @@ def action_geometry(camera: PTZCamera, poses, person_height_m: float) -> ActionG
     )
 
 
-@numba.njit(cache=True)
+@numba.njit
 def _predict(H, mean_m, cov_m2, track, V):
     """Equation 9 for one action and track: (u, v, var_u, cov_uv, var_v, w), w > 0 in front.
 
@@ -92,18 +92,18 @@ def _predict(H, mean_m, cov_m2, track, V):
     return u, v, var_u, cov_uv, var_v, w
 
 
-@numba.njit(cache=True)
+@numba.njit
 def _log_det(V):
     return math.log(V[0, 0] * V[1, 1] - V[0, 1] * V[1, 0])
 
 
-@numba.njit(cache=True)
+@numba.njit
 def _information(var_u, cov_uv, var_v, log_det_V):
     """``1/2 log(det Sigma_o / det V)`` (nats) of equation 7 for one action and track."""
     return 0.5 * (math.log(var_u * var_v - cov_uv * cov_uv) - log_det_V)
 
 
-@numba.njit(cache=True)
+@numba.njit
 def _information_if_detected(ground_to_image, actions, mean_m, position_cov_m2, V):
     L, n = actions.shape[0], mean_m.shape[0]
     log_det_V = _log_det(V)
@@ -132,7 +132,7 @@ def information_if_detected_nats(geometry: ActionGeometry, mean_m, position_cov_
     )
 
 
-@numba.njit(cache=True)
+@numba.njit
 def _alpha_closed_form(W, u, v, var_u, cov_uv, var_v, width_px, height_px, realistic, kd, r0_px, plateau):
     """Equation 8 in closed form for one action and track (see :func:`detection_weight_integral`).
 
@@ -173,7 +173,7 @@ def _alpha_closed_form(W, u, v, var_u, cov_uv, var_v, width_px, height_px, reali
     return min(max(value, 0.0), 1.0)
 
 
-@numba.njit(cache=True)
+@numba.njit
 def _integral_terms(
     ground_to_image,
     head_from_feet,
@@ -258,7 +258,7 @@ def detection_weight_integral(
     return detection_weight_and_information_integral(camera, geometry, recall, mean_m, position_cov_m2, V, actions)[0]
 
 
-@numba.njit(cache=True)
+@numba.njit
 def _detection_weight_sampled(
     ground_to_image,
     head_to_image,

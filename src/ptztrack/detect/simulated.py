@@ -30,7 +30,7 @@ from ptztrack.roles import CameraBackend
 from ptztrack.types import Detections, PeopleInView
 
 
-@numba.vectorize(["float64(float64, float64, float64)"], nopython=True, cache=True)
+@numba.vectorize(["float64(float64, float64, float64)"], nopython=True)
 def realistic_recall(height_px, recall_kd, recall_r0_px):
     """``1 - exp(-Kd (r - r0))`` for ``r >= r0``, else 0 (a ufunc that compiled code can call too)."""
     if height_px < recall_r0_px:
