@@ -278,19 +278,16 @@ class Recording(_Strict):
     usually one view of a dataset file (:func:`ptztrack.builders.recording.dataset_scenario` fills this
     section from it).
 
-    With a recording, the camera's position and focal length come from the
-    calibration (``camera.image_size_px`` sets the virtual view), and the
-    action grid's pan and tilt are offsets from the pose that shows the whole
-    recorded frame. Relative paths in a scenario file are relative to it.
+    With a recording, the camera's position and focal length come from the calibration
+    (``camera.image_size_px`` sets the virtual view), and the action grid's pan and tilt are offsets from
+    the pose that shows the whole recorded frame. Relative paths in a scenario file are relative to it.
     ground_truth : the recorded view's annotations, a MOTChallenge file with world x, y in metres in columns
-    8-9 (frames from 1): the people of the run, whom it is scored against.
-    calibration : the recorded view's calibration, a Tsai XML (PETS 2009) or a pinhole JSON (``view``
-    picks its view).
+    8-9 (frames from 1): the people of the run, whom it is scored against. calibration : the recorded
+    view's calibration, a Tsai XML (PETS 2009) or a pinhole JSON (``view`` picks its view).
     video : the recorded video, which the virtual camera's pictures are cut from (None: no pictures; the
     'hog' detector, 'registered' pose feedback and 'spatiogram' measurements need it).
-    occluded_above : the fraction of a person's box (0 to 1) hidden by nearer people above which the
-    person counts as occluded: the 'ideal' detector of a recording does not report them and the recall
-    fit leaves them out.
+    occluded_above : the fraction of a person's box (0 to 1) hidden by nearer people above which a person
+    is occluded: a recording's 'ideal' detector does not report them and the recall fit leaves them out.
     view : the view's key in a pinhole JSON calibration (None: its only view).
     recorded_size_px : the recorded frames' (width, height) (None: read from a Tsai calibration or the video).
     frame_step : the recorded frames between two steps (the scenario's ``frame_rate_hz`` is the step rate).
@@ -369,11 +366,10 @@ class Scenario(_Strict):
     the time the people's walk and the tracker's motion model advance by.
     people : the synthetic crowd (section ``people``); with a ``recording``, its ``width_m`` applies, and its
     ``height_m`` where a rendered recording leaves a person's height unknown.
-    camera : the PTZ camera, its lens and its pose error (section ``camera``).
-    actions : the grid of poses the policies choose from every step (section ``actions``).
-    detector : the detector and what the policies know of it (section ``detector``).
-    tracker : the tracker and its data association (section ``tracker``).
-    control : the information-gain policies' parameters (section ``control``).
+    camera : the PTZ camera, its lens and its pose error (section ``camera``). actions : the grid of poses
+    the policies choose from every step (section ``actions``). detector : the detector and what the
+    policies know of it (section ``detector``). tracker : the tracker and its data association (section
+    ``tracker``). control : the information-gain policies' parameters (section ``control``).
     pose_feedback : which pose the tracker maps detections with (section ``pose_feedback``).
     follow : the follow camera's person, motion limits and particle filter (section ``follow``).
     recording : the recorded view the virtual PTZ camera looks at (section ``recording``; None: the
