@@ -56,7 +56,7 @@ def fields(load: Load) -> dict[str, str]:
     particle = sorted(of("particle"), key=lambda row: row["in_view_fraction"])
     kept = [row for row in particle if row["in_view_fraction"] >= 0.98]
     otb_people = sorted({row["target_id"] for row in summary["otb_people"]})
-    return {
+    return particle_seeds_fields(load) | {
         "follow_people": str(closed[trackers[0]]["people"]),
         "follow_steps": integer(sum(row["steps"] for row in of(trackers[0]))),
         "follow_table": table([""] + trackers, body),
@@ -73,6 +73,27 @@ def fields(load: Load) -> dict[str, str]:
             if row["in_view_fraction"] < 0.98
         ),
     }
+
+
+# Each run and the seed its command gives (``--seed``; the first run takes the default, 0).
+FOLLOW_SEED_RUNS = (("follow", 0), ("follow-particle-seed-1", 1), ("follow-particle-seed-2", 2))
+FOLLOW_SEED_ROWS = (
+    ("in-view fraction", "closed_loop", "in_view_fraction"),
+    ("target point error", "closed_loop", "target_point_error"),
+    ("success AUC", "otb", "success_auc"),
+    ("precision at 20 px", "otb", "precision_20px"),
+)
+
+
+def particle_seeds_fields(load: Load) -> dict[str, str]:
+    """The particle filter's figures at each seed of its draws, and their mean."""
+    runs = [load(run) for run, _ in FOLLOW_SEED_RUNS]
+    seeds = [str(seed) for _, seed in FOLLOW_SEED_RUNS]
+    body = []
+    for name, section, key in FOLLOW_SEED_ROWS:
+        values = [next(row for row in run[section] if row["tracker"] == "particle")[key] for run in runs]
+        body.append([name] + [fixed(value, 3) for value in values] + [fixed(mean(values), 3)])
+    return {"follow_seeds_table": table([""] + [f"seed {seed}" for seed in seeds] + ["mean"], body)}
 
 
 def headline(load: Load) -> list[str]:
