@@ -49,10 +49,10 @@ def _address(camera, password: str = PASSWORD) -> CameraAddress:
 @pytest.mark.slow
 def test_a_live_smpl_run_with_hog_at_half_the_recordings_pace_scores_near_the_offline_run(tmp_path):
     """`ptztrack serve-camera` in a process of its own, as a camera is a machine of its own, the recording
-    at half its pace: the live run scores within 20 points of the offline run of the recording steps its
+    at half its pace: the live run scores within 30 points of the offline run of the recording steps its
     pictures showed (a live run's score depends on its timing, so the bound is looser than the spread of
-    live runs in the docs' Real cameras page, while a run whose pictures are placed wrongly falls far
-    below zero). Half the pace, so that a slower machine running the whole suite keeps up: what is
+    live runs beside the rest of the suite, decision record 0097, while a run whose pictures are placed
+    wrongly falls far below zero). Half the pace, so that a slower machine running the whole suite keeps up: what is
     checked here is where the pictures are placed; the pace and the score at the recording's own pace
     are measured by benchmarks/live_loop.py."""
     log = tmp_path / "truth.csv"
@@ -66,7 +66,7 @@ def test_a_live_smpl_run_with_hog_at_half_the_recordings_pace_scores_near_the_of
     offline = offline_counterpart(scenario, world, live, truth_log)
     offline_mota = episode_metrics(run_episode(offline, "smpl", 0))["mota"]
     assert len(live.capture_time_s) == 300 and np.all(np.isfinite(live.poses))
-    assert abs(live_mota - offline_mota) <= 0.20, (live_mota, offline_mota)
+    assert abs(live_mota - offline_mota) <= 0.30, (live_mota, offline_mota)
 
 
 @pytest.mark.slow
