@@ -29,6 +29,11 @@ def fixed(value: float, digits: int) -> str:
     return f"{value:.{digits}f}"
 
 
+def dimensions(values: Sequence[float]) -> str:
+    """Sizes joined by ' x ': (640, 480) -> '640 x 480', (25.0, 18.0) -> '25 x 18'."""
+    return " x ".join(f"{value:g}" for value in values)
+
+
 def integer(value: float) -> str:
     """A count, rounded, with thousands separated by commas: 12668 -> '12,668'."""
     return f"{round(value):,}"

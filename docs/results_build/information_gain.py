@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 from . import Load
-from .formatting import by_label, fixed, paired, pct, pct_pm, points, span, table
+from .formatting import by_label, dimensions, fixed, paired, pct, pct_pm, points, span, table
 
 PTZ_FIGURES = (
     ("MOTA", "mota"),
@@ -236,9 +236,9 @@ def any_recording_fields(load: Load) -> dict[str, str]:
     recording = document["recording"]
     return {
         "any_recording_seed": str(recording["seed"]),
-        "any_recording_size": " x ".join(str(size) for size in recording["image_size_px"]),
+        "any_recording_size": dimensions(recording["image_size_px"]),
         "any_recording_fps": f"{recording['frame_rate_hz']:g}",
-        "any_recording_area": " x ".join(f"{side:g}" for side in recording["area_m"]),
+        "any_recording_area": dimensions(recording["area_m"]),
         "any_recording_camera": ", ".join(f"{coordinate:g}" for coordinate in recording["camera_position_m"]),
         "any_recording_f": f"{recording['f_px']:g}",
         "any_recording_people": str(recording["people"]),

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from . import Load
-from .formatting import fixed, table
+from .formatting import dimensions, fixed, table
 
 
 def decision_speed_fields(load: Load) -> dict[str, str]:
@@ -35,7 +35,7 @@ def follow_speed_fields(load: Load) -> dict[str, str]:
     speed = load("follow-speed")
     return {
         "follow_speed_steps": str(speed["steps"]),
-        "follow_speed_view": " x ".join(str(size) for size in speed["view_size_px"]),
+        "follow_speed_view": dimensions(speed["view_size_px"]),
         "follow_speed_person": str(speed["person"]),
         "follow_speed_particles": str(speed["particles"]),
         "follow_speed_patches": str(speed["patches"]),
@@ -67,7 +67,7 @@ def registration_speed_fields(load: Load) -> dict[str, str]:
     speed = load("registration-speed")
     return {
         "registration_speed_views": str(speed["views"]),
-        "registration_speed_size": " x ".join(str(size) for size in speed["size_px"]),
+        "registration_speed_size": dimensions(speed["size_px"]),
         "registration_speed_median": fixed(speed["register_ms_median"], 1),
         "registration_speed_p90": fixed(speed["register_ms_p90"], 1),
         "registration_speed_sift": fixed(speed["sift_ms_median"], 1),
@@ -81,7 +81,7 @@ def occupancy_speed_fields(load: Load) -> dict[str, str]:
     stages = speed["stages_ms_per_frame"]
     return {
         "occupancy_speed_views": str(speed["views"]),
-        "occupancy_speed_size": " x ".join(str(size) for size in speed["image_size_px"]),
+        "occupancy_speed_size": dimensions(speed["image_size_px"]),
         "occupancy_speed_frames": str(speed["frames"]),
         "occupancy_speed_lpom_fps": fixed(speed["frames_per_s"], 1),
         "occupancy_speed_lpom_ms": fixed(speed["ms_per_frame_median"], 1),
@@ -95,7 +95,7 @@ def occupancy_speed_fields(load: Load) -> dict[str, str]:
         "occupancy_speed_pom_ms": fixed(speed["pom_ms_per_frame_median"], 1),
         "occupancy_speed_pom_iterations": f"{speed['pom_iterations_mean']:.0f}",
         "occupancy_speed_pom_cells": str(speed["pom_cells"]),
-        "occupancy_speed_pom_working": " x ".join(str(size) for size in speed["pom_working_px"]),
+        "occupancy_speed_pom_working": dimensions(speed["pom_working_px"]),
     }
 
 
@@ -142,18 +142,18 @@ def step_cost_fields(load: Load) -> dict[str, str]:
     }
 
 
-SPEED_PARTS = {
-    "decision-speed": decision_speed_fields,
-    "follow-speed": follow_speed_fields,
-    "msg-speed": msg_speed_fields,
-    "registration-speed": registration_speed_fields,
-    "occupancy-speed": occupancy_speed_fields,
-    "step-cost": step_cost_fields,
-}
+SPEED_PARTS = (
+    decision_speed_fields,
+    follow_speed_fields,
+    msg_speed_fields,
+    registration_speed_fields,
+    occupancy_speed_fields,
+    step_cost_fields,
+)
 
 
 def fields(load: Load) -> dict[str, str]:
     fields: dict[str, str] = {}
-    for part in SPEED_PARTS.values():
+    for part in SPEED_PARTS:
         fields |= part(load)
     return fields
